@@ -1,0 +1,105 @@
+//! Exact point-to-triangle-mesh distance through parry's BVH (f64).
+
+use parry3d_f64::math::Vector;
+use parry3d_f64::query::PointQueryWithLocation as _;
+use parry3d_f64::shape::{TriMesh, TriMeshFlags};
+
+use crate::error::{Error, Result};
+use crate::geometry::{Point3, TriangleMesh, cross, dot, norm, sub};
+
+/// The closest point of the mesh to a query point.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct MeshHit {
+    /// Unsigned Euclidean distance.
+    pub distance: f64,
+    /// The closest point on the surface.
+    pub closest: Point3,
+    /// Index of the triangle the closest point lies on.
+    pub triangle: u32,
+}
+
+/// A triangle mesh indexed for closest-point queries.
+pub struct MeshIndex {
+    trimesh: TriMesh,
+    normals: Vec<Point3>,
+}
+
+impl MeshIndex {
+    /// Builds the BVH. The mesh must be valid ([`TriangleMesh::validate`]).
+    pub fn new(mesh: &TriangleMesh) -> Result<Self> {
+        mesh.validate("mesh")?;
+        let vertices: Vec<Vector> = mesh.vertices.iter().map(|p| Vector::new(p[0], p[1], p[2])).collect();
+        let normals = mesh
+            .triangles
+            .iter()
+            .map(|t| {
+                let c = mesh.corners(t);
+                let n = cross(sub(c[1], c[0]), sub(c[2], c[0]));
+                let l = norm(n);
+                if l > 0.0 { [n[0] / l, n[1] / l, n[2] / l] } else { [0.0; 3] }
+            })
+            .collect();
+        let trimesh = TriMesh::with_flags(vertices, mesh.triangles.clone(), TriMeshFlags::empty())
+            .map_err(|e| Error::Geometry(format!("cannot index the mesh: {e}")))?;
+        Ok(MeshIndex { trimesh, normals })
+    }
+
+    /// The closest surface point to `p`.
+    pub fn closest(&self, p: Point3) -> MeshHit {
+        let q = Vector::new(p[0], p[1], p[2]);
+        let (proj, (triangle, _)) = self.trimesh.project_local_point_and_get_location(q, false);
+        let closest = [proj.point.x, proj.point.y, proj.point.z];
+        MeshHit {
+            distance: norm(sub(p, closest)),
+            closest,
+            triangle,
+        }
+    }
+
+    /// Distance signed by the normal of the closest triangle (positive on the side the
+    /// counter-clockwise normal points to), as CloudCompare's C2M does.
+    pub fn signed(&self, p: Point3, hit: &MeshHit) -> f64 {
+        let n = self.normals.get(hit.triangle as usize).copied().unwrap_or([0.0; 3]);
+        if dot(sub(p, hit.closest), n) < 0.0 { -hit.distance } else { hit.distance }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn tri() -> TriangleMesh {
+        TriangleMesh {
+            vertices: vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]],
+            triangles: vec![[0, 1, 2]],
+        }
+    }
+
+    #[test]
+    fn face_edge_and_vertex_regions() {
+        let idx = MeshIndex::new(&tri()).unwrap();
+        // Face region: straight above the interior.
+        let h = idx.closest([0.25, 0.25, 2.0]);
+        assert!((h.distance - 2.0).abs() < 1e-15);
+        assert!(idx.signed([0.25, 0.25, -2.0], &idx.closest([0.25, 0.25, -2.0])) < 0.0);
+        // Edge region (beyond the hypotenuse x + y = 1): closest point is on the edge.
+        let h = idx.closest([1.0, 1.0, 0.0]);
+        assert!((h.distance - (0.5f64).sqrt()).abs() < 1e-15);
+        // Vertex region (beyond vertex (1,0,0) along +x, and below in y).
+        let h = idx.closest([2.0, -1.0, 1.0]);
+        assert!((h.distance - 3.0f64.sqrt()).abs() < 1e-15, "{}", h.distance);
+        assert_eq!(h.closest, [1.0, 0.0, 0.0]);
+    }
+
+    #[test]
+    fn degenerate_triangle_does_not_break_queries() {
+        let mut m = tri();
+        m.vertices.push([5.0, 0.0, 0.0]);
+        m.vertices.push([6.0, 0.0, 0.0]);
+        m.triangles.push([3, 4, 1]); // collinear: a segment from x=1 to x=6 on the x axis
+        let idx = MeshIndex::new(&m).unwrap();
+        let h = idx.closest([5.5, 0.0, 1.0]);
+        assert!(h.distance.is_finite());
+        assert!((h.distance - 1.0).abs() < 1e-12, "{}", h.distance);
+    }
+}

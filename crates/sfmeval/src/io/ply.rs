@@ -1,0 +1,718 @@
+//! PLY reader (ascii, binary little and big endian), from bytes.
+//!
+//! A hand-written reader rather than `ply-rs`: ply-rs builds a hash map per vertex and was measured
+//! to spend most of 2.2 s on 200k points (shared/TOOLS.md); this reader walks the body once, with a
+//! fixed-stride fast path for binary vertices. `benches/ply_parse.rs` times both.
+//!
+//! Vertices need `x y z` (any scalar type). Colours are taken from `red green blue` (or `r g b`,
+//! `diffuse_red ...`), integer or float 0..1. Faces come from `vertex_indices` or `vertex_index`
+//! (any list types); polygons are fan-triangulated. Every other element and property is skipped.
+
+use crate::error::{Error, Result};
+use crate::geometry::Point3;
+
+const FMT: &str = "PLY";
+
+/// Body encoding of a PLY file.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum PlyEncoding {
+    /// Text body.
+    Ascii,
+    /// Binary, little endian.
+    BinaryLittleEndian,
+    /// Binary, big endian.
+    BinaryBigEndian,
+}
+
+/// What a PLY file holds.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PlyData {
+    /// Body encoding.
+    pub encoding: PlyEncoding,
+    /// Vertex positions.
+    pub vertices: Vec<Point3>,
+    /// Vertex colours, when the vertex element has red/green/blue.
+    pub colors: Option<Vec<[u8; 3]>>,
+    /// Triangles (polygons fan-triangulated).
+    pub triangles: Vec<[u32; 3]>,
+    /// Whether the file has a face element (a mesh) at all.
+    pub has_faces: bool,
+    /// Faces with fewer than 3 vertices, which were skipped.
+    pub skipped_faces: usize,
+    /// `comment` and `obj_info` lines.
+    pub comments: Vec<String>,
+    /// Names of the vertex properties, in file order.
+    pub vertex_properties: Vec<String>,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Scalar {
+    I8,
+    U8,
+    I16,
+    U16,
+    I32,
+    U32,
+    F32,
+    F64,
+}
+
+impl Scalar {
+    fn parse(s: &str) -> Option<Scalar> {
+        Some(match s {
+            "char" | "int8" => Scalar::I8,
+            "uchar" | "uint8" => Scalar::U8,
+            "short" | "int16" => Scalar::I16,
+            "ushort" | "uint16" => Scalar::U16,
+            "int" | "int32" => Scalar::I32,
+            "uint" | "uint32" => Scalar::U32,
+            "float" | "float32" => Scalar::F32,
+            "double" | "float64" => Scalar::F64,
+            _ => return None,
+        })
+    }
+
+    fn size(self) -> usize {
+        match self {
+            Scalar::I8 | Scalar::U8 => 1,
+            Scalar::I16 | Scalar::U16 => 2,
+            Scalar::I32 | Scalar::U32 | Scalar::F32 => 4,
+            Scalar::F64 => 8,
+        }
+    }
+
+    fn is_float(self) -> bool {
+        matches!(self, Scalar::F32 | Scalar::F64)
+    }
+
+    /// Largest value of an integer type (for colour normalisation).
+    fn int_max(self) -> f64 {
+        match self {
+            Scalar::I8 => 127.0,
+            Scalar::U8 => 255.0,
+            Scalar::I16 => 32767.0,
+            Scalar::U16 => 65535.0,
+            Scalar::I32 => 2147483647.0,
+            Scalar::U32 => 4294967295.0,
+            Scalar::F32 | Scalar::F64 => 1.0,
+        }
+    }
+
+    #[inline]
+    fn read(self, b: &[u8], big: bool) -> f64 {
+        // `b` always holds at least `self.size()` bytes (checked by the callers).
+        macro_rules! rd {
+            ($t:ty, $n:expr) => {{
+                let mut a = [0u8; $n];
+                a.copy_from_slice(&b[..$n]);
+                if big {
+                    <$t>::from_be_bytes(a) as f64
+                } else {
+                    <$t>::from_le_bytes(a) as f64
+                }
+            }};
+        }
+        match self {
+            Scalar::I8 => f64::from(b[0] as i8),
+            Scalar::U8 => f64::from(b[0]),
+            Scalar::I16 => rd!(i16, 2),
+            Scalar::U16 => rd!(u16, 2),
+            Scalar::I32 => rd!(i32, 4),
+            Scalar::U32 => rd!(u32, 4),
+            Scalar::F32 => rd!(f32, 4),
+            Scalar::F64 => rd!(f64, 8),
+        }
+    }
+}
+
+#[derive(Debug, Clone)]
+enum Property {
+    Scalar { name: String, ty: Scalar },
+    List { name: String, count: Scalar, item: Scalar },
+}
+
+impl Property {
+    fn name(&self) -> &str {
+        match self {
+            Property::Scalar { name, .. } | Property::List { name, .. } => name,
+        }
+    }
+}
+
+#[derive(Debug, Clone)]
+struct Element {
+    name: String,
+    count: u64,
+    properties: Vec<Property>,
+}
+
+impl Element {
+    /// Byte size of one entry when it has no list property.
+    fn fixed_stride(&self) -> Option<usize> {
+        self.properties.iter().try_fold(0usize, |acc, p| match p {
+            Property::Scalar { ty, .. } => Some(acc + ty.size()),
+            Property::List { .. } => None,
+        })
+    }
+
+    /// Smallest possible byte size of one binary entry.
+    fn min_binary_size(&self) -> usize {
+        self.properties
+            .iter()
+            .map(|p| match p {
+                Property::Scalar { ty, .. } => ty.size(),
+                Property::List { count, .. } => count.size(),
+            })
+            .sum::<usize>()
+            .max(1)
+    }
+
+    fn scalar(&self, names: &[&str]) -> Option<(usize, Scalar)> {
+        self.properties
+            .iter()
+            .enumerate()
+            .find_map(|(i, p)| match p {
+                Property::Scalar { name, ty } if names.contains(&name.as_str()) => Some((i, *ty)),
+                _ => None,
+            })
+    }
+}
+
+struct Header {
+    encoding: PlyEncoding,
+    elements: Vec<Element>,
+    comments: Vec<String>,
+    body_start: usize,
+}
+
+fn parse_header(bytes: &[u8]) -> Result<Header> {
+    if !bytes.starts_with(b"ply") {
+        return Err(Error::malformed(FMT, "does not start with the magic word 'ply'"));
+    }
+    let end = find(bytes, b"end_header").ok_or_else(|| {
+        Error::truncated(FMT, "no 'end_header' line: the header is incomplete")
+    })?;
+    let after = end + b"end_header".len();
+    let body_start = match bytes.get(after..) {
+        Some([b'\r', b'\n', ..]) => after + 2,
+        Some([b'\n', ..]) | Some([b'\r', ..]) => after + 1,
+        Some([]) | None => after,
+        Some(_) => return Err(Error::malformed(FMT, "text after 'end_header' on its line")),
+    };
+    let text = std::str::from_utf8(&bytes[..end])
+        .map_err(|_| Error::malformed(FMT, "header is not valid text"))?;
+    let mut encoding = None;
+    let mut elements: Vec<Element> = Vec::new();
+    let mut comments = Vec::new();
+    for (lineno, raw) in text.lines().enumerate() {
+        let line = raw.trim();
+        let mut words = line.split_whitespace();
+        let Some(keyword) = words.next() else {
+            continue;
+        };
+        let bad = |what: &str| Error::malformed(FMT, format!("header line {}: {what}: '{line}'", lineno + 1));
+        match keyword {
+            "ply" if lineno == 0 => {}
+            "format" => {
+                encoding = Some(match words.next() {
+                    Some("ascii") => PlyEncoding::Ascii,
+                    Some("binary_little_endian") => PlyEncoding::BinaryLittleEndian,
+                    Some("binary_big_endian") => PlyEncoding::BinaryBigEndian,
+                    _ => return Err(bad("unknown format")),
+                });
+            }
+            "comment" | "obj_info" => {
+                comments.push(line[keyword.len()..].trim().to_string());
+            }
+            "element" => {
+                let name = words.next().ok_or_else(|| bad("element without a name"))?;
+                let count = words
+                    .next()
+                    .and_then(|c| c.parse::<u64>().ok())
+                    .ok_or_else(|| bad("element count is not a non-negative integer"))?;
+                elements.push(Element {
+                    name: name.to_string(),
+                    count,
+                    properties: Vec::new(),
+                });
+            }
+            "property" => {
+                let element = elements
+                    .last_mut()
+                    .ok_or_else(|| bad("property before any element"))?;
+                let first = words.next().ok_or_else(|| bad("property without a type"))?;
+                let prop = if first == "list" {
+                    let count = words.next().and_then(Scalar::parse);
+                    let item = words.next().and_then(Scalar::parse);
+                    let name = words.next();
+                    match (count, item, name) {
+                        (Some(count), Some(item), Some(name)) if !count.is_float() => {
+                            Property::List {
+                                name: name.to_string(),
+                                count,
+                                item,
+                            }
+                        }
+                        _ => return Err(bad("bad list property")),
+                    }
+                } else {
+                    let ty = Scalar::parse(first).ok_or_else(|| bad("unknown property type"))?;
+                    let name = words.next().ok_or_else(|| bad("property without a name"))?;
+                    Property::Scalar {
+                        name: name.to_string(),
+                        ty,
+                    }
+                };
+                element.properties.push(prop);
+            }
+            _ => return Err(bad("unknown header keyword")),
+        }
+    }
+    let encoding = encoding.ok_or_else(|| Error::malformed(FMT, "no 'format' line in the header"))?;
+    Ok(Header {
+        encoding,
+        elements,
+        comments,
+        body_start,
+    })
+}
+
+fn find(hay: &[u8], needle: &[u8]) -> Option<usize> {
+    hay.windows(needle.len()).position(|w| w == needle)
+}
+
+/// Where the vertex element's interesting properties are.
+struct VertexLayout {
+    xyz: [(usize, Scalar); 3],
+    rgb: Option<[(usize, Scalar); 3]>,
+}
+
+fn vertex_layout(e: &Element) -> Result<VertexLayout> {
+    let get = |n: &str| {
+        e.scalar(&[n]).ok_or_else(|| {
+            Error::malformed(FMT, format!("vertex element has no scalar property '{n}'"))
+        })
+    };
+    let xyz = [get("x")?, get("y")?, get("z")?];
+    let r = e.scalar(&["red", "r", "diffuse_red"]);
+    let g = e.scalar(&["green", "g", "diffuse_green"]);
+    let b = e.scalar(&["blue", "b", "diffuse_blue"]);
+    let rgb = match (r, g, b) {
+        (Some(r), Some(g), Some(b)) => Some([r, g, b]),
+        _ => None,
+    };
+    Ok(VertexLayout { xyz, rgb })
+}
+
+fn to_u8(v: f64, ty: Scalar) -> u8 {
+    let unit = if ty.is_float() { v } else { v / ty.int_max() };
+    (unit.clamp(0.0, 1.0) * 255.0).round() as u8
+}
+
+fn face_list_index(e: &Element) -> Option<usize> {
+    e.properties.iter().position(|p| {
+        matches!(p, Property::List { name, .. } if name == "vertex_indices" || name == "vertex_index")
+    })
+}
+
+/// Reads a PLY file from bytes.
+pub fn read_ply(bytes: &[u8]) -> Result<PlyData> {
+    let header = parse_header(bytes)?;
+    let body = &bytes[header.body_start.min(bytes.len())..];
+    let vertex_idx = header
+        .elements
+        .iter()
+        .position(|e| e.name == "vertex")
+        .ok_or_else(|| Error::malformed(FMT, "no 'vertex' element"))?;
+    let layout = vertex_layout(&header.elements[vertex_idx])?;
+    let mut out = PlyData {
+        encoding: header.encoding,
+        vertices: Vec::new(),
+        colors: None,
+        triangles: Vec::new(),
+        has_faces: header.elements.iter().any(|e| e.name == "face"),
+        skipped_faces: 0,
+        comments: header.comments.clone(),
+        vertex_properties: header.elements[vertex_idx]
+            .properties
+            .iter()
+            .map(|p| p.name().to_string())
+            .collect(),
+    };
+    match header.encoding {
+        PlyEncoding::Ascii => read_ascii_body(&header, body, &layout, &mut out)?,
+        PlyEncoding::BinaryLittleEndian => read_binary_body(&header, body, &layout, false, &mut out)?,
+        PlyEncoding::BinaryBigEndian => read_binary_body(&header, body, &layout, true, &mut out)?,
+    }
+    crate::geometry::check_finite(FMT, "vertex", &out.vertices)?;
+    let n = out.vertices.len() as u64;
+    if let Some((i, bad)) = out
+        .triangles
+        .iter()
+        .enumerate()
+        .find_map(|(i, t)| t.iter().find(|&&v| u64::from(v) >= n).map(|b| (i, *b)))
+    {
+        return Err(Error::malformed(
+            FMT,
+            format!("face triangle #{i} uses vertex index {bad} but there are {n} vertices"),
+        ));
+    }
+    Ok(out)
+}
+
+fn push_polygon(out: &mut PlyData, poly: &[u32]) {
+    if poly.len() < 3 {
+        out.skipped_faces += 1;
+        return;
+    }
+    for k in 1..poly.len() - 1 {
+        out.triangles.push([poly[0], poly[k], poly[k + 1]]);
+    }
+}
+
+fn read_binary_body(
+    header: &Header,
+    body: &[u8],
+    layout: &VertexLayout,
+    big: bool,
+    out: &mut PlyData,
+) -> Result<()> {
+    let mut pos = 0usize;
+    for element in &header.elements {
+        let remaining = body.len().saturating_sub(pos) as u64;
+        let min = element.min_binary_size() as u64;
+        if element.count > remaining / min {
+            return Err(Error::CountMismatch {
+                format: FMT,
+                what: element_what(&element.name),
+                declared: element.count,
+                available: remaining / min,
+            });
+        }
+        let count = element.count as usize;
+        if element.name == "vertex" {
+            let stride = element.fixed_stride().ok_or_else(|| {
+                Error::unsupported(FMT, "list properties in the vertex element are not supported")
+            })?;
+            let offsets = prefix_offsets(element);
+            let mut vertices = Vec::with_capacity(count);
+            let mut colors = layout.rgb.map(|_| Vec::with_capacity(count));
+            let xyz = layout.xyz.map(|(i, ty)| (offsets[i], ty));
+            let rgb = layout.rgb.map(|c| c.map(|(i, ty)| (offsets[i], ty)));
+            let data = body
+                .get(pos..pos + stride * count)
+                .ok_or_else(|| Error::truncated(FMT, "vertex data ends early"))?;
+            for rec in data.chunks_exact(stride) {
+                vertices.push(xyz.map(|(o, ty)| ty.read(&rec[o..], big)));
+                if let (Some(colors), Some(rgb)) = (colors.as_mut(), rgb) {
+                    colors.push(rgb.map(|(o, ty)| to_u8(ty.read(&rec[o..], big), ty)));
+                }
+            }
+            pos += stride * count;
+            out.vertices = vertices;
+            out.colors = colors;
+        } else if let Some(stride) = element.fixed_stride() {
+            let len = stride
+                .checked_mul(count)
+                .filter(|&l| pos + l <= body.len())
+                .ok_or_else(|| Error::truncated(FMT, format!("'{}' data ends early", element.name)))?;
+            pos += len;
+        } else {
+            let face_list = (element.name == "face")
+                .then(|| face_list_index(element))
+                .flatten();
+            let mut poly: Vec<u32> = Vec::new();
+            if face_list.is_some() {
+                out.triangles.reserve(count);
+            }
+            for entry in 0..count {
+                for (pi, prop) in element.properties.iter().enumerate() {
+                    match prop {
+                        Property::Scalar { ty, .. } => {
+                            pos += ty.size();
+                        }
+                        Property::List { count: cty, item, .. } => {
+                            let n = body
+                                .get(pos..pos + cty.size())
+                                .map(|b| cty.read(b, big))
+                                .ok_or_else(|| truncated_entry(element, entry))?;
+                            pos += cty.size();
+                            if n < 0.0 {
+                                return Err(Error::malformed(
+                                    FMT,
+                                    format!("negative list length in '{}' #{entry}", element.name),
+                                ));
+                            }
+                            let n = n as usize;
+                            let bytes_needed = n
+                                .checked_mul(item.size())
+                                .filter(|&l| pos + l <= body.len())
+                                .ok_or_else(|| truncated_entry(element, entry))?;
+                            if Some(pi) == face_list {
+                                poly.clear();
+                                for k in 0..n {
+                                    let v = item.read(&body[pos + k * item.size()..], big);
+                                    if v < 0.0 || v.fract() != 0.0 || v > f64::from(u32::MAX) {
+                                        return Err(Error::malformed(
+                                            FMT,
+                                            format!("face #{entry} has vertex index {v}"),
+                                        ));
+                                    }
+                                    poly.push(v as u32);
+                                }
+                                push_polygon(out, &poly);
+                            }
+                            pos += bytes_needed;
+                        }
+                    }
+                }
+                if pos > body.len() {
+                    return Err(truncated_entry(element, entry));
+                }
+            }
+        }
+    }
+    Ok(())
+}
+
+fn truncated_entry(element: &Element, entry: usize) -> Error {
+    Error::truncated(
+        FMT,
+        format!(
+            "'{}' entry #{entry} of {} ends early",
+            element.name, element.count
+        ),
+    )
+}
+
+fn element_what(name: &str) -> &'static str {
+    match name {
+        "vertex" => "vertices",
+        "face" => "faces",
+        _ => "elements",
+    }
+}
+
+fn prefix_offsets(e: &Element) -> Vec<usize> {
+    let mut offsets = Vec::with_capacity(e.properties.len());
+    let mut o = 0;
+    for p in &e.properties {
+        offsets.push(o);
+        if let Property::Scalar { ty, .. } = p {
+            o += ty.size();
+        }
+    }
+    offsets
+}
+
+struct Tokens<'a> {
+    text: &'a [u8],
+    pos: usize,
+}
+
+impl<'a> Tokens<'a> {
+    #[inline]
+    fn next(&mut self) -> Option<&'a [u8]> {
+        let t = self.text;
+        while self.pos < t.len() && t[self.pos].is_ascii_whitespace() {
+            self.pos += 1;
+        }
+        if self.pos >= t.len() {
+            return None;
+        }
+        let start = self.pos;
+        while self.pos < t.len() && !t[self.pos].is_ascii_whitespace() {
+            self.pos += 1;
+        }
+        Some(&t[start..self.pos])
+    }
+
+    fn number(&mut self, element: &Element, entry: usize) -> Result<f64> {
+        let tok = self.next().ok_or_else(|| truncated_entry(element, entry))?;
+        parse_number(tok).ok_or_else(|| {
+            Error::malformed(
+                FMT,
+                format!(
+                    "'{}' #{entry}: '{}' is not a number",
+                    element.name,
+                    String::from_utf8_lossy(&tok[..tok.len().min(32)])
+                ),
+            )
+        })
+    }
+}
+
+fn parse_number(tok: &[u8]) -> Option<f64> {
+    std::str::from_utf8(tok).ok()?.parse::<f64>().ok()
+}
+
+fn read_ascii_body(header: &Header, body: &[u8], layout: &VertexLayout, out: &mut PlyData) -> Result<()> {
+    let mut tokens = Tokens { text: body, pos: 0 };
+    for element in &header.elements {
+        // Each entry needs at least one token of at least 2 bytes ("0 " or "0\n").
+        let available = (body.len().saturating_sub(tokens.pos) as u64 + 1) / 2;
+        let per_entry = element.properties.len().max(1) as u64;
+        if element.count > available / per_entry {
+            return Err(Error::CountMismatch {
+                format: FMT,
+                what: element_what(&element.name),
+                declared: element.count,
+                available: available / per_entry,
+            });
+        }
+        let count = element.count as usize;
+        let is_vertex = element.name == "vertex";
+        let face_list = (element.name == "face")
+            .then(|| face_list_index(element))
+            .flatten();
+        if is_vertex {
+            out.vertices.reserve(count);
+            if layout.rgb.is_some() {
+                out.colors = Some(Vec::with_capacity(count));
+            }
+        }
+        let mut values = vec![0.0f64; element.properties.len()];
+        let mut poly: Vec<u32> = Vec::new();
+        for entry in 0..count {
+            for (pi, prop) in element.properties.iter().enumerate() {
+                match prop {
+                    Property::Scalar { .. } => {
+                        values[pi] = if is_vertex {
+                            tokens.number(element, entry)?
+                        } else {
+                            tokens.next().ok_or_else(|| truncated_entry(element, entry))?;
+                            0.0
+                        };
+                    }
+                    Property::List { .. } => {
+                        let n = tokens.number(element, entry)?;
+                        if n < 0.0 || n.fract() != 0.0 {
+                            return Err(Error::malformed(
+                                FMT,
+                                format!("'{}' #{entry}: bad list length {n}", element.name),
+                            ));
+                        }
+                        let n = n as usize;
+                        if Some(pi) == face_list {
+                            poly.clear();
+                            for _ in 0..n {
+                                let v = tokens.number(element, entry)?;
+                                if v < 0.0 || v.fract() != 0.0 || v > f64::from(u32::MAX) {
+                                    return Err(Error::malformed(
+                                        FMT,
+                                        format!("face #{entry} has vertex index {v}"),
+                                    ));
+                                }
+                                poly.push(v as u32);
+                            }
+                            push_polygon(out, &poly);
+                        } else {
+                            for _ in 0..n {
+                                tokens.next().ok_or_else(|| truncated_entry(element, entry))?;
+                            }
+                        }
+                    }
+                }
+            }
+            if is_vertex {
+                out.vertices.push(layout.xyz.map(|(i, _)| values[i]));
+                if let (Some(colors), Some(rgb)) = (out.colors.as_mut(), layout.rgb) {
+                    colors.push(rgb.map(|(i, ty)| to_u8(values[i], ty)));
+                }
+            }
+        }
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const ASCII_QUAD: &str = "ply\r\nformat ascii 1.0\r\ncomment made by hand\r\nobj_info test\r\nelement vertex 4\r\nproperty float x\r\nproperty float y\r\nproperty float z\r\nproperty uchar red\r\nproperty uchar green\r\nproperty uchar blue\r\nelement face 1\r\nproperty list uchar int vertex_indices\r\nend_header\r\n0 0 0 255 0 0\r\n1 0 0 0 255 0\r\n1 1 0 0 0 255\r\n0 1 0 10 20 30\r\n4 0 1 2 3\r\n";
+
+    #[test]
+    fn ascii_crlf_quad_is_fan_triangulated() {
+        let ply = read_ply(ASCII_QUAD.as_bytes()).unwrap();
+        assert_eq!(ply.vertices.len(), 4);
+        assert_eq!(ply.triangles, vec![[0, 1, 2], [0, 2, 3]]);
+        assert_eq!(ply.colors.as_ref().unwrap()[3], [10, 20, 30]);
+        assert_eq!(ply.comments, vec!["made by hand", "test"]);
+        assert!(ply.has_faces);
+    }
+
+    fn binary_cloud(big: bool, n: u32) -> Vec<u8> {
+        let fmt = if big { "binary_big_endian" } else { "binary_little_endian" };
+        let mut b = format!(
+            "ply\nformat {fmt} 1.0\nelement vertex {n}\nproperty double x\nproperty float y\nproperty short z\nproperty ushort red\nproperty ushort green\nproperty ushort blue\nelement extra 1\nproperty list uint uchar junk\nend_header\n"
+        )
+        .into_bytes();
+        for i in 0..n {
+            let f = f64::from(i);
+            if big {
+                b.extend(f.to_be_bytes());
+                b.extend((f as f32 * 2.0).to_be_bytes());
+                b.extend((-(i as i16)).to_be_bytes());
+                b.extend(65535u16.to_be_bytes());
+                b.extend(0u16.to_be_bytes());
+                b.extend(32768u16.to_be_bytes());
+            } else {
+                b.extend(f.to_le_bytes());
+                b.extend((f as f32 * 2.0).to_le_bytes());
+                b.extend((-(i as i16)).to_le_bytes());
+                b.extend(65535u16.to_le_bytes());
+                b.extend(0u16.to_le_bytes());
+                b.extend(32768u16.to_le_bytes());
+            }
+        }
+        if big {
+            b.extend(2u32.to_be_bytes());
+        } else {
+            b.extend(2u32.to_le_bytes());
+        }
+        b.extend([7u8, 8u8]);
+        b
+    }
+
+    #[test]
+    fn binary_both_endians_mixed_types() {
+        for big in [false, true] {
+            let ply = read_ply(&binary_cloud(big, 5)).unwrap();
+            assert_eq!(ply.vertices[3], [3.0, 6.0, -3.0]);
+            assert_eq!(ply.colors.as_ref().unwrap()[1], [255, 0, 128]);
+            assert!(!ply.has_faces);
+        }
+    }
+
+    #[test]
+    fn truncated_binary_is_an_error() {
+        let b = binary_cloud(false, 5);
+        let err = read_ply(&b[..b.len() - 30]).unwrap_err();
+        assert!(matches!(err, Error::CountMismatch { .. } | Error::Truncated { .. }), "{err}");
+    }
+
+    #[test]
+    fn huge_count_is_refused_without_allocating() {
+        let b = b"ply\nformat binary_little_endian 1.0\nelement vertex 18446744073709551615\nproperty float x\nproperty float y\nproperty float z\nend_header\n\0\0\0\0";
+        assert!(matches!(read_ply(b), Err(Error::CountMismatch { .. })));
+        let a = b"ply\nformat ascii 1.0\nelement vertex 4000000000\nproperty float x\nproperty float y\nproperty float z\nend_header\n1 2 3\n";
+        assert!(matches!(read_ply(a), Err(Error::CountMismatch { .. })));
+    }
+
+    #[test]
+    fn nan_and_bad_index_are_errors() {
+        let nan = "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\nproperty float z\nend_header\nnan 0 0\n";
+        assert!(matches!(read_ply(nan.as_bytes()), Err(Error::NonFinite { .. })));
+        let idx = "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\nelement face 1\nproperty list uchar uint vertex_index\nend_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 3\n";
+        assert!(matches!(read_ply(idx.as_bytes()), Err(Error::Malformed { .. })));
+    }
+
+    #[test]
+    fn garbage_is_malformed() {
+        assert!(matches!(read_ply(b"hello"), Err(Error::Malformed { .. })));
+        assert!(matches!(read_ply(b"ply\nformat ascii 1.0\n"), Err(Error::Truncated { .. })));
+        let no_x = "ply\nformat ascii 1.0\nelement vertex 1\nproperty float a\nend_header\n1\n";
+        assert!(matches!(read_ply(no_x.as_bytes()), Err(Error::Malformed { .. })));
+    }
+}

@@ -1,0 +1,54 @@
+//! Exports: the reconstruction coloured by error (binary PLY with a `distance` scalar) and
+//! per-point distances (CSV). Both return bytes; front ends write them to disk atomically.
+
+use std::fmt::Write as _;
+
+use crate::colormap::distance_color;
+use crate::evaluate::{Evaluation, PointStatus};
+
+/// Binary little-endian PLY of every kept point in the ground-truth frame, coloured by its
+/// distance clipped at `clip` (viridis), with `float distance` (and `float signed_distance`).
+pub fn colored_ply(eval: &Evaluation, clip: f64) -> Vec<u8> {
+    let kept: Vec<usize> = (0..eval.points_in_gt.len()).filter(|&i| eval.status[i] == PointStatus::Kept).collect();
+    let signed = eval.signed_distances.as_ref();
+    let mut header = format!(
+        "ply\nformat binary_little_endian 1.0\ncomment sfmeval {} error heat map, distances clipped at {clip} for colour\nelement vertex {}\nproperty double x\nproperty double y\nproperty double z\nproperty uchar red\nproperty uchar green\nproperty uchar blue\nproperty float distance\n",
+        env!("CARGO_PKG_VERSION"),
+        kept.len()
+    );
+    if signed.is_some() {
+        header.push_str("property float signed_distance\n");
+    }
+    header.push_str("end_header\n");
+    let mut out = header.into_bytes();
+    out.reserve(kept.len() * 35);
+    for i in kept {
+        for c in eval.points_in_gt[i] {
+            out.extend(c.to_le_bytes());
+        }
+        out.extend(distance_color(eval.distances[i], clip));
+        out.extend((eval.distances[i] as f32).to_le_bytes());
+        if let Some(s) = signed {
+            out.extend((s[i] as f32).to_le_bytes());
+        }
+    }
+    out
+}
+
+/// CSV with one row per reconstructed point: index, position in the ground-truth frame,
+/// distance, signed distance (empty when not computed) and status (`kept`, `outside_volume`,
+/// `too_far`).
+pub fn distances_csv(eval: &Evaluation) -> String {
+    let mut s = String::with_capacity(eval.points_in_gt.len() * 64);
+    s.push_str("index,x,y,z,distance,signed_distance,status\n");
+    for (i, p) in eval.points_in_gt.iter().enumerate() {
+        let signed = eval.signed_distances.as_ref().map(|v| v[i].to_string()).unwrap_or_default();
+        let status = match eval.status[i] {
+            PointStatus::Kept => "kept",
+            PointStatus::OutsideVolume => "outside_volume",
+            PointStatus::TooFar => "too_far",
+        };
+        let _ = writeln!(s, "{i},{},{},{},{},{signed},{status}", p[0], p[1], p[2], eval.distances[i]);
+    }
+    s
+}

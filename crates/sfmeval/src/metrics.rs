@@ -1,0 +1,37 @@
+//! Precision, recall and F-score at a distance threshold, as the Tanks and Temples evaluation
+//! defines them: a distance counts when it is strictly below tau.
+
+/// Share of `distances` strictly below `tau` (0 for an empty list).
+pub fn share_below(distances: &[f64], tau: f64) -> f64 {
+    if distances.is_empty() {
+        return 0.0;
+    }
+    distances.iter().filter(|&&d| d < tau).count() as f64 / distances.len() as f64
+}
+
+/// Harmonic mean 2PR/(P+R), 0 when both are 0.
+pub fn f_score(precision: f64, recall: f64) -> f64 {
+    if precision + recall > 0.0 {
+        2.0 * precision * recall / (precision + recall)
+    } else {
+        0.0
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn hand_counted() {
+        let acc = [0.1, 0.2, 0.3, 0.4];
+        let comp = [0.05, 0.5, 0.5, 0.5, 0.5];
+        let p = share_below(&acc, 0.3); // 0.1, 0.2 → 2/4 (0.3 is not strictly below)
+        let r = share_below(&comp, 0.3); // 1/5
+        assert_eq!(p, 0.5);
+        assert_eq!(r, 0.2);
+        assert!((f_score(p, r) - 2.0 * 0.5 * 0.2 / 0.7).abs() < 1e-15);
+        assert_eq!(f_score(0.0, 0.0), 0.0);
+        assert_eq!(share_below(&[], 1.0), 0.0);
+    }
+}

@@ -1,0 +1,231 @@
+//! The `sfmeval.report/1` JSON report (see `schemas/report.schema.json`). Every front end writes
+//! this shape; fields may be added, none renamed without a schema bump.
+
+use serde::{Deserialize, Serialize};
+
+use crate::stats::Statistics;
+
+/// Schema id of reports.
+pub const REPORT_SCHEMA: &str = "sfmeval.report/1";
+
+/// The whole report.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Report {
+    /// Always [`REPORT_SCHEMA`].
+    pub schema: String,
+    /// The program that wrote it.
+    pub tool: Tool,
+    /// What was measured.
+    pub inputs: Inputs,
+    /// Every option that changes a number.
+    pub options: ReportOptions,
+    /// The crop applied.
+    pub crop: CropReport,
+    /// The transform that took the reconstruction into the ground-truth frame.
+    pub alignment: AlignmentReport,
+    /// Reconstruction → ground truth distances.
+    pub accuracy: AccuracyReport,
+    /// Ground truth → reconstruction distances.
+    pub completeness: CompletenessReport,
+    /// Precision / recall / F-score per threshold.
+    pub thresholds: Vec<ThresholdReport>,
+    /// Camera pose errors (null when no cameras were given).
+    pub cameras: Option<serde_json::Value>,
+    /// Things the user should know.
+    pub warnings: Vec<String>,
+}
+
+/// Name and version of the writer.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Tool {
+    /// `"sfmeval"`.
+    pub name: String,
+    /// Crate version.
+    pub version: String,
+}
+
+impl Default for Tool {
+    fn default() -> Self {
+        Tool {
+            name: "sfmeval".into(),
+            version: env!("CARGO_PKG_VERSION").into(),
+        }
+    }
+}
+
+/// Both inputs.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Inputs {
+    /// The reconstruction.
+    pub reconstruction: ReconstructionInput,
+    /// The ground truth.
+    pub ground_truth: GroundTruthInput,
+}
+
+/// The reconstruction as read.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ReconstructionInput {
+    /// File name (no folders).
+    pub name: String,
+    /// `ply`, `colmap`, `nvm`, ...
+    pub format: String,
+    /// Points read.
+    pub points: u64,
+    /// Registered images (0 for a bare cloud).
+    pub images: u64,
+}
+
+/// The ground truth as read.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct GroundTruthInput {
+    /// File name (no folders).
+    pub name: String,
+    /// `glb`, `gltf`, `ply`, `obj`.
+    pub format: String,
+    /// Vertices (or points of a cloud).
+    pub vertices: u64,
+    /// Triangles (0 for a cloud).
+    pub triangles: u64,
+    /// Length of the bounding-box diagonal, in ground-truth units.
+    pub diagonal: f64,
+    /// Surface area (0 for a cloud).
+    pub area: f64,
+}
+
+/// Options that change numbers.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ReportOptions {
+    /// Completeness samples requested on a mesh.
+    pub samples: u64,
+    /// Seed of the surface sampler.
+    pub seed: u64,
+    /// Whether signed accuracy was computed.
+    pub signed: bool,
+    /// Histogram bins.
+    pub histogram_bins: u64,
+    /// Thresholds given in ground-truth units.
+    pub tau: Vec<f64>,
+    /// Thresholds given in percent of the ground-truth diagonal.
+    pub tau_percent_of_diagonal: Vec<f64>,
+    /// Requested alignment method.
+    pub align: String,
+}
+
+/// What the crop did.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct CropReport {
+    /// `none`, `box`, `oriented_box`, `sphere`, `max_distance`, or `<volume>+max_distance`.
+    pub kind: String,
+    /// Reconstructed points kept.
+    pub kept: u64,
+    /// Reconstructed points discarded (all reasons).
+    pub discarded: u64,
+    /// Discarded because outside the volume.
+    pub discarded_outside_volume: u64,
+    /// Discarded because farther than `max_distance` from the ground truth.
+    pub discarded_farther_than_max_distance: u64,
+    /// The volume, as in the crop file.
+    pub volume: Option<crate::crop::Volume>,
+    /// The distance limit.
+    pub max_distance: Option<f64>,
+    /// Ground-truth samples inside the volume (used for completeness).
+    pub ground_truth_samples_kept: u64,
+}
+
+/// One stage of the alignment.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct AlignmentStage {
+    /// `given`, `cameras`, `points`, `global`, `icp`.
+    pub method: String,
+    /// The transform after this stage.
+    pub gt_from_recon: [[f64; 4]; 4],
+    /// Its scale.
+    pub scale: f64,
+    /// Root mean square residual of the stage's correspondences.
+    pub rmse: Option<f64>,
+    /// Share of correspondences kept as inliers.
+    pub inlier_ratio: Option<f64>,
+    /// Iterations run.
+    pub iterations: u64,
+    /// Whether the stage met its stopping criterion.
+    pub converged: bool,
+    /// Why the stage was rejected or what it fell back to, if anything.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub note: Option<String>,
+}
+
+/// The final transform and how it was found.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct AlignmentReport {
+    /// `none`, `given`, `cameras`, `icp`, `global`, `cameras+icp`, ...
+    pub method: String,
+    /// Row-major 4×4 mapping the reconstruction into the ground-truth frame.
+    pub gt_from_recon: [[f64; 4]; 4],
+    /// Scale of the transform.
+    pub scale: f64,
+    /// Residual of the last stage (null when no stage measured one).
+    pub rmse: Option<f64>,
+    /// Inlier share of the last stage.
+    pub inlier_ratio: Option<f64>,
+    /// Iterations over all stages.
+    pub iterations: u64,
+    /// Whether every stage converged.
+    pub converged: bool,
+    /// One entry per stage.
+    pub stages: Vec<AlignmentStage>,
+}
+
+/// Reconstruction → ground-truth distance statistics.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct AccuracyReport {
+    /// Always `reconstruction_to_ground_truth`.
+    pub direction: String,
+    /// `point_to_triangle` (mesh GT) or `point_to_point` (cloud GT).
+    pub metric: String,
+    /// Statistics of the unsigned distances of kept points.
+    #[serde(flatten)]
+    pub stats: Statistics,
+    /// Statistics of signed distances (by the closest triangle's normal), when asked for.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub signed: Option<Statistics>,
+}
+
+/// Ground-truth → reconstruction distance statistics.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct CompletenessReport {
+    /// Always `ground_truth_to_reconstruction`.
+    pub direction: String,
+    /// `surface_samples` (mesh GT) or `ground_truth_points` (cloud GT).
+    pub source: String,
+    /// Ground-truth points measured (inside the crop volume).
+    pub samples: u64,
+    /// Seed of the surface sampler.
+    pub seed: u64,
+    /// Statistics of the distances.
+    #[serde(flatten)]
+    pub stats: Statistics,
+}
+
+/// Precision, recall and F-score at one threshold.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ThresholdReport {
+    /// Threshold in ground-truth units.
+    pub tau: f64,
+    /// Threshold as a fraction of the ground-truth diagonal.
+    pub tau_relative_to_diagonal: f64,
+    /// Share of kept reconstructed points closer than tau to the ground truth.
+    pub precision: f64,
+    /// Share of ground-truth samples closer than tau to the reconstruction.
+    pub recall: f64,
+    /// 2PR / (P + R), 0 when both are 0.
+    pub f_score: f64,
+}
+
+impl Report {
+    /// Pretty JSON with a trailing newline; the same report always gives the same bytes.
+    pub fn to_json(&self) -> String {
+        let mut s = serde_json::to_string_pretty(self).unwrap_or_default();
+        s.push('\n');
+        s
+    }
+}
