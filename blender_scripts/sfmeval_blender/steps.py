@@ -100,67 +100,85 @@ def reset_scene():
 
 
 # -- step 1: import object --------------------------------------------------------------------
+def _ramp(nodes, links, fac, positions, colors):
+    ramp = nodes.new("ShaderNodeValToRGB")
+    els = ramp.color_ramp.elements
+    els[0].position, els[1].position = positions
+    els[0].color = list(colors[0]) + [1.0]
+    els[1].color = list(colors[1]) + [1.0]
+    links.new(fac, ramp.inputs["Fac"])
+    return ramp.outputs["Color"]
+
+
+def _math(nodes, links, op, a, b=None, c=None):
+    n = nodes.new("ShaderNodeMath")
+    n.operation = op
+    for i, v in enumerate((a, b, c)):
+        if v is None:
+            continue
+        if isinstance(v, (int, float)):
+            n.inputs[i].default_value = v
+        else:
+            links.new(v, n.inputs[i])
+    return n.outputs[0]
+
+
 def _material_from_desc(desc, cfg_obj):
+    """A Principled material whose colour is a procedural texture of *object* coordinates, so
+    the texture sticks to the surface in every view (no UVs needed).
+
+    colour = ramp(coarse pattern → colour_a/colour_b) × ramp(fine noise → grey/white)
+    """
     mat = bpy.data.materials.new(desc["name"])
     compat.use_nodes(mat)
     nt = mat.node_tree
     nodes, links = nt.nodes, nt.links
     bsdf = nodes.get("Principled BSDF") or nodes.new("ShaderNodeBsdfPrincipled")
     texco = nodes.new("ShaderNodeTexCoord")
-    mapping = nodes.new("ShaderNodeMapping")
-    scale = desc["scale"] * cfg_obj["texture_scale"]
-    compat.set_input(mapping, ["Scale"], (scale, scale, scale))
-    links.new(texco.outputs["Object"], mapping.inputs["Vector"])
-    pattern = desc["pattern"]
-    noise = nodes.new("ShaderNodeTexNoise")
-    compat.set_input(noise, ["Detail"], 8.0)
-    compat.set_input(noise, ["Roughness"], 0.6)
-    compat.set_input(noise, ["Scale"], 1.0)
-    links.new(mapping.outputs["Vector"], noise.inputs["Vector"])
-    fac = noise.outputs["Fac"]
-    if pattern in ("voronoi", "marble", "bands"):
-        vor = nodes.new("ShaderNodeTexVoronoi")
-        compat.set_input(vor, ["Scale"], 1.5 if pattern != "voronoi" else 1.0)
-        links.new(mapping.outputs["Vector"], vor.inputs["Vector"])
-        add = nodes.new("ShaderNodeMath")
-        add.operation = "MULTIPLY_ADD" if "MULTIPLY_ADD" in compat.enum_items(add, "operation") else "ADD"
-        if pattern == "bands":
-            # stripes along z of the object + noise: sin(z·k + noise)
-            sep = nodes.new("ShaderNodeSeparateXYZ")
-            links.new(mapping.outputs["Vector"], sep.inputs[0])
-            wav = nodes.new("ShaderNodeMath")
-            wav.operation = "SINE"
-            madd = nodes.new("ShaderNodeMath")
-            madd.operation = "MULTIPLY_ADD"
-            links.new(sep.outputs[2], madd.inputs[0])
-            madd.inputs[1].default_value = 3.0
-            links.new(noise.outputs["Fac"], madd.inputs[2])
-            links.new(madd.outputs[0], wav.inputs[0])
-            links.new(wav.outputs[0], add.inputs[0])
-            add.inputs[1].default_value = 0.5
-            links.new(vor.outputs["Distance"], add.inputs[2])
-        else:
-            links.new(noise.outputs["Fac"], add.inputs[0])
-            add.inputs[1].default_value = 1.0
-            links.new(vor.outputs["Distance"], add.inputs[2])
-        fac = add.outputs[0]
-        norm = nodes.new("ShaderNodeMapRange")
-        compat.set_input(norm, ["From Min"], 0.2 if pattern != "bands" else -1.0)
-        compat.set_input(norm, ["From Max"], 1.3 if pattern != "bands" else 1.5)
-        links.new(fac, norm.inputs[0])
-        fac = norm.outputs[0]
-    ramp = nodes.new("ShaderNodeValToRGB")
+    s = desc["scale"] * cfg_obj["texture_scale"]
+    vec = texco.outputs["Object"]
     contrast = desc["contrast"] if cfg_obj["texture_contrast"] < 0 else cfg_obj["texture_contrast"]
+
+    def noise(scale, detail):
+        n = nodes.new("ShaderNodeTexNoise")
+        compat.set_input(n, ["Scale"], scale)
+        compat.set_input(n, ["Detail"], detail)
+        compat.set_input(n, ["Roughness"], 0.6)
+        links.new(vec, n.inputs["Vector"])
+        return n.outputs["Fac"]
+
+    pattern = desc["pattern"]
+    if pattern == "voronoi":
+        vor = nodes.new("ShaderNodeTexVoronoi")
+        compat.set_input(vor, ["Scale"], s)
+        links.new(vec, vor.inputs["Vector"])
+        fac = _math(nodes, links, "MULTIPLY_ADD", vor.outputs["Distance"], 1.2, noise(3 * s, 4))
+        fac = _math(nodes, links, "SUBTRACT", fac, 0.45)
+        positions = (0.25, 0.6)
+    elif pattern in ("bands", "marble"):
+        sep = nodes.new("ShaderNodeSeparateXYZ")
+        links.new(vec, sep.inputs[0])
+        axis = sep.outputs[2] if pattern == "bands" else sep.outputs[0]
+        warp = _math(nodes, links, "MULTIPLY", noise(0.6 * s, 6), 7.0 if pattern == "bands" else 12.0)
+        arg = _math(nodes, links, "MULTIPLY_ADD", axis, 2.0 * s, warp)
+        fac = _math(nodes, links, "MULTIPLY_ADD", _math(nodes, links, "SINE", arg), 0.5, 0.5)
+        positions = (0.3, 0.7)
+    else:
+        fac = noise(s, 8)
+        positions = (0.44, 0.56)
     a, b = desc["color_a"], desc["color_b"]
     mid = [(a[i] + b[i]) / 2 for i in range(3)]
     ca = [mid[i] + (a[i] - mid[i]) * contrast for i in range(3)]
     cb = [mid[i] + (b[i] - mid[i]) * contrast for i in range(3)]
-    ramp.color_ramp.elements[0].position = 0.3
-    ramp.color_ramp.elements[0].color = ca + [1.0]
-    ramp.color_ramp.elements[1].position = 0.7
-    ramp.color_ramp.elements[1].color = cb + [1.0]
-    links.new(fac, ramp.inputs["Fac"])
-    links.new(ramp.outputs["Color"], bsdf.inputs["Base Color"])
+    coarse = _ramp(nodes, links, fac, positions, (ca, cb))
+    lo = 1.0 - 0.55 * contrast
+    fine = _ramp(nodes, links, noise(5.0 * s, 6), (0.4, 0.6), ((lo, lo, lo), (1.0, 1.0, 1.0)))
+    mix, mfac, ma, mb, mout = compat.new_mix_node(nodes)
+    mix.blend_type = "MULTIPLY"
+    mfac.default_value = 1.0
+    links.new(coarse, ma)
+    links.new(fine, mb)
+    links.new(mout, bsdf.inputs["Base Color"])
     compat.set_input(bsdf, ["Roughness"], desc["roughness"])
     compat.set_input(bsdf, ["Metallic"], desc["metallic"])
     compat.set_input(bsdf, ["Specular IOR Level", "Specular"], 0.3)
