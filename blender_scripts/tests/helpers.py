@@ -1,0 +1,74 @@
+"""Numpy helpers for the tests: projection, GLB loading, Umeyama similarity."""
+
+import numpy as np
+
+
+def camera_matrices(cams):
+    cam = cams["cameras"][0]
+    K = np.array([[cam["fx"], 0, cam["cx"]], [0, cam["fy"], cam["cy"]], [0, 0, 1.0]])
+    poses = {}
+    for im in cams["images"]:
+        R = np.array(im["cam_from_world"]["rotation"], dtype=float)
+        t = np.array(im["cam_from_world"]["translation"], dtype=float)
+        poses[im["name"]] = (R, t)
+    return cam, K, poses
+
+
+def project(K, R, t, X):
+    """World points (N,3) → pixel coordinates (N,2) in the COLMAP convention, and depth z."""
+    Xc = X @ R.T + t
+    z = Xc[:, 2]
+    uv = (Xc[:, :2] / z[:, None]) * np.array([K[0, 0], K[1, 1]]) + np.array([K[0, 2], K[1, 2]])
+    return uv, z
+
+
+def glb_vertices(path):
+    """World-space vertices of every mesh in a GLB, node transforms applied (trimesh)."""
+    import trimesh
+    scene = trimesh.load(path, force="scene")
+    meshes = []
+    for node in scene.graph.nodes_geometry:
+        transform, geom_name = scene.graph[node]
+        g = scene.geometry[geom_name]
+        meshes.append(trimesh.transformations.transform_points(g.vertices, transform))
+    return np.vstack(meshes), scene
+
+
+def bilinear(img, u, v):
+    """Sample img (H,W) at continuous pixel coords in the COLMAP convention (pixel centres at
+    +0.5). Returns values and a validity flag (all four neighbours inside and non-zero)."""
+    h, w = img.shape
+    x = u - 0.5
+    y = v - 0.5
+    x0 = np.floor(x).astype(int)
+    y0 = np.floor(y).astype(int)
+    ok = (x0 >= 0) & (y0 >= 0) & (x0 + 1 < w) & (y0 + 1 < h)
+    x0c = np.clip(x0, 0, w - 2)
+    y0c = np.clip(y0, 0, h - 2)
+    fx = x - x0c
+    fy = y - y0c
+    a = img[y0c, x0c]
+    b = img[y0c, x0c + 1]
+    c = img[y0c + 1, x0c]
+    d = img[y0c + 1, x0c + 1]
+    ok &= (a > 0) & (b > 0) & (c > 0) & (d > 0)
+    val = a * (1 - fx) * (1 - fy) + b * fx * (1 - fy) + c * (1 - fx) * fy + d * fx * fy
+    return val, ok
+
+
+def umeyama(src, dst, with_scale=True):
+    """Similarity (s, R, t) minimising ||dst − (s R src + t)||² (Umeyama 1991)."""
+    src = np.asarray(src, float)
+    dst = np.asarray(dst, float)
+    mu_s, mu_d = src.mean(0), dst.mean(0)
+    xs, xd = src - mu_s, dst - mu_d
+    cov = xd.T @ xs / len(src)
+    U, S, Vt = np.linalg.svd(cov)
+    D = np.eye(3)
+    if np.linalg.det(U) * np.linalg.det(Vt) < 0:
+        D[2, 2] = -1
+    R = U @ D @ Vt
+    var_s = (xs ** 2).sum() / len(src)
+    s = np.trace(np.diag(S) @ D) / var_s if with_scale else 1.0
+    t = mu_d - s * R @ mu_s
+    return s, R, t
