@@ -6,7 +6,9 @@ use std::path::{Path, PathBuf};
 use anyhow::{Context as _, Result, bail};
 use clap::{Args, Parser, Subcommand};
 use sfmeval::crop::{Crop, Volume};
-use sfmeval::evaluate::{AlignmentInput, EvalOptions, InputInfo, PreparedGroundTruth, evaluate, DEFAULT_SAMPLES};
+use sfmeval::evaluate::{
+    AlignmentInput, DEFAULT_SAMPLES, EvalOptions, InputInfo, PreparedGroundTruth, evaluate,
+};
 use sfmeval::geometry::{Aabb, GroundTruth};
 use sfmeval::io;
 use sfmeval::transform::Similarity;
@@ -58,20 +60,35 @@ struct EvalArgs {
     #[arg(long, value_name = "FILE", conflicts_with_all = ["crop_box", "crop_sphere"])]
     crop: Option<PathBuf>,
     /// Axis-aligned crop box: xmin,ymin,zmin,xmax,ymax,zmax (ground-truth frame).
-    #[arg(long, value_name = "X0,Y0,Z0,X1,Y1,Z1", value_delimiter = ',', num_args = 6, allow_negative_numbers = true, conflicts_with = "crop_sphere")]
-    crop_box: Option<Vec<f64>>,
+    #[arg(
+        long,
+        value_name = "X0,Y0,Z0,X1,Y1,Z1",
+        allow_hyphen_values = true,
+        conflicts_with = "crop_sphere"
+    )]
+    crop_box: Option<String>,
     /// Crop sphere: cx,cy,cz,radius (ground-truth frame).
-    #[arg(long, value_name = "CX,CY,CZ,R", value_delimiter = ',', num_args = 4, allow_negative_numbers = true)]
-    crop_sphere: Option<Vec<f64>>,
+    #[arg(long, value_name = "CX,CY,CZ,R", allow_hyphen_values = true)]
+    crop_sphere: Option<String>,
     /// Discard reconstructed points farther than D from the ground truth.
-    #[arg(long, value_name = "D")]
+    #[arg(long, value_name = "D", allow_hyphen_values = true)]
     max_distance: Option<f64>,
     /// Thresholds in ground-truth units (comma-separated).
-    #[arg(long, value_name = "LIST", value_delimiter = ',')]
+    #[arg(
+        long,
+        value_name = "LIST",
+        value_delimiter = ',',
+        allow_hyphen_values = true
+    )]
     tau: Vec<f64>,
     /// Thresholds in percent of the ground-truth bounding-box diagonal (comma-separated).
     /// Default when no threshold is given: 0.5,1,2.
-    #[arg(long, value_name = "LIST", value_delimiter = ',')]
+    #[arg(
+        long,
+        value_name = "LIST",
+        value_delimiter = ',',
+        allow_hyphen_values = true
+    )]
     tau_relative: Vec<f64>,
     /// Completeness samples drawn on a ground-truth mesh.
     #[arg(long, value_name = "N", default_value_t = DEFAULT_SAMPLES)]
@@ -113,7 +130,10 @@ pub fn run(cli: Cli) -> Result<()> {
     match cli.command {
         Command::Eval(args) => {
             if let Some(n) = args.threads {
-                rayon::ThreadPoolBuilder::new().num_threads(n.max(1)).build_global().ok();
+                rayon::ThreadPoolBuilder::new()
+                    .num_threads(n.max(1))
+                    .build_global()
+                    .ok();
             }
             eval(&args)
         }
@@ -122,16 +142,41 @@ pub fn run(cli: Cli) -> Result<()> {
     }
 }
 
+/// Parses exactly `N` comma-separated numbers.
+fn numbers<const N: usize>(flag: &str, text: &str) -> Result<[f64; N]> {
+    let v: Vec<f64> = text
+        .split(',')
+        .map(|w| {
+            w.trim()
+                .parse::<f64>()
+                .with_context(|| format!("{flag}: '{w}' is not a number"))
+        })
+        .collect::<Result<_>>()?;
+    v.try_into().map_err(|v: Vec<f64>| {
+        anyhow::anyhow!("{flag} needs {N} comma-separated numbers, got {}", v.len())
+    })
+}
+
 fn crop_from_args(args: &EvalArgs) -> Result<Crop> {
     let mut crop = match &args.crop {
-        Some(path) => Crop::parse(&read(path)?).with_context(|| format!("crop file '{}'", path.display()))?,
+        Some(path) => {
+            Crop::parse(&read(path)?).with_context(|| format!("crop file '{}'", path.display()))?
+        }
         None => Crop::default(),
     };
     if let Some(b) = &args.crop_box {
-        crop.volume = Some(Volume::Box { min: [b[0], b[1], b[2]], max: [b[3], b[4], b[5]] });
+        let b = numbers::<6>("--crop-box", b)?;
+        crop.volume = Some(Volume::Box {
+            min: [b[0], b[1], b[2]],
+            max: [b[3], b[4], b[5]],
+        });
     }
     if let Some(s) = &args.crop_sphere {
-        crop.volume = Some(Volume::Sphere { center: [s[0], s[1], s[2]], radius: s[3] });
+        let s = numbers::<4>("--crop-sphere", s)?;
+        crop.volume = Some(Volume::Sphere {
+            center: [s[0], s[1], s[2]],
+            radius: s[3],
+        });
     }
     if args.max_distance.is_some() {
         crop.max_distance = args.max_distance;
@@ -153,7 +198,8 @@ fn eval(args: &EvalArgs) -> Result<()> {
     options.validate()?;
     let alignment = match &args.transform {
         Some(path) => AlignmentInput::given(
-            Similarity::parse(&read(path)?).with_context(|| format!("transform file '{}'", path.display()))?,
+            Similarity::parse(&read(path)?)
+                .with_context(|| format!("transform file '{}'", path.display()))?,
         ),
         None => AlignmentInput::none(),
     };
@@ -182,7 +228,9 @@ fn eval(args: &EvalArgs) -> Result<()> {
         write_atomic(path, json.as_bytes())?;
     }
     if let Some(path) = &args.colored {
-        let clip = args.color_clip.unwrap_or(report.accuracy.stats.percentiles.p95);
+        let clip = args
+            .color_clip
+            .unwrap_or(report.accuracy.stats.percentiles.p95);
         write_atomic(path, &io::write::colored_ply(&evaluation, clip))?;
     }
     if let Some(path) = &args.csv {
@@ -206,7 +254,12 @@ fn gltf_neighbours(path: &Path, bytes: &[u8]) -> BTreeMap<String, Vec<u8>> {
         return out;
     };
     let dir = path.parent().unwrap_or(Path::new("."));
-    for b in v.get("buffers").and_then(|b| b.as_array()).into_iter().flatten() {
+    for b in v
+        .get("buffers")
+        .and_then(|b| b.as_array())
+        .into_iter()
+        .flatten()
+    {
         if let Some(uri) = b.get("uri").and_then(|u| u.as_str()) {
             if !uri.starts_with("data:") && !uri.contains("..") {
                 if let Ok(data) = std::fs::read(dir.join(uri)) {
@@ -233,7 +286,8 @@ fn info(path: &Path) -> Result<()> {
         }
     }
     let external = gltf_neighbours(path, &bytes);
-    let gt = io::read_ground_truth(&name, &bytes, &external).with_context(|| format!("'{}'", path.display()))?;
+    let gt = io::read_ground_truth(&name, &bytes, &external)
+        .with_context(|| format!("'{}'", path.display()))?;
     let (kind, pts, tris, area) = match &gt.ground_truth {
         GroundTruth::Mesh(m) => ("mesh", m.vertices.len(), m.triangles.len(), m.area()),
         GroundTruth::Cloud(c) => ("point cloud", c.points.len(), 0, 0.0),
@@ -273,7 +327,8 @@ fn demo(json: bool, report_path: Option<&Path>) -> Result<()> {
         warnings: Vec::new(),
     };
     let bars = Bars::new(false);
-    let prepared = PreparedGroundTruth::new(&gt.ground_truth, options.samples, options.seed, &bars)?;
+    let prepared =
+        PreparedGroundTruth::new(&gt.ground_truth, options.samples, options.seed, &bars)?;
     let evaluation = evaluate(&prepared, &recon.cloud, &alignment, &options, &info, &bars)?;
     if let Some(p) = report_path {
         write_atomic(p, evaluation.report.to_json().as_bytes())?;

@@ -15,7 +15,10 @@ pub struct Bars {
 impl Bars {
     /// Bars when stderr is a terminal and not quiet.
     pub fn new(quiet: bool) -> Self {
-        Bars { current: Mutex::new(None), enabled: !quiet && std::io::stderr().is_terminal() }
+        Bars {
+            current: Mutex::new(None),
+            enabled: !quiet && std::io::stderr().is_terminal(),
+        }
     }
 }
 

@@ -18,18 +18,34 @@ fn g(v: f64) -> String {
 pub fn render(r: &Report) -> String {
     let mut s = String::new();
     let i = &r.inputs;
-    let _ = writeln!(s, "sfmeval {}: {} vs {}", r.tool.version, i.reconstruction.name, i.ground_truth.name);
+    let _ = writeln!(
+        s,
+        "sfmeval {}: {} vs {}",
+        r.tool.version, i.reconstruction.name, i.ground_truth.name
+    );
     let _ = writeln!(
         s,
         "ground truth    {} ({}), {} vertices, {} triangles, bbox diagonal {}",
-        i.ground_truth.name, i.ground_truth.format, i.ground_truth.vertices, i.ground_truth.triangles, g(i.ground_truth.diagonal)
+        i.ground_truth.name,
+        i.ground_truth.format,
+        i.ground_truth.vertices,
+        i.ground_truth.triangles,
+        g(i.ground_truth.diagonal)
     );
-    let _ = writeln!(s, "reconstruction  {} ({}), {} points", i.reconstruction.name, i.reconstruction.format, i.reconstruction.points);
+    let _ = writeln!(
+        s,
+        "reconstruction  {} ({}), {} points",
+        i.reconstruction.name, i.reconstruction.format, i.reconstruction.points
+    );
     let c = &r.crop;
     let _ = writeln!(
         s,
         "crop            {}: kept {}, discarded {} (outside volume {}, farther than max distance {})",
-        c.kind, c.kept, c.discarded, c.discarded_outside_volume, c.discarded_farther_than_max_distance
+        c.kind,
+        c.kept,
+        c.discarded,
+        c.discarded_outside_volume,
+        c.discarded_farther_than_max_distance
     );
     let a = &r.alignment;
     let _ = write!(s, "alignment       {} (scale {})", a.method, g(a.scale));
@@ -38,19 +54,44 @@ pub fn render(r: &Report) -> String {
     }
     s.push('\n');
     for (label, st, extra) in [
-        ("accuracy", &r.accuracy.stats, format!("recon → GT, {}", r.accuracy.metric)),
-        ("completeness", &r.completeness.stats, format!("GT → recon, {} samples", r.completeness.samples)),
+        (
+            "accuracy",
+            &r.accuracy.stats,
+            format!("recon → GT, {}", r.accuracy.metric),
+        ),
+        (
+            "completeness",
+            &r.completeness.stats,
+            format!("GT → recon, {} samples", r.completeness.samples),
+        ),
     ] {
         let _ = writeln!(
             s,
             "{label:<15} mean {}  median {}  rms {}  std {}  p90 {}  p99 {}  max {}  ({extra})",
-            g(st.mean), g(st.median), g(st.rms), g(st.std), g(st.percentiles.p90), g(st.percentiles.p99), g(st.max)
+            g(st.mean),
+            g(st.median),
+            g(st.rms),
+            g(st.std),
+            g(st.percentiles.p90),
+            g(st.percentiles.p99),
+            g(st.max)
         );
     }
     if let Some(sg) = &r.accuracy.signed {
-        let _ = writeln!(s, "signed accuracy mean {}  std {}  min {}  max {}", g(sg.mean), g(sg.std), g(sg.min), g(sg.max));
+        let _ = writeln!(
+            s,
+            "signed accuracy mean {}  std {}  min {}  max {}",
+            g(sg.mean),
+            g(sg.std),
+            g(sg.min),
+            g(sg.max)
+        );
     }
-    let _ = writeln!(s, "{:>14} {:>10} {:>10} {:>10} {:>10}", "tau", "% diag", "precision", "recall", "F-score");
+    let _ = writeln!(
+        s,
+        "{:>14} {:>10} {:>10} {:>10} {:>10}",
+        "tau", "% diag", "precision", "recall", "F-score"
+    );
     for t in &r.thresholds {
         let _ = writeln!(
             s,

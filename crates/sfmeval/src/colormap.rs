@@ -25,7 +25,11 @@ pub fn viridis(t: f64) -> [u8; 3] {
 
 /// Colour of a distance `d` clipped at `clip` (0 → dark purple, ≥ clip → yellow).
 pub fn distance_color(d: f64, clip: f64) -> [u8; 3] {
-    if clip > 0.0 { viridis(d / clip) } else { viridis(1.0) }
+    if clip > 0.0 {
+        viridis(d / clip)
+    } else {
+        viridis(1.0)
+    }
 }
 
 #[cfg(test)]
@@ -37,7 +41,9 @@ mod tests {
         assert_eq!(viridis(0.0), [68, 1, 84]);
         assert_eq!(viridis(1.0), [253, 231, 37]);
         assert_eq!(viridis(2.0), viridis(1.0));
-        let luma = |c: [u8; 3]| 0.2126 * f64::from(c[0]) + 0.7152 * f64::from(c[1]) + 0.0722 * f64::from(c[2]);
+        let luma = |c: [u8; 3]| {
+            0.2126 * f64::from(c[0]) + 0.7152 * f64::from(c[1]) + 0.0722 * f64::from(c[2])
+        };
         let mut last = -1.0;
         for i in 0..=100 {
             let l = luma(viridis(f64::from(i) / 100.0));

@@ -69,7 +69,8 @@ impl Volume {
             } => {
                 let d = sub(p, *center);
                 (0..3).all(|k| {
-                    let local = rotation[0][k] * d[0] + rotation[1][k] * d[1] + rotation[2][k] * d[2];
+                    let local =
+                        rotation[0][k] * d[0] + rotation[1][k] * d[1] + rotation[2][k] * d[2];
                     local.abs() <= half_extents[k]
                 })
             }
@@ -83,7 +84,9 @@ impl Volume {
     fn validate(&self) -> Result<()> {
         let finite = |v: &[f64]| v.iter().all(|x| x.is_finite());
         let ok = match self {
-            Volume::Box { min, max } => finite(min) && finite(max) && (0..3).all(|k| min[k] <= max[k]),
+            Volume::Box { min, max } => {
+                finite(min) && finite(max) && (0..3).all(|k| min[k] <= max[k])
+            }
             Volume::OrientedBox {
                 center,
                 half_extents,
@@ -95,7 +98,9 @@ impl Volume {
                     && rotation.iter().all(|r| finite(r))
                     && is_rotation(rotation)
             }
-            Volume::Sphere { center, radius } => finite(center) && radius.is_finite() && *radius >= 0.0,
+            Volume::Sphere { center, radius } => {
+                finite(center) && radius.is_finite() && *radius >= 0.0
+            }
         };
         if ok {
             Ok(())
@@ -138,10 +143,13 @@ pub const CROP_SCHEMA: &str = "sfmeval.crop/1";
 impl Crop {
     /// Parses a crop file.
     pub fn parse(bytes: &[u8]) -> Result<Crop> {
-        let crop: Crop = serde_json::from_slice(bytes).map_err(|e| Error::InvalidOption(format!("crop file: {e}")))?;
+        let crop: Crop = serde_json::from_slice(bytes)
+            .map_err(|e| Error::InvalidOption(format!("crop file: {e}")))?;
         if let Some(s) = &crop.schema {
             if s != CROP_SCHEMA {
-                return Err(Error::InvalidOption(format!("crop file schema is '{s}', expected '{CROP_SCHEMA}'")));
+                return Err(Error::InvalidOption(format!(
+                    "crop file schema is '{s}', expected '{CROP_SCHEMA}'"
+                )));
             }
         }
         crop.validate()?;
@@ -155,7 +163,9 @@ impl Crop {
         }
         if let Some(d) = self.max_distance {
             if !(d.is_finite() && d >= 0.0) {
-                return Err(Error::InvalidOption(format!("max distance must be ≥ 0, got {d}")));
+                return Err(Error::InvalidOption(format!(
+                    "max distance must be ≥ 0, got {d}"
+                )));
             }
         }
         Ok(())
@@ -191,7 +201,10 @@ mod tests {
 
     #[test]
     fn volumes() {
-        let b = Volume::Box { min: [0.0; 3], max: [1.0; 3] };
+        let b = Volume::Box {
+            min: [0.0; 3],
+            max: [1.0; 3],
+        };
         assert!(b.contains([0.5, 1.0, 0.0]) && !b.contains([0.5, 1.01, 0.0]));
         let s = 0.5f64.sqrt();
         // A box rotated 45° about z: its local x axis is (s, s, 0).
@@ -202,7 +215,10 @@ mod tests {
         };
         assert!(ob.contains([1.0, 1.0, 0.0]));
         assert!(!ob.contains([1.0, -1.0, 0.0]));
-        let sp = Volume::Sphere { center: [1.0, 0.0, 0.0], radius: 1.0 };
+        let sp = Volume::Sphere {
+            center: [1.0, 0.0, 0.0],
+            radius: 1.0,
+        };
         assert!(sp.contains([2.0, 0.0, 0.0]) && !sp.contains([2.0, 0.1, 0.0]));
     }
 

@@ -33,7 +33,9 @@ pub enum Error {
         available: u64,
     },
     /// Coordinates that are NaN or infinite.
-    #[error("{format} data has {count} non-finite coordinate(s); the first is {what} #{first_index}")]
+    #[error(
+        "{format} data has {count} non-finite coordinate(s); the first is {what} #{first_index}"
+    )]
     NonFinite {
         /// Format being read.
         format: &'static str,

@@ -8,12 +8,12 @@ use crate::distance::{CloudIndex, MeshIndex};
 use crate::error::{Error, Result};
 use crate::geometry::{Aabb, GroundTruth, Point3, PointCloud};
 use crate::metrics::{f_score, share_below};
+use crate::parallel;
 use crate::progress::{Progress, Stage};
 use crate::report::*;
 use crate::sampling::sample_surface;
 use crate::stats::{DEFAULT_BINS, Statistics};
 use crate::transform::Similarity;
-use crate::parallel;
 
 /// Default number of completeness samples on a ground-truth mesh. The recall at any tau is a
 /// binomial share, so its sampling standard error is at most 0.5/√n: 1M samples keep it below
@@ -62,8 +62,15 @@ impl EvalOptions {
     /// Checks ranges.
     pub fn validate(&self) -> Result<()> {
         self.crop.validate()?;
-        if let Some(t) = self.tau.iter().chain(&self.tau_percent_of_diagonal).find(|t| !(t.is_finite() && **t > 0.0)) {
-            return Err(Error::InvalidOption(format!("thresholds must be > 0, got {t}")));
+        if let Some(t) = self
+            .tau
+            .iter()
+            .chain(&self.tau_percent_of_diagonal)
+            .find(|t| !(t.is_finite() && **t > 0.0))
+        {
+            return Err(Error::InvalidOption(format!(
+                "thresholds must be > 0, got {t}"
+            )));
         }
         if self.samples == 0 {
             return Err(Error::InvalidOption("samples must be ≥ 1".into()));
@@ -72,7 +79,9 @@ impl EvalOptions {
             return Err(Error::InvalidOption("samples must be ≤ 100000000".into()));
         }
         if self.histogram_bins == 0 || self.histogram_bins > 100_000 {
-            return Err(Error::InvalidOption("histogram bins must be in 1..=100000".into()));
+            return Err(Error::InvalidOption(
+                "histogram bins must be in 1..=100000".into(),
+            ));
         }
         Ok(())
     }
@@ -116,10 +125,19 @@ pub struct PreparedGroundTruth {
 impl PreparedGroundTruth {
     /// Indexes the ground truth and draws `samples` surface samples with `seed` (a cloud ground
     /// truth uses its own points instead).
-    pub fn new(gt: &GroundTruth, samples: usize, seed: u64, progress: &dyn Progress) -> Result<Self> {
-        let aabb = Aabb::of(gt.points()).ok_or_else(|| Error::Empty { what: "ground truth".into() })?;
+    pub fn new(
+        gt: &GroundTruth,
+        samples: usize,
+        seed: u64,
+        progress: &dyn Progress,
+    ) -> Result<Self> {
+        let aabb = Aabb::of(gt.points()).ok_or_else(|| Error::Empty {
+            what: "ground truth".into(),
+        })?;
         if !(aabb.diagonal() > 0.0) {
-            return Err(Error::Geometry("the ground truth has zero extent (all points identical)".into()));
+            return Err(Error::Geometry(
+                "the ground truth has zero extent (all points identical)".into(),
+            ));
         }
         progress.start(Stage::IndexGroundTruth, 1);
         let (index, pts, vertices, triangles, area) = match gt {
@@ -128,9 +146,21 @@ impl PreparedGroundTruth {
                 progress.finish();
                 progress.start(Stage::Sampling, 1);
                 let s = sample_surface(m, samples, seed)?;
-                (GtIndex::Mesh(idx), s, m.vertices.len(), m.triangles.len(), m.area())
+                (
+                    GtIndex::Mesh(idx),
+                    s,
+                    m.vertices.len(),
+                    m.triangles.len(),
+                    m.area(),
+                )
             }
-            GroundTruth::Cloud(c) => (GtIndex::Cloud(CloudIndex::new(&c.points)?), c.points.clone(), c.points.len(), 0, 0.0),
+            GroundTruth::Cloud(c) => (
+                GtIndex::Cloud(CloudIndex::new(&c.points)?),
+                c.points.clone(),
+                c.points.len(),
+                0,
+                0.0,
+            ),
         };
         progress.finish();
         Ok(PreparedGroundTruth {
@@ -283,7 +313,9 @@ pub fn evaluate(
         )));
     }
     if recon.points.is_empty() {
-        return Err(Error::Empty { what: "reconstruction (no points)".into() });
+        return Err(Error::Empty {
+            what: "reconstruction (no points)".into(),
+        });
     }
     let mut warnings = info.warnings.clone();
     let t = alignment.gt_from_recon;
@@ -314,14 +346,33 @@ pub fn evaluate(
         })
         .collect();
     let count = |s: PointStatus| status.iter().filter(|&&x| x == s).count() as u64;
-    let (kept_n, outside, too_far) = (count(PointStatus::Kept), count(PointStatus::OutsideVolume), count(PointStatus::TooFar));
-    let kept_distances: Vec<f64> = distances.iter().zip(&status).filter(|(_, s)| **s == PointStatus::Kept).map(|(d, _)| *d).collect();
-    let kept_points: Vec<Point3> = points_in_gt.iter().zip(&status).filter(|(_, s)| **s == PointStatus::Kept).map(|(p, _)| *p).collect();
+    let (kept_n, outside, too_far) = (
+        count(PointStatus::Kept),
+        count(PointStatus::OutsideVolume),
+        count(PointStatus::TooFar),
+    );
+    let kept_distances: Vec<f64> = distances
+        .iter()
+        .zip(&status)
+        .filter(|(_, s)| **s == PointStatus::Kept)
+        .map(|(d, _)| *d)
+        .collect();
+    let kept_points: Vec<Point3> = points_in_gt
+        .iter()
+        .zip(&status)
+        .filter(|(_, s)| **s == PointStatus::Kept)
+        .map(|(p, _)| *p)
+        .collect();
     if kept_points.is_empty() {
         warnings.push("the crop discarded every reconstructed point".into());
     }
 
-    let completeness_points: Vec<Point3> = gt.samples().iter().copied().filter(|&p| crop.in_volume(p)).collect();
+    let completeness_points: Vec<Point3> = gt
+        .samples()
+        .iter()
+        .copied()
+        .filter(|&p| crop.in_volume(p))
+        .collect();
     let completeness_distances: Vec<f64> = if kept_points.is_empty() {
         vec![f64::INFINITY; completeness_points.len()]
     } else {
@@ -329,7 +380,9 @@ pub fn evaluate(
         let recon_index = CloudIndex::new(&kept_points)?;
         progress.finish();
         progress.start(Stage::Completeness, completeness_points.len() as u64);
-        let d = parallel::map(&completeness_points, progress, |&p| recon_index.nearest(p).0);
+        let d = parallel::map(&completeness_points, progress, |&p| {
+            recon_index.nearest(p).0
+        });
         progress.finish();
         d
     };
@@ -361,9 +414,18 @@ pub fn evaluate(
         .collect();
 
     let bins = options.histogram_bins;
-    let finite_completeness: Vec<f64> = completeness_distances.iter().copied().filter(|d| d.is_finite()).collect();
+    let finite_completeness: Vec<f64> = completeness_distances
+        .iter()
+        .copied()
+        .filter(|d| d.is_finite())
+        .collect();
     let signed_stats = signed_distances.as_ref().map(|s| {
-        let kept: Vec<f64> = s.iter().zip(&status).filter(|(_, st)| **st == PointStatus::Kept).map(|(d, _)| *d).collect();
+        let kept: Vec<f64> = s
+            .iter()
+            .zip(&status)
+            .filter(|(_, st)| **st == PointStatus::Kept)
+            .map(|(d, _)| *d)
+            .collect();
         Statistics::of(&kept, bins)
     });
     let report = Report {
@@ -386,7 +448,11 @@ pub fn evaluate(
             },
         },
         options: ReportOptions {
-            samples: if gt.is_mesh() { options.samples as u64 } else { gt.samples.len() as u64 },
+            samples: if gt.is_mesh() {
+                options.samples as u64
+            } else {
+                gt.samples.len() as u64
+            },
             seed: gt.sample_seed,
             signed: options.signed,
             histogram_bins: bins as u64,
@@ -407,13 +473,23 @@ pub fn evaluate(
         alignment: alignment.report.clone(),
         accuracy: AccuracyReport {
             direction: "reconstruction_to_ground_truth".into(),
-            metric: if gt.is_mesh() { "point_to_triangle" } else { "point_to_point" }.into(),
+            metric: if gt.is_mesh() {
+                "point_to_triangle"
+            } else {
+                "point_to_point"
+            }
+            .into(),
             stats: Statistics::of(&kept_distances, bins),
             signed: signed_stats,
         },
         completeness: CompletenessReport {
             direction: "ground_truth_to_reconstruction".into(),
-            source: if gt.is_mesh() { "surface_samples" } else { "ground_truth_points" }.into(),
+            source: if gt.is_mesh() {
+                "surface_samples"
+            } else {
+                "ground_truth_points"
+            }
+            .into(),
             samples: completeness_points.len() as u64,
             seed: gt.sample_seed,
             stats: Statistics::of(&finite_completeness, bins),

@@ -16,13 +16,17 @@ pub fn sample_surface(mesh: &TriangleMesh, n: usize, seed: u64) -> Result<Vec<Po
         cumulative.push(total);
     }
     if !(total > 0.0) || !total.is_finite() {
-        return Err(Error::Geometry("the ground-truth mesh has zero surface area".into()));
+        return Err(Error::Geometry(
+            "the ground-truth mesh has zero surface area".into(),
+        ));
     }
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
     let mut out = Vec::with_capacity(n);
     for _ in 0..n {
         let target = rng.random::<f64>() * total;
-        let i = cumulative.partition_point(|&c| c <= target).min(cumulative.len() - 1);
+        let i = cumulative
+            .partition_point(|&c| c <= target)
+            .min(cumulative.len() - 1);
         let [a, b, c] = mesh.corners(&mesh.triangles[i]);
         let (u, v): (f64, f64) = (rng.random(), rng.random());
         let su = u.sqrt();
@@ -44,13 +48,23 @@ mod tests {
     fn uniform_by_area_and_deterministic() {
         // Two triangles: area 0.5 and 4.5 (ratio 1:9).
         let mesh = TriangleMesh {
-            vertices: vec![[0., 0., 0.], [1., 0., 0.], [0., 1., 0.], [10., 0., 0.], [13., 0., 0.], [10., 3., 0.]],
+            vertices: vec![
+                [0., 0., 0.],
+                [1., 0., 0.],
+                [0., 1., 0.],
+                [10., 0., 0.],
+                [13., 0., 0.],
+                [10., 3., 0.],
+            ],
             triangles: vec![[0, 1, 2], [3, 4, 5]],
         };
         let s = sample_surface(&mesh, 100_000, 7).unwrap();
         let small = s.iter().filter(|p| p[0] < 5.0).count() as f64 / 1e5;
         assert!((small - 0.1).abs() < 0.005, "{small}");
-        assert!(s.iter().all(|p| p[2] == 0.0 && (p[0] < 5.0 && p[0] + p[1] <= 1.0 + 1e-12 || p[0] >= 10.0)));
+        assert!(
+            s.iter()
+                .all(|p| p[2] == 0.0 && (p[0] < 5.0 && p[0] + p[1] <= 1.0 + 1e-12 || p[0] >= 10.0))
+        );
         assert_eq!(s, sample_surface(&mesh, 100_000, 7).unwrap());
         assert_ne!(s, sample_surface(&mesh, 100_000, 8).unwrap());
     }

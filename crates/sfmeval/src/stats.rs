@@ -115,9 +115,19 @@ impl Statistics {
 /// the first/last bin.
 pub fn histogram(values: &[f64], lo: f64, hi: f64, bins: usize) -> Histogram {
     let bins = bins.max(1);
-    let width = if hi > lo { (hi - lo) / bins as f64 } else { 1.0 };
+    let width = if hi > lo {
+        (hi - lo) / bins as f64
+    } else {
+        1.0
+    };
     let edges = (0..=bins)
-        .map(|i| if i == bins { hi.max(lo) } else { lo + width * i as f64 })
+        .map(|i| {
+            if i == bins {
+                hi.max(lo)
+            } else {
+                lo + width * i as f64
+            }
+        })
         .collect();
     let mut counts = vec![0u64; bins];
     for &v in values {

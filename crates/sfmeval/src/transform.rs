@@ -44,10 +44,16 @@ impl Similarity {
     /// proper rotation (tolerance `1e-6` relative).
     pub fn from_matrix(m: [[f64; 4]; 4]) -> Result<Similarity> {
         if m.iter().flatten().any(|v| !v.is_finite()) {
-            return Err(Error::InvalidOption("transform has non-finite entries".into()));
+            return Err(Error::InvalidOption(
+                "transform has non-finite entries".into(),
+            ));
         }
         let last = m[3];
-        if last[0].abs() > 1e-9 || last[1].abs() > 1e-9 || last[2].abs() > 1e-9 || (last[3] - 1.0).abs() > 1e-9 {
+        if last[0].abs() > 1e-9
+            || last[1].abs() > 1e-9
+            || last[2].abs() > 1e-9
+            || (last[3] - 1.0).abs() > 1e-9
+        {
             return Err(Error::InvalidOption(format!(
                 "transform's last row is {last:?}, expected [0, 0, 0, 1]"
             )));
@@ -77,11 +83,12 @@ impl Similarity {
     /// `gt_from_recon` / `matrix` / `transform` field, e.g. an sfmeval report) or from text
     /// (16 whitespace-separated numbers, row-major; `#` comments allowed).
     pub fn parse(bytes: &[u8]) -> Result<Similarity> {
-        let text = std::str::from_utf8(bytes).map_err(|_| Error::InvalidOption("transform file is not text".into()))?;
+        let text = std::str::from_utf8(bytes)
+            .map_err(|_| Error::InvalidOption("transform file is not text".into()))?;
         let trimmed = text.trim_start();
         let numbers: Vec<f64> = if trimmed.starts_with('[') || trimmed.starts_with('{') {
-            let v: serde_json::Value =
-                serde_json::from_str(text).map_err(|e| Error::InvalidOption(format!("transform JSON: {e}")))?;
+            let v: serde_json::Value = serde_json::from_str(text)
+                .map_err(|e| Error::InvalidOption(format!("transform JSON: {e}")))?;
             let v = match &v {
                 serde_json::Value::Object(o) => o
                     .get("gt_from_recon")
@@ -97,11 +104,18 @@ impl Similarity {
                 .map(|l| l.split('#').next().unwrap_or(""))
                 .flat_map(|l| l.split(|c: char| c.is_whitespace() || c == ','))
                 .filter(|w| !w.is_empty())
-                .map(|w| w.parse::<f64>().map_err(|_| Error::InvalidOption(format!("transform: '{w}' is not a number"))))
+                .map(|w| {
+                    w.parse::<f64>().map_err(|_| {
+                        Error::InvalidOption(format!("transform: '{w}' is not a number"))
+                    })
+                })
                 .collect::<Result<_>>()?
         };
         if numbers.len() != 16 {
-            return Err(Error::InvalidOption(format!("transform needs 16 numbers (a 4×4), found {}", numbers.len())));
+            return Err(Error::InvalidOption(format!(
+                "transform needs 16 numbers (a 4×4), found {}",
+                numbers.len()
+            )));
         }
         let mut m = [[0.0; 4]; 4];
         for (i, v) in numbers.into_iter().enumerate() {
@@ -185,10 +199,15 @@ fn flatten_numbers(v: &serde_json::Value) -> Result<Vec<f64>> {
         match v {
             serde_json::Value::Array(a) => a.iter().try_for_each(|x| walk(x, out)),
             serde_json::Value::Number(n) => {
-                out.push(n.as_f64().ok_or_else(|| Error::InvalidOption("bad number in transform".into()))?);
+                out.push(
+                    n.as_f64()
+                        .ok_or_else(|| Error::InvalidOption("bad number in transform".into()))?,
+                );
                 Ok(())
             }
-            _ => Err(Error::InvalidOption("transform must contain only numbers".into())),
+            _ => Err(Error::InvalidOption(
+                "transform must contain only numbers".into(),
+            )),
         }
     }
     walk(v, &mut out)?;
@@ -201,10 +220,13 @@ mod tests {
 
     #[test]
     fn parse_text_and_json_and_reject_shear() {
-        let t = Similarity::parse(b"# rot z 90, scale 2\n0 -2 0 1\n2 0 0 2\n0 0 2 3\n0 0 0 1\n").unwrap();
+        let t = Similarity::parse(b"# rot z 90, scale 2\n0 -2 0 1\n2 0 0 2\n0 0 2 3\n0 0 0 1\n")
+            .unwrap();
         assert!((t.scale() - 2.0).abs() < 1e-12);
         assert_eq!(t.apply([1.0, 0.0, 0.0]), [1.0, 4.0, 3.0]);
-        let j = Similarity::parse(b"{\"gt_from_recon\": [[0,-2,0,1],[2,0,0,2],[0,0,2,3],[0,0,0,1]]}").unwrap();
+        let j =
+            Similarity::parse(b"{\"gt_from_recon\": [[0,-2,0,1],[2,0,0,2],[0,0,2,3],[0,0,0,1]]}")
+                .unwrap();
         assert_eq!(t, j);
         let inv = t.inverse();
         let p = inv.apply(t.apply([0.3, -0.2, 5.0]));

@@ -25,7 +25,11 @@ impl CloudIndex {
 
     /// Distance from `p` to its nearest neighbour, and that neighbour's index.
     pub fn nearest(&self, p: Point3) -> (f64, usize) {
-        let r = self.tree.query(&p).nearest_one::<SquaredEuclidean<f64>>().execute();
+        let r = self
+            .tree
+            .query(&p)
+            .nearest_one::<SquaredEuclidean<f64>>()
+            .execute();
         (r.distance.sqrt(), r.item as usize)
     }
 }
@@ -39,14 +43,20 @@ mod tests {
         let pts: Vec<Point3> = (0..500)
             .map(|i| {
                 let f = f64::from(i);
-                [(f * 0.37).sin() * 3.0, (f * 0.11).cos() * 2.0, (f * 0.07).sin()]
+                [
+                    (f * 0.37).sin() * 3.0,
+                    (f * 0.11).cos() * 2.0,
+                    (f * 0.07).sin(),
+                ]
             })
             .collect();
         let idx = CloudIndex::new(&pts).unwrap();
         for q in [[0.1, 0.2, 0.3], [5.0, -4.0, 1.0], [-1.0, 1.0, 0.5]] {
             let brute = pts
                 .iter()
-                .map(|p| ((p[0] - q[0]).powi(2) + (p[1] - q[1]).powi(2) + (p[2] - q[2]).powi(2)).sqrt())
+                .map(|p| {
+                    ((p[0] - q[0]).powi(2) + (p[1] - q[1]).powi(2) + (p[2] - q[2]).powi(2)).sqrt()
+                })
                 .fold(f64::INFINITY, f64::min);
             assert!((idx.nearest(q).0 - brute).abs() < 1e-12);
         }

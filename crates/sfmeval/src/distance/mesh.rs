@@ -28,7 +28,11 @@ impl MeshIndex {
     /// Builds the BVH. The mesh must be valid ([`TriangleMesh::validate`]).
     pub fn new(mesh: &TriangleMesh) -> Result<Self> {
         mesh.validate("mesh")?;
-        let vertices: Vec<Vector> = mesh.vertices.iter().map(|p| Vector::new(p[0], p[1], p[2])).collect();
+        let vertices: Vec<Vector> = mesh
+            .vertices
+            .iter()
+            .map(|p| Vector::new(p[0], p[1], p[2]))
+            .collect();
         let normals = mesh
             .triangles
             .iter()
@@ -36,7 +40,11 @@ impl MeshIndex {
                 let c = mesh.corners(t);
                 let n = cross(sub(c[1], c[0]), sub(c[2], c[0]));
                 let l = norm(n);
-                if l > 0.0 { [n[0] / l, n[1] / l, n[2] / l] } else { [0.0; 3] }
+                if l > 0.0 {
+                    [n[0] / l, n[1] / l, n[2] / l]
+                } else {
+                    [0.0; 3]
+                }
             })
             .collect();
         let trimesh = TriMesh::with_flags(vertices, mesh.triangles.clone(), TriMeshFlags::empty())
@@ -59,8 +67,16 @@ impl MeshIndex {
     /// Distance signed by the normal of the closest triangle (positive on the side the
     /// counter-clockwise normal points to), as CloudCompare's C2M does.
     pub fn signed(&self, p: Point3, hit: &MeshHit) -> f64 {
-        let n = self.normals.get(hit.triangle as usize).copied().unwrap_or([0.0; 3]);
-        if dot(sub(p, hit.closest), n) < 0.0 { -hit.distance } else { hit.distance }
+        let n = self
+            .normals
+            .get(hit.triangle as usize)
+            .copied()
+            .unwrap_or([0.0; 3]);
+        if dot(sub(p, hit.closest), n) < 0.0 {
+            -hit.distance
+        } else {
+            hit.distance
+        }
     }
 }
 

@@ -4,4 +4,4 @@ pub mod cloud;
 pub mod mesh;
 
 pub use cloud::CloudIndex;
-pub use mesh::{MeshIndex, MeshHit};
+pub use mesh::{MeshHit, MeshIndex};

@@ -59,11 +59,18 @@ fn split_glb(bytes: &[u8]) -> Result<(&[u8], Option<&[u8]>)> {
     };
     let version = u32_at(4).ok_or_else(|| Error::truncated(GLB, "header shorter than 12 bytes"))?;
     if version != 2 {
-        return Err(Error::unsupported(GLB, format!("container version {version}; only glTF 2.0 is supported")));
+        return Err(Error::unsupported(
+            GLB,
+            format!("container version {version}; only glTF 2.0 is supported"),
+        ));
     }
-    let total = u32_at(8).ok_or_else(|| Error::truncated(GLB, "header shorter than 12 bytes"))? as usize;
+    let total =
+        u32_at(8).ok_or_else(|| Error::truncated(GLB, "header shorter than 12 bytes"))? as usize;
     if total > bytes.len() {
-        return Err(Error::truncated(GLB, format!("header says {total} bytes, file has {}", bytes.len())));
+        return Err(Error::truncated(
+            GLB,
+            format!("header says {total} bytes, file has {}", bytes.len()),
+        ));
     }
     let mut pos = 12;
     let mut json = None;
@@ -75,7 +82,12 @@ fn split_glb(bytes: &[u8]) -> Result<(&[u8], Option<&[u8]>)> {
         let end = start
             .checked_add(len)
             .filter(|&e| e <= total)
-            .ok_or_else(|| Error::truncated(GLB, format!("chunk of {len} bytes at offset {pos} runs past the end")))?;
+            .ok_or_else(|| {
+                Error::truncated(
+                    GLB,
+                    format!("chunk of {len} bytes at offset {pos} runs past the end"),
+                )
+            })?;
         match kind {
             0x4E4F_534A if json.is_none() => json = Some(&bytes[start..end]),
             0x004E_4942 if bin.is_none() => bin = Some(&bytes[start..end]),
@@ -105,19 +117,29 @@ pub fn read_gltf(bytes: &[u8], external: &BTreeMap<String, Vec<u8>>) -> Result<G
         for ext in req.iter().filter_map(|e| e.as_str()) {
             if !HARMLESS_REQUIRED.contains(&ext) {
                 let hint = match ext {
-                    "KHR_draco_mesh_compression" => "Draco-compressed glTF cannot be read: re-export without mesh compression",
-                    "EXT_meshopt_compression" | "KHR_meshopt_compression" => "meshopt-compressed glTF cannot be read: re-export without compression",
-                    "EXT_mesh_gpu_instancing" => "GPU-instanced meshes are not supported: re-export with instancing off",
+                    "KHR_draco_mesh_compression" => {
+                        "Draco-compressed glTF cannot be read: re-export without mesh compression"
+                    }
+                    "EXT_meshopt_compression" | "KHR_meshopt_compression" => {
+                        "meshopt-compressed glTF cannot be read: re-export without compression"
+                    }
+                    "EXT_mesh_gpu_instancing" => {
+                        "GPU-instanced meshes are not supported: re-export with instancing off"
+                    }
                     _ => "this required extension is not supported",
                 };
-                return Err(Error::unsupported(format, format!("requires extension '{ext}': {hint}")));
+                return Err(Error::unsupported(
+                    format,
+                    format!("requires extension '{ext}': {hint}"),
+                ));
             }
         }
     }
     // The geometry does not depend on the extensions left; the crate would refuse them.
     obj.remove("extensionsRequired");
     obj.remove("extensionsUsed");
-    let cleaned = serde_json::to_vec(&value).map_err(|e| Error::malformed(format, e.to_string()))?;
+    let cleaned =
+        serde_json::to_vec(&value).map_err(|e| Error::malformed(format, e.to_string()))?;
     let doc = gltf::Gltf::from_slice(&cleaned)
         .map_err(|e| Error::malformed(format, format!("invalid glTF: {e}")))?
         .document;
@@ -170,13 +192,18 @@ fn resolve_buffers(
     for buffer in doc.buffers() {
         let data = match buffer.source() {
             gltf::buffer::Source::Bin => blob
-                .ok_or_else(|| Error::malformed(format, "buffer refers to the GLB BIN chunk but there is none"))?
+                .ok_or_else(|| {
+                    Error::malformed(
+                        format,
+                        "buffer refers to the GLB BIN chunk but there is none",
+                    )
+                })?
                 .to_vec(),
             gltf::buffer::Source::Uri(uri) => {
                 if let Some(rest) = uri.strip_prefix("data:") {
-                    let (_, payload) = rest
-                        .split_once(";base64,")
-                        .ok_or_else(|| Error::unsupported(format, "data URI without base64 encoding"))?;
+                    let (_, payload) = rest.split_once(";base64,").ok_or_else(|| {
+                        Error::unsupported(format, "data URI without base64 encoding")
+                    })?;
                     base64::engine::general_purpose::STANDARD
                         .decode(payload)
                         .map_err(|e| Error::malformed(format, format!("buffer data URI: {e}")))?
@@ -196,7 +223,12 @@ fn resolve_buffers(
         if data.len() < buffer.length() {
             return Err(Error::truncated(
                 format,
-                format!("buffer {} declares {} bytes but holds {}", buffer.index(), buffer.length(), data.len()),
+                format!(
+                    "buffer {} declares {} bytes but holds {}",
+                    buffer.index(),
+                    buffer.length(),
+                    data.len()
+                ),
             ));
         }
         out.push(data);
@@ -248,7 +280,8 @@ fn apply(m: &Mat4, p: Point3) -> Point3 {
 }
 
 fn det3(m: &Mat4) -> f64 {
-    m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1]) - m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0])
+    m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1])
+        - m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0])
         + m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0])
 }
 
@@ -265,7 +298,10 @@ const MAX_DEPTH: usize = 256;
 impl Walker {
     fn walk(&mut self, node: &gltf::Node, parent: &Mat4, depth: usize) -> Result<()> {
         if depth > MAX_DEPTH {
-            return Err(Error::malformed(self.format, "node hierarchy deeper than 256 levels (a cycle?)"));
+            return Err(Error::malformed(
+                self.format,
+                "node hierarchy deeper than 256 levels (a cycle?)",
+            ));
         }
         // glTF matrices are column-major: m[c][r].
         let cm = node.transform().matrix();
@@ -290,37 +326,62 @@ impl Walker {
 
     fn primitive(&mut self, prim: &gltf::Primitive, world: &Mat4, mesh_index: usize) -> Result<()> {
         let mode = prim.mode();
-        if !matches!(mode, Mode::Triangles | Mode::TriangleStrip | Mode::TriangleFan) {
-            self.warnings.push(format!("mesh {mesh_index}: skipped a {mode:?} primitive (not a surface)"));
+        if !matches!(
+            mode,
+            Mode::Triangles | Mode::TriangleStrip | Mode::TriangleFan
+        ) {
+            self.warnings.push(format!(
+                "mesh {mesh_index}: skipped a {mode:?} primitive (not a surface)"
+            ));
             return Ok(());
         }
-        let pos = prim
-            .get(&gltf::Semantic::Positions)
-            .ok_or_else(|| Error::malformed(self.format, format!("mesh {mesh_index}: primitive without POSITION")))?;
+        let pos = prim.get(&gltf::Semantic::Positions).ok_or_else(|| {
+            Error::malformed(
+                self.format,
+                format!("mesh {mesh_index}: primitive without POSITION"),
+            )
+        })?;
         if pos.dimensions() != Dimensions::Vec3 {
-            return Err(Error::malformed(self.format, format!("mesh {mesh_index}: POSITION is not VEC3")));
+            return Err(Error::malformed(
+                self.format,
+                format!("mesh {mesh_index}: POSITION is not VEC3"),
+            ));
         }
         let local = decode_accessor(self.format, &self.buffers, &pos)?;
         let n = local.len() / 3;
         let base = self.mesh.vertices.len();
         if base + n > u32::MAX as usize {
-            return Err(Error::unsupported(self.format, "more than 4 billion vertices"));
+            return Err(Error::unsupported(
+                self.format,
+                "more than 4 billion vertices",
+            ));
         }
-        self.mesh
-            .vertices
-            .extend(local.chunks_exact(3).map(|c| apply(world, [c[0], c[1], c[2]])));
+        self.mesh.vertices.extend(
+            local
+                .chunks_exact(3)
+                .map(|c| apply(world, [c[0], c[1], c[2]])),
+        );
         let indices: Vec<u32> = match prim.indices() {
             Some(acc) => {
                 if acc.dimensions() != Dimensions::Scalar
-                    || !matches!(acc.data_type(), DataType::U8 | DataType::U16 | DataType::U32)
+                    || !matches!(
+                        acc.data_type(),
+                        DataType::U8 | DataType::U16 | DataType::U32
+                    )
                 {
-                    return Err(Error::malformed(self.format, format!("mesh {mesh_index}: indices are not unsigned integer scalars")));
+                    return Err(Error::malformed(
+                        self.format,
+                        format!("mesh {mesh_index}: indices are not unsigned integer scalars"),
+                    ));
                 }
                 let raw = decode_accessor(self.format, &self.buffers, &acc)?;
                 let mut out = Vec::with_capacity(raw.len());
                 for v in raw {
                     if v >= n as f64 {
-                        return Err(Error::malformed(self.format, format!("mesh {mesh_index}: index {v} ≥ vertex count {n}")));
+                        return Err(Error::malformed(
+                            self.format,
+                            format!("mesh {mesh_index}: index {v} ≥ vertex count {n}"),
+                        ));
                     }
                     out.push(v as u32);
                 }
@@ -331,7 +392,11 @@ impl Walker {
         let flip = det3(world) < 0.0;
         let b = base as u32;
         let mut push = |a: u32, c1: u32, c2: u32| {
-            let t = if flip { [a + b, c2 + b, c1 + b] } else { [a + b, c1 + b, c2 + b] };
+            let t = if flip {
+                [a + b, c2 + b, c1 + b]
+            } else {
+                [a + b, c1 + b, c2 + b]
+            };
             self.mesh.triangles.push(t);
         };
         match mode {
@@ -383,7 +448,11 @@ fn component(dt: DataType, b: &[u8], normalized: bool) -> f64 {
 }
 
 /// Decodes an accessor into a flat list of f64 components, checking every range.
-fn decode_accessor(format: &'static str, buffers: &[Vec<u8>], acc: &gltf::Accessor) -> Result<Vec<f64>> {
+fn decode_accessor(
+    format: &'static str,
+    buffers: &[Vec<u8>],
+    acc: &gltf::Accessor,
+) -> Result<Vec<f64>> {
     let dims = acc.dimensions().multiplicity();
     let dt = acc.data_type();
     let csize = dt.size();
@@ -394,7 +463,9 @@ fn decode_accessor(format: &'static str, buffers: &[Vec<u8>], acc: &gltf::Access
     let mut out = Vec::new();
     match acc.view() {
         Some(view) => {
-            let buf = buffers.get(view.buffer().index()).ok_or_else(|| err("buffer missing"))?;
+            let buf = buffers
+                .get(view.buffer().index())
+                .ok_or_else(|| err("buffer missing"))?;
             let stride = view.stride().unwrap_or(elem).max(elem);
             let view_start = view.offset();
             let view_end = view_start
@@ -405,7 +476,11 @@ fn decode_accessor(format: &'static str, buffers: &[Vec<u8>], acc: &gltf::Access
             if count > 0 {
                 let last_end = acc
                     .offset()
-                    .checked_add((count - 1).checked_mul(stride).ok_or_else(|| err("count overflows"))?)
+                    .checked_add(
+                        (count - 1)
+                            .checked_mul(stride)
+                            .ok_or_else(|| err("count overflows"))?,
+                    )
                     .and_then(|s| s.checked_add(elem))
                     .ok_or_else(|| err("count overflows"))?;
                 if last_end > view_bytes.len() {
@@ -413,7 +488,8 @@ fn decode_accessor(format: &'static str, buffers: &[Vec<u8>], acc: &gltf::Access
                         format,
                         what: "accessor elements",
                         declared: count as u64,
-                        available: (view_bytes.len().saturating_sub(acc.offset()) / stride.max(1)) as u64,
+                        available: (view_bytes.len().saturating_sub(acc.offset()) / stride.max(1))
+                            as u64,
                     });
                 }
             }
@@ -435,7 +511,9 @@ fn decode_accessor(format: &'static str, buffers: &[Vec<u8>], acc: &gltf::Access
     if let Some(sparse) = acc.sparse() {
         let n = sparse.count();
         let iv = sparse.indices();
-        let ibuf = buffers.get(iv.view().buffer().index()).ok_or_else(|| err("sparse buffer missing"))?;
+        let ibuf = buffers
+            .get(iv.view().buffer().index())
+            .ok_or_else(|| err("sparse buffer missing"))?;
         let isize = match iv.index_type() {
             gltf::accessor::sparse::IndexType::U8 => 1,
             gltf::accessor::sparse::IndexType::U16 => 2,
@@ -446,7 +524,9 @@ fn decode_accessor(format: &'static str, buffers: &[Vec<u8>], acc: &gltf::Access
             .get(istart..istart.saturating_add(n.saturating_mul(isize)))
             .ok_or_else(|| err("sparse indices run past their buffer"))?;
         let vv = sparse.values();
-        let vbuf = buffers.get(vv.view().buffer().index()).ok_or_else(|| err("sparse buffer missing"))?;
+        let vbuf = buffers
+            .get(vv.view().buffer().index())
+            .ok_or_else(|| err("sparse buffer missing"))?;
         let vstart = vv.view().offset() + vv.offset();
         let vbytes = vbuf
             .get(vstart..vstart.saturating_add(n.saturating_mul(elem)))

@@ -75,7 +75,11 @@ pub struct LoadedGroundTruth {
 
 /// Reads a ground truth: GLB/glTF/OBJ meshes, PLY meshes, or a PLY cloud (no faces).
 /// `external` supplies the external buffers of a `.gltf` by relative URI.
-pub fn read_ground_truth(name: &str, bytes: &[u8], external: &BTreeMap<String, Vec<u8>>) -> Result<LoadedGroundTruth> {
+pub fn read_ground_truth(
+    name: &str,
+    bytes: &[u8],
+    external: &BTreeMap<String, Vec<u8>>,
+) -> Result<LoadedGroundTruth> {
     let format = detect(name, bytes)?;
     let mut warnings = Vec::new();
     let ground_truth = match format {
@@ -88,21 +92,36 @@ pub fn read_ground_truth(name: &str, bytes: &[u8], external: &BTreeMap<String, V
         Format::Ply => {
             let p = ply::read_ply(bytes)?;
             if p.skipped_faces > 0 {
-                warnings.push(format!("{} faces with fewer than 3 vertices were skipped", p.skipped_faces));
+                warnings.push(format!(
+                    "{} faces with fewer than 3 vertices were skipped",
+                    p.skipped_faces
+                ));
             }
             if p.has_faces && !p.triangles.is_empty() {
-                let mesh = TriangleMesh { vertices: p.vertices, triangles: p.triangles };
+                let mesh = TriangleMesh {
+                    vertices: p.vertices,
+                    triangles: p.triangles,
+                };
                 mesh.validate("PLY")?;
                 GroundTruth::Mesh(mesh)
             } else {
                 if p.vertices.is_empty() {
-                    return Err(Error::Empty { what: "ground-truth PLY (no vertices)".into() });
+                    return Err(Error::Empty {
+                        what: "ground-truth PLY (no vertices)".into(),
+                    });
                 }
-                GroundTruth::Cloud(PointCloud { points: p.vertices, colors: p.colors })
+                GroundTruth::Cloud(PointCloud {
+                    points: p.vertices,
+                    colors: p.colors,
+                })
             }
         }
     };
-    Ok(LoadedGroundTruth { ground_truth, format, warnings })
+    Ok(LoadedGroundTruth {
+        ground_truth,
+        format,
+        warnings,
+    })
 }
 
 /// A reconstruction point cloud as read.
@@ -124,21 +143,39 @@ pub fn read_point_cloud(name: &str, bytes: &[u8]) -> Result<LoadedCloud> {
         Format::Ply => {
             let p = ply::read_ply(bytes)?;
             if !p.triangles.is_empty() {
-                warnings.push(format!("the reconstruction PLY has {} triangles; only its vertices are evaluated", p.triangles.len()));
+                warnings.push(format!(
+                    "the reconstruction PLY has {} triangles; only its vertices are evaluated",
+                    p.triangles.len()
+                ));
             }
-            PointCloud { points: p.vertices, colors: p.colors }
+            PointCloud {
+                points: p.vertices,
+                colors: p.colors,
+            }
         }
         Format::Obj => {
             warnings.push("the reconstruction is a mesh; only its vertices are evaluated".into());
-            PointCloud { points: obj::read_obj(bytes)?.vertices, colors: None }
+            PointCloud {
+                points: obj::read_obj(bytes)?.vertices,
+                colors: None,
+            }
         }
         Format::Glb | Format::Gltf => {
             warnings.push("the reconstruction is a mesh; only its vertices are evaluated".into());
-            PointCloud { points: gltf::read_gltf(bytes, &BTreeMap::new())?.mesh.vertices, colors: None }
+            PointCloud {
+                points: gltf::read_gltf(bytes, &BTreeMap::new())?.mesh.vertices,
+                colors: None,
+            }
         }
     };
     if cloud.points.is_empty() {
-        return Err(Error::Empty { what: format!("reconstruction '{name}' (no points)") });
+        return Err(Error::Empty {
+            what: format!("reconstruction '{name}' (no points)"),
+        });
     }
-    Ok(LoadedCloud { cloud, format, warnings })
+    Ok(LoadedCloud {
+        cloud,
+        format,
+        warnings,
+    })
 }

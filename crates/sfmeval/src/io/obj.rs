@@ -40,10 +40,14 @@ pub fn read_obj(bytes: &[u8]) -> Result<TriangleMesh> {
                 let n = mesh.vertices.len() as i64;
                 for corner in words {
                     let v = corner.split('/').next().unwrap_or("");
-                    let i: i64 = v.parse().map_err(|_| bad(&format!("bad face corner '{corner}'")))?;
+                    let i: i64 = v
+                        .parse()
+                        .map_err(|_| bad(&format!("bad face corner '{corner}'")))?;
                     let idx = if i > 0 { i - 1 } else { n + i };
                     if i == 0 || idx < 0 || idx >= n {
-                        return Err(bad(&format!("face index {i} with {n} vertices defined so far")));
+                        return Err(bad(&format!(
+                            "face index {i} with {n} vertices defined so far"
+                        )));
                     }
                     poly.push(idx as u32);
                 }
@@ -57,7 +61,11 @@ pub fn read_obj(bytes: &[u8]) -> Result<TriangleMesh> {
             _ => {}
         }
     }
-    if mesh.vertices.is_empty() && mesh.triangles.is_empty() && !bytes.is_empty() && !looks_like_text(bytes) {
+    if mesh.vertices.is_empty()
+        && mesh.triangles.is_empty()
+        && !bytes.is_empty()
+        && !looks_like_text(bytes)
+    {
         return Err(Error::malformed(FMT, "not a text file"));
     }
     mesh.validate(FMT)?;
@@ -65,7 +73,10 @@ pub fn read_obj(bytes: &[u8]) -> Result<TriangleMesh> {
 }
 
 fn looks_like_text(bytes: &[u8]) -> bool {
-    bytes.iter().take(4096).all(|&c| c == b'\t' || c == b'\n' || c == b'\r' || (0x20..0x7f).contains(&c) || c >= 0x80)
+    bytes
+        .iter()
+        .take(4096)
+        .all(|&c| c == b'\t' || c == b'\n' || c == b'\r' || (0x20..0x7f).contains(&c) || c >= 0x80)
 }
 
 #[cfg(test)]
@@ -82,8 +93,14 @@ mod tests {
     #[test]
     fn errors() {
         assert!(matches!(read_obj(b"v 0 0\n"), Err(Error::Malformed { .. })));
-        assert!(matches!(read_obj(b"v 0 0 0\nf 1 2 3\n"), Err(Error::Malformed { .. })));
+        assert!(matches!(
+            read_obj(b"v 0 0 0\nf 1 2 3\n"),
+            Err(Error::Malformed { .. })
+        ));
         assert!(matches!(read_obj(b"v 0 0 0\n"), Err(Error::Empty { .. })));
-        assert!(matches!(read_obj(b"v nan 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n"), Err(Error::NonFinite { .. })));
+        assert!(matches!(
+            read_obj(b"v nan 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n"),
+            Err(Error::NonFinite { .. })
+        ));
     }
 }

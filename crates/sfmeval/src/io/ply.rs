@@ -128,8 +128,15 @@ impl Scalar {
 
 #[derive(Debug, Clone)]
 enum Property {
-    Scalar { name: String, ty: Scalar },
-    List { name: String, count: Scalar, item: Scalar },
+    Scalar {
+        name: String,
+        ty: Scalar,
+    },
+    List {
+        name: String,
+        count: Scalar,
+        item: Scalar,
+    },
 }
 
 impl Property {
@@ -188,11 +195,13 @@ struct Header {
 
 fn parse_header(bytes: &[u8]) -> Result<Header> {
     if !bytes.starts_with(b"ply") {
-        return Err(Error::malformed(FMT, "does not start with the magic word 'ply'"));
+        return Err(Error::malformed(
+            FMT,
+            "does not start with the magic word 'ply'",
+        ));
     }
-    let end = find(bytes, b"end_header").ok_or_else(|| {
-        Error::truncated(FMT, "no 'end_header' line: the header is incomplete")
-    })?;
+    let end = find(bytes, b"end_header")
+        .ok_or_else(|| Error::truncated(FMT, "no 'end_header' line: the header is incomplete"))?;
     let after = end + b"end_header".len();
     let body_start = match bytes.get(after..) {
         Some([b'\r', b'\n', ..]) => after + 2,
@@ -211,7 +220,9 @@ fn parse_header(bytes: &[u8]) -> Result<Header> {
         let Some(keyword) = words.next() else {
             continue;
         };
-        let bad = |what: &str| Error::malformed(FMT, format!("header line {}: {what}: '{line}'", lineno + 1));
+        let bad = |what: &str| {
+            Error::malformed(FMT, format!("header line {}: {what}: '{line}'", lineno + 1))
+        };
         match keyword {
             "ply" if lineno == 0 => {}
             "format" => {
@@ -269,7 +280,8 @@ fn parse_header(bytes: &[u8]) -> Result<Header> {
             _ => return Err(bad("unknown header keyword")),
         }
     }
-    let encoding = encoding.ok_or_else(|| Error::malformed(FMT, "no 'format' line in the header"))?;
+    let encoding =
+        encoding.ok_or_else(|| Error::malformed(FMT, "no 'format' line in the header"))?;
     Ok(Header {
         encoding,
         elements,
@@ -342,7 +354,9 @@ pub fn read_ply(bytes: &[u8]) -> Result<PlyData> {
     };
     match header.encoding {
         PlyEncoding::Ascii => read_ascii_body(&header, body, &layout, &mut out)?,
-        PlyEncoding::BinaryLittleEndian => read_binary_body(&header, body, &layout, false, &mut out)?,
+        PlyEncoding::BinaryLittleEndian => {
+            read_binary_body(&header, body, &layout, false, &mut out)?
+        }
         PlyEncoding::BinaryBigEndian => read_binary_body(&header, body, &layout, true, &mut out)?,
     }
     crate::geometry::check_finite(FMT, "vertex", &out.vertices)?;
@@ -393,7 +407,10 @@ fn read_binary_body(
         let count = element.count as usize;
         if element.name == "vertex" {
             let stride = element.fixed_stride().ok_or_else(|| {
-                Error::unsupported(FMT, "list properties in the vertex element are not supported")
+                Error::unsupported(
+                    FMT,
+                    "list properties in the vertex element are not supported",
+                )
             })?;
             let offsets = prefix_offsets(element);
             let mut vertices = Vec::with_capacity(count);
@@ -416,7 +433,9 @@ fn read_binary_body(
             let len = stride
                 .checked_mul(count)
                 .filter(|&l| pos + l <= body.len())
-                .ok_or_else(|| Error::truncated(FMT, format!("'{}' data ends early", element.name)))?;
+                .ok_or_else(|| {
+                    Error::truncated(FMT, format!("'{}' data ends early", element.name))
+                })?;
             pos += len;
         } else {
             let face_list = (element.name == "face")
@@ -432,7 +451,9 @@ fn read_binary_body(
                         Property::Scalar { ty, .. } => {
                             pos += ty.size();
                         }
-                        Property::List { count: cty, item, .. } => {
+                        Property::List {
+                            count: cty, item, ..
+                        } => {
                             let n = body
                                 .get(pos..pos + cty.size())
                                 .map(|b| cty.read(b, big))
@@ -547,7 +568,12 @@ fn parse_number(tok: &[u8]) -> Option<f64> {
     std::str::from_utf8(tok).ok()?.parse::<f64>().ok()
 }
 
-fn read_ascii_body(header: &Header, body: &[u8], layout: &VertexLayout, out: &mut PlyData) -> Result<()> {
+fn read_ascii_body(
+    header: &Header,
+    body: &[u8],
+    layout: &VertexLayout,
+    out: &mut PlyData,
+) -> Result<()> {
     let mut tokens = Tokens { text: body, pos: 0 };
     for element in &header.elements {
         // Each entry needs at least one token of at least 2 bytes ("0 " or "0\n").
@@ -578,10 +604,14 @@ fn read_ascii_body(header: &Header, body: &[u8], layout: &VertexLayout, out: &mu
             for (pi, prop) in element.properties.iter().enumerate() {
                 match prop {
                     Property::Scalar { .. } => {
+                        // Text keeps every digit written (as Open3D and CloudCompare read it),
+                        // even where the header declares `float`.
                         values[pi] = if is_vertex {
                             tokens.number(element, entry)?
                         } else {
-                            tokens.next().ok_or_else(|| truncated_entry(element, entry))?;
+                            tokens
+                                .next()
+                                .ok_or_else(|| truncated_entry(element, entry))?;
                             0.0
                         };
                     }
@@ -609,7 +639,9 @@ fn read_ascii_body(header: &Header, body: &[u8], layout: &VertexLayout, out: &mu
                             push_polygon(out, &poly);
                         } else {
                             for _ in 0..n {
-                                tokens.next().ok_or_else(|| truncated_entry(element, entry))?;
+                                tokens
+                                    .next()
+                                    .ok_or_else(|| truncated_entry(element, entry))?;
                             }
                         }
                     }
@@ -643,7 +675,11 @@ mod tests {
     }
 
     fn binary_cloud(big: bool, n: u32) -> Vec<u8> {
-        let fmt = if big { "binary_big_endian" } else { "binary_little_endian" };
+        let fmt = if big {
+            "binary_big_endian"
+        } else {
+            "binary_little_endian"
+        };
         let mut b = format!(
             "ply\nformat {fmt} 1.0\nelement vertex {n}\nproperty double x\nproperty float y\nproperty short z\nproperty ushort red\nproperty ushort green\nproperty ushort blue\nelement extra 1\nproperty list uint uchar junk\nend_header\n"
         )
@@ -689,7 +725,10 @@ mod tests {
     fn truncated_binary_is_an_error() {
         let b = binary_cloud(false, 5);
         let err = read_ply(&b[..b.len() - 30]).unwrap_err();
-        assert!(matches!(err, Error::CountMismatch { .. } | Error::Truncated { .. }), "{err}");
+        assert!(
+            matches!(err, Error::CountMismatch { .. } | Error::Truncated { .. }),
+            "{err}"
+        );
     }
 
     #[test]
@@ -703,16 +742,28 @@ mod tests {
     #[test]
     fn nan_and_bad_index_are_errors() {
         let nan = "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\nproperty float z\nend_header\nnan 0 0\n";
-        assert!(matches!(read_ply(nan.as_bytes()), Err(Error::NonFinite { .. })));
+        assert!(matches!(
+            read_ply(nan.as_bytes()),
+            Err(Error::NonFinite { .. })
+        ));
         let idx = "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\nelement face 1\nproperty list uchar uint vertex_index\nend_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 3\n";
-        assert!(matches!(read_ply(idx.as_bytes()), Err(Error::Malformed { .. })));
+        assert!(matches!(
+            read_ply(idx.as_bytes()),
+            Err(Error::Malformed { .. })
+        ));
     }
 
     #[test]
     fn garbage_is_malformed() {
         assert!(matches!(read_ply(b"hello"), Err(Error::Malformed { .. })));
-        assert!(matches!(read_ply(b"ply\nformat ascii 1.0\n"), Err(Error::Truncated { .. })));
+        assert!(matches!(
+            read_ply(b"ply\nformat ascii 1.0\n"),
+            Err(Error::Truncated { .. })
+        ));
         let no_x = "ply\nformat ascii 1.0\nelement vertex 1\nproperty float a\nend_header\n1\n";
-        assert!(matches!(read_ply(no_x.as_bytes()), Err(Error::Malformed { .. })));
+        assert!(matches!(
+            read_ply(no_x.as_bytes()),
+            Err(Error::Malformed { .. })
+        ));
     }
 }

@@ -9,7 +9,9 @@ use crate::evaluate::{Evaluation, PointStatus};
 /// Binary little-endian PLY of every kept point in the ground-truth frame, coloured by its
 /// distance clipped at `clip` (viridis), with `float distance` (and `float signed_distance`).
 pub fn colored_ply(eval: &Evaluation, clip: f64) -> Vec<u8> {
-    let kept: Vec<usize> = (0..eval.points_in_gt.len()).filter(|&i| eval.status[i] == PointStatus::Kept).collect();
+    let kept: Vec<usize> = (0..eval.points_in_gt.len())
+        .filter(|&i| eval.status[i] == PointStatus::Kept)
+        .collect();
     let signed = eval.signed_distances.as_ref();
     let mut header = format!(
         "ply\nformat binary_little_endian 1.0\ncomment sfmeval {} error heat map, distances clipped at {clip} for colour\nelement vertex {}\nproperty double x\nproperty double y\nproperty double z\nproperty uchar red\nproperty uchar green\nproperty uchar blue\nproperty float distance\n",
@@ -42,13 +44,21 @@ pub fn distances_csv(eval: &Evaluation) -> String {
     let mut s = String::with_capacity(eval.points_in_gt.len() * 64);
     s.push_str("index,x,y,z,distance,signed_distance,status\n");
     for (i, p) in eval.points_in_gt.iter().enumerate() {
-        let signed = eval.signed_distances.as_ref().map(|v| v[i].to_string()).unwrap_or_default();
+        let signed = eval
+            .signed_distances
+            .as_ref()
+            .map(|v| v[i].to_string())
+            .unwrap_or_default();
         let status = match eval.status[i] {
             PointStatus::Kept => "kept",
             PointStatus::OutsideVolume => "outside_volume",
             PointStatus::TooFar => "too_far",
         };
-        let _ = writeln!(s, "{i},{},{},{},{},{signed},{status}", p[0], p[1], p[2], eval.distances[i]);
+        let _ = writeln!(
+            s,
+            "{i},{},{},{},{},{signed},{status}",
+            p[0], p[1], p[2], eval.distances[i]
+        );
     }
     s
 }

@@ -1,0 +1,167 @@
+//! Closed-form least-squares similarity between matched point sets (Umeyama 1991), with the
+//! reflection correction, optionally weighted.
+
+use nalgebra::{Matrix3, Vector3};
+
+use super::{from_m, is_finite, to_v};
+use crate::error::{Error, Result};
+use crate::geometry::Point3;
+use crate::transform::Similarity;
+
+/// Below this √(λ₂/λ₁) of the source covariance the points count as collinear: the rotation
+/// about their line is then undetermined.
+pub const COLLINEAR_RATIO: f64 = 1e-7;
+
+/// The similarity `dst ≈ s·R·src + t` minimising the sum of squared residuals; `with_scale =
+/// false` fixes `s = 1` (a rigid motion). Needs ≥ 3 finite, non-collinear pairs.
+///
+/// ```
+/// use sfmeval::align::umeyama;
+/// let src = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+/// let dst = src.map(|p| [2.0 * p[0] + 1.0, 2.0 * p[1], 2.0 * p[2] - 3.0]);
+/// let t = umeyama(&src, &dst, true).unwrap();
+/// assert!((t.scale() - 2.0).abs() < 1e-12);
+/// ```
+pub fn umeyama(src: &[Point3], dst: &[Point3], with_scale: bool) -> Result<Similarity> {
+    umeyama_weighted(src, dst, None, with_scale)
+}
+
+/// [`umeyama`] with non-negative per-pair weights (`None` = all 1).
+pub fn umeyama_weighted(src: &[Point3], dst: &[Point3], weights: Option<&[f64]>, with_scale: bool) -> Result<Similarity> {
+    if src.len() != dst.len() {
+        return Err(Error::InvalidOption(format!(
+            "umeyama needs matched pairs: {} source and {} target points",
+            src.len(),
+            dst.len()
+        )));
+    }
+    if let Some(w) = weights {
+        if w.len() != src.len() {
+            return Err(Error::InvalidOption(format!("{} weights for {} pairs", w.len(), src.len())));
+        }
+        if w.iter().any(|w| !(w.is_finite() && *w >= 0.0)) {
+            return Err(Error::InvalidOption("weights must be finite and ≥ 0".into()));
+        }
+    }
+    if let Some(i) = src.iter().zip(dst).position(|(a, b)| !(is_finite(a) && is_finite(b))) {
+        let count = src.iter().zip(dst).filter(|(a, b)| !(is_finite(a) && is_finite(b))).count();
+        return Err(Error::NonFinite { format: "alignment", what: "point pair", count, first_index: i });
+    }
+    let w = |i: usize| weights.map_or(1.0, |w| w[i]);
+    let used = (0..src.len()).filter(|&i| w(i) > 0.0).count();
+    if used < 3 {
+        return Err(Error::InvalidOption(format!(
+            "a similarity needs at least 3 point pairs, got {used}"
+        )));
+    }
+    let total: f64 = (0..src.len()).map(w).sum();
+    let mut mu_s = Vector3::zeros();
+    let mut mu_d = Vector3::zeros();
+    for i in 0..src.len() {
+        mu_s += w(i) * to_v(src[i]);
+        mu_d += w(i) * to_v(dst[i]);
+    }
+    mu_s /= total;
+    mu_d /= total;
+    let mut sigma = Matrix3::zeros();
+    let mut cov_s = Matrix3::zeros();
+    let mut var_s = 0.0;
+    for i in 0..src.len() {
+        let a = to_v(src[i]) - mu_s;
+        let b = to_v(dst[i]) - mu_d;
+        sigma += w(i) * b * a.transpose();
+        cov_s += w(i) * a * a.transpose();
+        var_s += w(i) * a.norm_squared();
+    }
+    sigma /= total;
+    cov_s /= total;
+    var_s /= total;
+    let (l, _) = super::sorted_eigen(&cov_s);
+    if !(l[0] > 0.0) {
+        return Err(Error::Geometry("all source points coincide: no similarity is defined".into()));
+    }
+    if (l[1] / l[0]).sqrt() < COLLINEAR_RATIO {
+        return Err(Error::Geometry(
+            "the source points are collinear: the rotation about their line is undetermined".into(),
+        ));
+    }
+    let svd = sigma.svd(true, true);
+    let (u, vt) = match (svd.u, svd.v_t) {
+        (Some(u), Some(vt)) => (u, vt),
+        _ => return Err(Error::Geometry("SVD of the cross-covariance failed".into())),
+    };
+    let mut s_diag = Matrix3::identity();
+    if u.determinant() * vt.determinant() < 0.0 {
+        s_diag[(2, 2)] = -1.0;
+    }
+    let r = u * s_diag * vt;
+    let scale = if with_scale {
+        let d = svd.singular_values;
+        (d[0] + d[1] + s_diag[(2, 2)] * d[2]) / var_s
+    } else {
+        1.0
+    };
+    if !(scale.is_finite() && scale > 0.0) {
+        return Err(Error::Geometry(
+            "the target points collapse to a point: the similarity's scale would be 0".into(),
+        ));
+    }
+    let t = mu_d - scale * r * mu_s;
+    let out = Similarity::from_parts(scale, from_m(&r), [t.x, t.y, t.z]);
+    if out.matrix.iter().flatten().any(|v| !v.is_finite()) {
+        return Err(Error::Geometry("the similarity is not finite".into()));
+    }
+    Ok(out)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::align::rotation_angle_deg;
+
+    fn rot(axis: [f64; 3], deg: f64) -> [[f64; 3]; 3] {
+        let a = nalgebra::Unit::new_normalize(Vector3::new(axis[0], axis[1], axis[2]));
+        let r = nalgebra::Rotation3::from_axis_angle(&a, deg.to_radians());
+        from_m(r.matrix())
+    }
+
+    #[test]
+    fn exact_recovery_and_reflection_safe() {
+        let src: Vec<Point3> = (0..20)
+            .map(|i| {
+                let f = f64::from(i);
+                [(f * 0.7).sin() * 3.0, (f * 1.3).cos(), f * 0.1]
+            })
+            .collect();
+        let truth = Similarity::from_parts(0.37, rot([0.3, -1.0, 0.2], 123.0), [5.0, -2.0, 1e3]);
+        let dst: Vec<Point3> = src.iter().map(|p| truth.apply(*p)).collect();
+        let t = umeyama(&src, &dst, true).unwrap();
+        assert!((t.scale() - 0.37).abs() < 1e-12);
+        assert!(rotation_angle_deg(&t.rotation(), &truth.rotation()) < 1e-6);
+        // A mirrored target: the best proper rotation, never a reflection.
+        let mirrored: Vec<Point3> = src.iter().map(|p| [-p[0], p[1], p[2]]).collect();
+        let m = umeyama(&src, &mirrored, true).unwrap();
+        assert!(m.scale() > 0.0);
+        assert!(Similarity::from_matrix(m.matrix).is_ok());
+        // Rigid variant keeps scale 1.
+        assert!((umeyama(&src, &dst, false).unwrap().scale() - 1.0).abs() < 1e-15);
+    }
+
+    #[test]
+    fn bad_inputs_are_errors() {
+        let a = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0]];
+        assert!(matches!(umeyama(&a, &a, true), Err(Error::InvalidOption(_))));
+        let line = [[0.0, 0.0, 0.0], [1.0, 1.0, 1.0], [2.0, 2.0, 2.0], [3.0, 3.0, 3.0]];
+        assert!(matches!(umeyama(&line, &line, true), Err(Error::Geometry(_))));
+        let same = [[1.0, 2.0, 3.0]; 4];
+        assert!(matches!(umeyama(&same, &line, true), Err(Error::Geometry(_))));
+        let tri = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]];
+        assert!(matches!(umeyama(&tri, &same[..3], true), Err(Error::Geometry(_))));
+        let nan = [[f64::NAN, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]];
+        assert!(matches!(umeyama(&nan, &tri, true), Err(Error::NonFinite { .. })));
+        assert!(umeyama(&tri, &a, true).is_err());
+        // Weighted: zero weights drop pairs.
+        assert!(umeyama_weighted(&tri, &tri, Some(&[1.0, 1.0, 0.0]), true).is_err());
+        assert!(umeyama_weighted(&tri, &tri, Some(&[1.0, 1.0, -1.0]), true).is_err());
+    }
+}

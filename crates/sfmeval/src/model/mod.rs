@@ -1,0 +1,448 @@
+//! Sparse SfM models (cameras, registered images with poses, 3D points with tracks) read from the
+//! bytes of every tool's output into one [`Reconstruction`].
+//!
+//! | format | reader |
+//! |---|---|
+//! | COLMAP text / binary (`cameras`, `images`, `points3D`), one or several sub-models | [`colmap::read_colmap_folder`], [`colmap::read_colmap_text`], [`colmap::read_colmap_binary`] |
+//! | VisualSfM NVM v3 (several models in one file) | [`nvm::read_nvm`] |
+//! | Bundler `.out` v0.3 + `list.txt` | [`bundler::read_bundler`] |
+//! | OpenMVG `sfm_data.json` | [`openmvg::read_openmvg_json`] |
+//! | `cameras.json` (`sfmeval.cameras/1`) | [`cameras_json::read_cameras_json`] |
+//!
+//! Poses are always `cam_from_world` in the OpenCV/COLMAP convention (x right, y down, z
+//! forward; `x_cam = R·X + t`), and intrinsics use COLMAP's pixel convention (the image centre is
+//! `(W/2, H/2)`), whatever the file's own convention. [`strip`] removes the camera centres that
+//! OpenMVG and Theia write into their PLY clouds; [`matching`] pairs images with ground-truth
+//! images by file name.
+
+pub mod bundler;
+pub mod cameras_json;
+pub mod colmap;
+pub mod matching;
+pub mod nvm;
+pub mod openmvg;
+pub mod strip;
+mod text;
+
+#[cfg(test)]
+mod fuzz_tests;
+
+use crate::error::{Error, Result};
+use crate::geometry::{Point3, PointCloud};
+
+/// A row-major 3×3 matrix.
+pub type Mat3 = [[f64; 3]; 3];
+
+/// A rigid transform `x ↦ R·x + t`; for a camera pose, `cam_from_world`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Rigid {
+    /// Row-major rotation.
+    pub rotation: Mat3,
+    /// Translation.
+    pub translation: Point3,
+}
+
+impl Rigid {
+    /// The identity.
+    pub const IDENTITY: Rigid = Rigid {
+        rotation: [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]],
+        translation: [0.0, 0.0, 0.0],
+    };
+
+    /// From a Hamilton quaternion `[w, x, y, z]` (normalised here) and a translation. `None`
+    /// when the quaternion has zero or non-finite norm.
+    pub fn from_quaternion(q: [f64; 4], translation: Point3) -> Option<Rigid> {
+        Some(Rigid {
+            rotation: quaternion_to_matrix(q)?,
+            translation,
+        })
+    }
+
+    /// From a rotation and the camera centre `C` (so `t = −R·C`), as NVM and OpenMVG store it.
+    pub fn from_rotation_center(rotation: Mat3, center: Point3) -> Rigid {
+        let rc = mat_vec(&rotation, center);
+        Rigid {
+            rotation,
+            translation: [-rc[0], -rc[1], -rc[2]],
+        }
+    }
+
+    /// The camera centre `C = −Rᵀ·t` (the origin of the camera frame in world coordinates).
+    pub fn center(&self) -> Point3 {
+        let c = mat_t_vec(&self.rotation, self.translation);
+        [-c[0], -c[1], -c[2]]
+    }
+
+    /// Applies the transform to a point.
+    pub fn apply(&self, p: Point3) -> Point3 {
+        let r = mat_vec(&self.rotation, p);
+        [
+            r[0] + self.translation[0],
+            r[1] + self.translation[1],
+            r[2] + self.translation[2],
+        ]
+    }
+
+    /// True when every entry is finite.
+    pub fn is_finite(&self) -> bool {
+        self.rotation.iter().flatten().all(|v| v.is_finite())
+            && self.translation.iter().all(|v| v.is_finite())
+    }
+}
+
+/// Rotation matrix of a Hamilton quaternion `[w, x, y, z]`, normalised first.
+pub fn quaternion_to_matrix(q: [f64; 4]) -> Option<Mat3> {
+    let n = (q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]).sqrt();
+    if !(n.is_finite() && n > 0.0) {
+        return None;
+    }
+    let [w, x, y, z] = q.map(|v| v / n);
+    Some([
+        [
+            1.0 - 2.0 * (y * y + z * z),
+            2.0 * (x * y - w * z),
+            2.0 * (x * z + w * y),
+        ],
+        [
+            2.0 * (x * y + w * z),
+            1.0 - 2.0 * (x * x + z * z),
+            2.0 * (y * z - w * x),
+        ],
+        [
+            2.0 * (x * z - w * y),
+            2.0 * (y * z + w * x),
+            1.0 - 2.0 * (x * x + y * y),
+        ],
+    ])
+}
+
+/// `M·v`.
+pub fn mat_vec(m: &Mat3, v: Point3) -> Point3 {
+    [0, 1, 2].map(|i| m[i][0] * v[0] + m[i][1] * v[1] + m[i][2] * v[2])
+}
+
+/// `Mᵀ·v`.
+pub fn mat_t_vec(m: &Mat3, v: Point3) -> Point3 {
+    [0, 1, 2].map(|i| m[0][i] * v[0] + m[1][i] * v[1] + m[2][i] * v[2])
+}
+
+/// `A·B`.
+pub fn mat_mul(a: &Mat3, b: &Mat3) -> Mat3 {
+    let mut m = [[0.0; 3]; 3];
+    for (i, row) in m.iter_mut().enumerate() {
+        for (j, v) in row.iter_mut().enumerate() {
+            *v = (0..3).map(|k| a[i][k] * b[k][j]).sum();
+        }
+    }
+    m
+}
+
+/// `Mᵀ`.
+pub fn transpose(m: &Mat3) -> Mat3 {
+    let mut t = [[0.0; 3]; 3];
+    for (i, row) in t.iter_mut().enumerate() {
+        for (j, v) in row.iter_mut().enumerate() {
+            *v = m[j][i];
+        }
+    }
+    t
+}
+
+/// Rotation angle of a rotation matrix in degrees, in `[0, 180]`; robust near 0 and 180°
+/// (`atan2` of the sine and cosine parts instead of `acos` of the trace).
+pub fn rotation_angle_deg(r: &Mat3) -> f64 {
+    let cos = ((r[0][0] + r[1][1] + r[2][2]) - 1.0) / 2.0;
+    let v = [r[2][1] - r[1][2], r[0][2] - r[2][0], r[1][0] - r[0][1]];
+    let sin = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt() / 2.0;
+    sin.atan2(cos).to_degrees()
+}
+
+/// A camera (intrinsics) of a reconstruction.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Camera {
+    /// The file's camera id (COLMAP camera id, OpenMVG intrinsic key, NVM/Bundler camera index).
+    pub id: u64,
+    /// COLMAP model name (`PINHOLE`, `SIMPLE_RADIAL`, ...), or the format's own name when it has
+    /// no COLMAP equivalent (OpenMVG `pinhole_brown_t2` ...).
+    pub model: String,
+    /// Image width in pixels; 0 when the format does not store it (NVM, Bundler).
+    pub width: u64,
+    /// Image height in pixels; 0 when unknown.
+    pub height: u64,
+    /// Focal length along x in pixels (0 when the model has none, e.g. equirectangular).
+    pub fx: f64,
+    /// Focal length along y in pixels (`fy = fx` for single-focal models).
+    pub fy: f64,
+    /// Principal point x, COLMAP convention (`W/2` is the image centre); 0 when unknown.
+    pub cx: f64,
+    /// Principal point y, COLMAP convention; 0 when unknown.
+    pub cy: f64,
+    /// All parameters as the file stores them (COLMAP order for COLMAP models).
+    pub params: Vec<f64>,
+}
+
+impl Camera {
+    /// A pinhole camera with one focal length and the given principal point.
+    pub fn simple(id: u64, model: &str, f: f64, cx: f64, cy: f64) -> Camera {
+        Camera {
+            id,
+            model: model.to_string(),
+            width: 0,
+            height: 0,
+            fx: f,
+            fy: f,
+            cx,
+            cy,
+            params: vec![f, cx, cy],
+        }
+    }
+
+    /// Mean focal length `(fx + fy) / 2` in pixels.
+    pub fn focal(&self) -> f64 {
+        0.5 * (self.fx + self.fy)
+    }
+}
+
+/// One 2D observation of an image.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Observation {
+    /// Pixel coordinates as the file stores them (COLMAP: absolute, COLMAP convention; NVM and
+    /// Bundler writers differ, see `research/formats.md`).
+    pub xy: [f64; 2],
+    /// Index into [`Reconstruction::points`] of the 3D point it observes, if any.
+    pub point: Option<usize>,
+}
+
+/// A registered image.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Image {
+    /// The file's image id (COLMAP image id, OpenMVG view id, NVM/Bundler camera index).
+    pub id: u64,
+    /// Image file name as written by the tool (may contain folders or backslashes).
+    pub name: String,
+    /// Id of its [`Camera`] (`Camera::id`).
+    pub camera_id: u64,
+    /// World-to-camera pose (OpenCV convention).
+    pub cam_from_world: Rigid,
+    /// 2D observations (empty when the format has none or they were not kept).
+    pub observations: Vec<Observation>,
+}
+
+impl Image {
+    /// The camera centre in world coordinates.
+    pub fn center(&self) -> Point3 {
+        self.cam_from_world.center()
+    }
+}
+
+/// One element of a 3D point's track.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct TrackElement {
+    /// Index into [`Reconstruction::images`].
+    pub image: usize,
+    /// Index of the keypoint in that image (the file's 2D point index / feature id).
+    pub keypoint: u64,
+}
+
+/// A 3D point.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Point3D {
+    /// Position in the reconstruction's frame.
+    pub xyz: Point3,
+    /// RGB colour, when the format stores one.
+    pub color: Option<[u8; 3]>,
+    /// Mean reprojection error in pixels, when the format stores it.
+    pub error: Option<f64>,
+    /// Observations of the point.
+    pub track: Vec<TrackElement>,
+}
+
+/// Size of a sub-model that was read but not used (the largest one is used).
+#[derive(Debug, Clone, PartialEq, Eq, serde::Serialize)]
+pub struct SubModel {
+    /// Where it came from (`sparse/1`, `model 2`, ...).
+    pub name: String,
+    /// Registered images.
+    pub images: usize,
+    /// 3D points.
+    pub points: usize,
+}
+
+/// A sparse reconstruction in memory: the one type every SfM reader returns.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct Reconstruction {
+    /// Cameras (intrinsics).
+    pub cameras: Vec<Camera>,
+    /// Registered images.
+    pub images: Vec<Image>,
+    /// Names of images the file lists without a pose (Bundler zero cameras, OpenMVG views
+    /// without extrinsics).
+    pub unregistered: Vec<String>,
+    /// 3D points.
+    pub points: Vec<Point3D>,
+    /// Format name for the report (`colmap`, `colmap_binary`, `nvm`, `bundler`, `openmvg`,
+    /// `cameras_json`).
+    pub format: &'static str,
+    /// Things a user should know (dropped references, other sub-models, ...).
+    pub warnings: Vec<String>,
+    /// The other sub-models found beside this one (this one is the largest).
+    pub sub_models: Vec<SubModel>,
+}
+
+impl Reconstruction {
+    /// An empty reconstruction of the given format.
+    pub fn new(format: &'static str) -> Reconstruction {
+        Reconstruction {
+            format,
+            ..Default::default()
+        }
+    }
+
+    /// Number of separate models the source held (this one plus [`Self::sub_models`]).
+    pub fn num_models(&self) -> usize {
+        1 + self.sub_models.len()
+    }
+
+    /// Camera centres of the registered images, in image order.
+    pub fn camera_centers(&self) -> Vec<Point3> {
+        self.images.iter().map(Image::center).collect()
+    }
+
+    /// The camera of an image, if present.
+    pub fn camera_of(&self, image: &Image) -> Option<&Camera> {
+        self.cameras.iter().find(|c| c.id == image.camera_id)
+    }
+
+    /// The 3D points as a cloud (colours when every point has one).
+    pub fn to_point_cloud(&self) -> PointCloud {
+        let colors: Option<Vec<[u8; 3]>> = self.points.iter().map(|p| p.color).collect();
+        PointCloud {
+            points: self.points.iter().map(|p| p.xyz).collect(),
+            colors: if self.points.is_empty() { None } else { colors },
+        }
+    }
+
+    /// A summary of this model's size under `name`.
+    pub fn summary(&self, name: &str) -> SubModel {
+        SubModel {
+            name: name.to_string(),
+            images: self.images.len(),
+            points: self.points.len(),
+        }
+    }
+
+    /// Fails with [`Error::NonFinite`] when a pose or a point is NaN/infinite.
+    pub fn check_finite(&self, format: &'static str) -> Result<()> {
+        let bad: Vec<usize> = self
+            .images
+            .iter()
+            .enumerate()
+            .filter(|(_, im)| !im.cam_from_world.is_finite())
+            .map(|(i, _)| i)
+            .collect();
+        if let Some(&first_index) = bad.first() {
+            return Err(Error::NonFinite {
+                format,
+                what: "image pose",
+                count: bad.len(),
+                first_index,
+            });
+        }
+        let pts: Vec<Point3> = self.points.iter().map(|p| p.xyz).collect();
+        crate::geometry::check_finite(format, "3D point", &pts)
+    }
+}
+
+/// Picks the largest model (most registered images, then most points; the first on ties) of
+/// several named ones and records the others in its [`Reconstruction::sub_models`] with a
+/// warning. Fails with [`Error::Empty`] when `models` is empty.
+pub fn choose_largest(models: Vec<(String, Reconstruction)>) -> Result<Reconstruction> {
+    let mut best: Option<usize> = None;
+    for (i, (_, m)) in models.iter().enumerate() {
+        let better = match best.and_then(|b| models.get(b)) {
+            None => true,
+            Some((_, b)) => (m.images.len(), m.points.len()) > (b.images.len(), b.points.len()),
+        };
+        if better {
+            best = Some(i);
+        }
+    }
+    let best = best.ok_or_else(|| Error::Empty {
+        what: "SfM model (no sub-model found)".into(),
+    })?;
+    let summaries: Vec<SubModel> = models
+        .iter()
+        .enumerate()
+        .filter(|(i, _)| *i != best)
+        .map(|(_, (name, m))| m.summary(name))
+        .collect();
+    let mut models = models;
+    let (name, mut chosen) = models.swap_remove(best);
+    if !summaries.is_empty() {
+        let others: Vec<String> = summaries
+            .iter()
+            .map(|s| format!("{} ({} images, {} points)", s.name, s.images, s.points))
+            .collect();
+        chosen.warnings.push(format!(
+            "{} separate models; using the largest, {} ({} images, {} points); not used: {}",
+            summaries.len() + 1,
+            name,
+            chosen.images.len(),
+            chosen.points.len(),
+            others.join(", ")
+        ));
+    }
+    chosen.sub_models.extend(summaries);
+    Ok(chosen)
+}
+
+#[cfg(test)]
+#[allow(clippy::unwrap_used, clippy::expect_used)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn quaternion_and_center() {
+        // 90° about z.
+        let h = std::f64::consts::FRAC_1_SQRT_2;
+        let p = Rigid::from_quaternion([h, 0.0, 0.0, h], [1.0, 2.0, 3.0]).unwrap();
+        let r = p.rotation;
+        assert!((r[0][1] + 1.0).abs() < 1e-15 && (r[1][0] - 1.0).abs() < 1e-15);
+        let c = p.center();
+        let back = p.apply(c);
+        assert!(back.iter().all(|v| v.abs() < 1e-12));
+        let q = Rigid::from_rotation_center(r, c);
+        assert!((q.translation[2] - 3.0).abs() < 1e-12);
+        assert!((rotation_angle_deg(&r) - 90.0).abs() < 1e-12);
+        assert!(Rigid::from_quaternion([0.0; 4], [0.0; 3]).is_none());
+        assert!(Rigid::from_quaternion([f64::NAN, 0.0, 0.0, 0.0], [0.0; 3]).is_none());
+    }
+
+    #[test]
+    fn rotation_angle_small_and_half_turn() {
+        let t = 1e-7f64;
+        let r = [[t.cos(), -t.sin(), 0.0], [t.sin(), t.cos(), 0.0], [0.0, 0.0, 1.0]];
+        assert!((rotation_angle_deg(&r) - t.to_degrees()).abs() < 1e-15);
+        let half = [[1.0, 0.0, 0.0], [0.0, -1.0, 0.0], [0.0, 0.0, -1.0]];
+        assert!((rotation_angle_deg(&half) - 180.0).abs() < 1e-12);
+    }
+
+    #[test]
+    fn largest_is_chosen_and_others_reported() {
+        let mut a = Reconstruction::new("colmap");
+        a.images.push(Image {
+            id: 1,
+            name: "a.jpg".into(),
+            camera_id: 1,
+            cam_from_world: Rigid::IDENTITY,
+            observations: vec![],
+        });
+        let b = Reconstruction::new("colmap");
+        let chosen = choose_largest(vec![("sparse/0".into(), b), ("sparse/1".into(), a)]).unwrap();
+        assert_eq!(chosen.images.len(), 1);
+        assert_eq!(chosen.num_models(), 2);
+        assert_eq!(chosen.sub_models[0].name, "sparse/0");
+        assert!(chosen.warnings[0].contains("sparse/1"));
+        assert!(matches!(choose_largest(vec![]), Err(Error::Empty { .. })));
+    }
+}
