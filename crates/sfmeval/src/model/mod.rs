@@ -25,7 +25,7 @@ pub mod strip;
 mod text;
 
 #[cfg(test)]
-mod fuzz_tests;
+pub(crate) mod fuzz_tests;
 
 use crate::error::{Error, Result};
 use crate::geometry::{Point3, PointCloud};
@@ -421,7 +421,11 @@ mod tests {
     #[test]
     fn rotation_angle_small_and_half_turn() {
         let t = 1e-7f64;
-        let r = [[t.cos(), -t.sin(), 0.0], [t.sin(), t.cos(), 0.0], [0.0, 0.0, 1.0]];
+        let r = [
+            [t.cos(), -t.sin(), 0.0],
+            [t.sin(), t.cos(), 0.0],
+            [0.0, 0.0, 1.0],
+        ];
         assert!((rotation_angle_deg(&r) - t.to_degrees()).abs() < 1e-15);
         let half = [[1.0, 0.0, 0.0], [0.0, -1.0, 0.0], [0.0, 0.0, -1.0]];
         assert!((rotation_angle_deg(&half) - 180.0).abs() < 1e-12);

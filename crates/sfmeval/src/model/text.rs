@@ -27,13 +27,23 @@ pub(crate) fn parse<T: std::str::FromStr>(
     what: &str,
     line: usize,
 ) -> Result<T> {
-    let tok = tok.ok_or_else(|| Error::truncated(format, format!("line {line}: missing {what}")))?;
-    tok.parse::<T>()
-        .map_err(|_| Error::malformed(format, format!("line {line}: {what} '{}' is not a valid number", clip(tok))))
+    let tok =
+        tok.ok_or_else(|| Error::truncated(format, format!("line {line}: missing {what}")))?;
+    tok.parse::<T>().map_err(|_| {
+        Error::malformed(
+            format,
+            format!("line {line}: {what} '{}' is not a valid number", clip(tok)),
+        )
+    })
 }
 
 /// Parses a finite f64.
-pub(crate) fn parse_f64(format: &'static str, tok: Option<&str>, what: &str, line: usize) -> Result<f64> {
+pub(crate) fn parse_f64(
+    format: &'static str,
+    tok: Option<&str>,
+    what: &str,
+    line: usize,
+) -> Result<f64> {
     let v: f64 = parse(format, tok, what, line)?;
     if !v.is_finite() {
         return Err(Error::NonFinite {
@@ -74,11 +84,6 @@ impl<'a> Tokens<'a> {
             current: "".split_whitespace(),
             line: 0,
         }
-    }
-
-    /// The current line number (1-based).
-    pub(crate) fn line(&self) -> usize {
-        self.line
     }
 
     /// The next token, or `None` at the end.
