@@ -138,6 +138,7 @@ pub fn read_gltf(bytes: &[u8], external: &BTreeMap<String, Vec<u8>>) -> Result<G
     // The geometry does not depend on the extensions left; the crate would refuse them.
     obj.remove("extensionsRequired");
     obj.remove("extensionsUsed");
+    prepare_for_validation(format, obj)?;
     let cleaned =
         serde_json::to_vec(&value).map_err(|e| Error::malformed(format, e.to_string()))?;
     let doc = gltf::Gltf::from_slice(&cleaned)
@@ -180,6 +181,75 @@ pub fn read_gltf(bytes: &[u8], external: &BTreeMap<String, Vec<u8>>) -> Result<G
         warnings: reader.warnings,
         instances: reader.instances,
     })
+}
+
+/// Prepares the JSON for the crate's validation, which itself panics on some bad indices:
+/// checks that every accessor index a primitive uses exists, and fills the `min`/`max` that the
+/// spec requires on POSITION accessors (some exporters omit them; we never use them).
+fn prepare_for_validation(
+    format: &'static str,
+    root: &mut serde_json::Map<String, serde_json::Value>,
+) -> Result<()> {
+    let n_accessors = root
+        .get("accessors")
+        .and_then(|a| a.as_array())
+        .map_or(0, |a| a.len());
+    let mut position_accessors = Vec::new();
+    let bad = |what: String| Error::malformed(format, what);
+    for (mi, mesh) in root
+        .get("meshes")
+        .and_then(|m| m.as_array())
+        .into_iter()
+        .flatten()
+        .enumerate()
+    {
+        for (pi, prim) in mesh
+            .get("primitives")
+            .and_then(|p| p.as_array())
+            .into_iter()
+            .flatten()
+            .enumerate()
+        {
+            let mut refs: Vec<&serde_json::Value> = Vec::new();
+            if let Some(attrs) = prim.get("attributes").and_then(|a| a.as_object()) {
+                refs.extend(attrs.values());
+                if let Some(i) = attrs.get("POSITION").and_then(|i| i.as_u64()) {
+                    position_accessors.push(i as usize);
+                }
+            }
+            refs.extend(prim.get("indices"));
+            for t in prim
+                .get("targets")
+                .and_then(|t| t.as_array())
+                .into_iter()
+                .flatten()
+            {
+                refs.extend(t.as_object().into_iter().flat_map(|o| o.values()));
+            }
+            for r in refs {
+                match r.as_u64() {
+                    Some(i) if (i as usize) < n_accessors => {}
+                    _ => {
+                        return Err(bad(format!(
+                            "mesh {mi} primitive {pi} refers to accessor {r}, but there are {n_accessors}"
+                        )));
+                    }
+                }
+            }
+        }
+    }
+    if let Some(accessors) = root.get_mut("accessors").and_then(|a| a.as_array_mut()) {
+        for i in position_accessors {
+            if let Some(acc) = accessors.get_mut(i).and_then(|a| a.as_object_mut()) {
+                for key in ["min", "max"] {
+                    if !acc.contains_key(key) {
+                        acc.insert(key.into(), serde_json::json!([0.0, 0.0, 0.0]));
+                    }
+                }
+            }
+        }
+    }
+    Ok(())
 }
 
 fn resolve_buffers(
@@ -555,4 +625,230 @@ fn decode_accessor(
         });
     }
     Ok(out)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Builds a glTF JSON with one data-URI buffer holding `positions` (f32) then `indices`.
+    fn gltf_json(
+        positions: &[[f32; 3]],
+        indices: Option<(&[u32], u32)>,
+        mode: u32,
+        nodes: &str,
+        extra: &str,
+    ) -> Vec<u8> {
+        let mut buf: Vec<u8> = positions
+            .iter()
+            .flatten()
+            .flat_map(|v| v.to_le_bytes())
+            .collect();
+        let pos_len = buf.len();
+        let mut accessors = format!(
+            r#"{{"bufferView":0,"componentType":5126,"count":{},"type":"VEC3"}}"#,
+            positions.len()
+        );
+        let mut views = format!(r#"{{"buffer":0,"byteOffset":0,"byteLength":{pos_len}}}"#);
+        let mut prim = format!(r#"{{"attributes":{{"POSITION":0}},"mode":{mode}"#);
+        if let Some((idx, ctype)) = indices {
+            let start = buf.len();
+            for &i in idx {
+                match ctype {
+                    5121 => buf.push(i as u8),
+                    5123 => buf.extend((i as u16).to_le_bytes()),
+                    _ => buf.extend(i.to_le_bytes()),
+                }
+            }
+            let len = buf.len() - start;
+            while buf.len() % 4 != 0 {
+                buf.push(0);
+            }
+            accessors.push_str(&format!(
+                r#",{{"bufferView":1,"componentType":{ctype},"count":{},"type":"SCALAR"}}"#,
+                idx.len()
+            ));
+            views.push_str(&format!(
+                r#",{{"buffer":0,"byteOffset":{start},"byteLength":{len}}}"#
+            ));
+            prim.push_str(r#","indices":1"#);
+        }
+        prim.push('}');
+        let b64 = base64::engine::general_purpose::STANDARD.encode(&buf);
+        format!(
+            r#"{{"asset":{{"version":"2.0"}},{extra}"scene":0,"scenes":[{{"nodes":[0]}}],"nodes":{nodes},"meshes":[{{"primitives":[{prim}]}}],"accessors":[{accessors}],"bufferViews":[{views}],"buffers":[{{"byteLength":{},"uri":"data:application/octet-stream;base64,{b64}"}}]}}"#,
+            buf.len()
+        )
+        .into_bytes()
+    }
+
+    const QUAD: [[f32; 3]; 4] = [
+        [0.0, 0.0, 0.0],
+        [1.0, 0.0, 0.0],
+        [1.0, 1.0, 0.0],
+        [0.0, 1.0, 0.0],
+    ];
+    const PLAIN: &str = r#"[{"mesh":0}]"#;
+
+    fn read(bytes: &[u8]) -> Result<GltfMesh> {
+        read_gltf(bytes, &BTreeMap::new())
+    }
+
+    #[test]
+    fn index_types_and_non_indexed() {
+        for ctype in [5121, 5123, 5125] {
+            let g = read(&gltf_json(
+                &QUAD,
+                Some((&[0, 1, 2, 0, 2, 3], ctype)),
+                4,
+                PLAIN,
+                "",
+            ))
+            .unwrap();
+            assert_eq!(
+                g.mesh.triangles,
+                vec![[0, 1, 2], [0, 2, 3]],
+                "component type {ctype}"
+            );
+        }
+        let g = read(&gltf_json(&QUAD[..3], None, 4, PLAIN, "")).unwrap();
+        assert_eq!(g.mesh.triangles, vec![[0, 1, 2]]);
+    }
+
+    #[test]
+    fn strips_and_fans_keep_winding() {
+        let strip = read(&gltf_json(&QUAD, Some((&[0, 1, 3, 2], 5125)), 5, PLAIN, "")).unwrap();
+        assert_eq!(strip.mesh.triangles, vec![[0, 1, 3], [3, 1, 2]]);
+        let fan = read(&gltf_json(&QUAD, Some((&[0, 1, 2, 3], 5125)), 6, PLAIN, "")).unwrap();
+        assert_eq!(fan.mesh.triangles, vec![[1, 2, 0], [2, 3, 0]]);
+        // Both windings face +z like the triangle list.
+        for m in [&strip.mesh, &fan.mesh] {
+            for t in &m.triangles {
+                let c = m.corners(t);
+                let n = crate::geometry::cross(
+                    crate::geometry::sub(c[1], c[0]),
+                    crate::geometry::sub(c[2], c[0]),
+                );
+                assert!(n[2] > 0.0);
+            }
+        }
+    }
+
+    #[test]
+    fn node_hierarchy_trs_and_matrix() {
+        // Parent: translation (10,0,0), uniform scale 2. Child: rotation 90° about z (quaternion
+        // x y z w), then a matrix node translating by (0,0,5) (column-major).
+        let s = std::f32::consts::FRAC_1_SQRT_2;
+        let nodes = format!(
+            r#"[{{"children":[1],"translation":[10,0,0],"scale":[2,2,2]}},{{"children":[2],"rotation":[0,0,{s},{s}]}},{{"mesh":0,"matrix":[1,0,0,0, 0,1,0,0, 0,0,1,0, 0,0,5,1]}}]"#
+        );
+        let g = read(&gltf_json(&QUAD[..3], None, 4, &nodes, "")).unwrap();
+        // (1,0,0) → +z5 → (1,0,5) → rot z 90 → (0,1,5) → scale 2 → (0,2,10) → +10x → (10,2,10)
+        let v = g.mesh.vertices[1];
+        assert!(
+            (v[0] - 10.0).abs() < 1e-6 && (v[1] - 2.0).abs() < 1e-6 && (v[2] - 10.0).abs() < 1e-6,
+            "{v:?}"
+        );
+        assert_eq!(g.instances, 1);
+    }
+
+    #[test]
+    fn mirroring_flips_winding() {
+        let nodes = r#"[{"mesh":0,"scale":[-1,1,1]}]"#;
+        let g = read(&gltf_json(&QUAD[..3], None, 4, nodes, "")).unwrap();
+        assert_eq!(g.mesh.triangles, vec![[0, 2, 1]]);
+    }
+
+    #[test]
+    fn glb_container_round_trip() {
+        let json = gltf_json(&QUAD, Some((&[0, 1, 2, 0, 2, 3], 5123)), 4, PLAIN, "");
+        let mut padded = json.clone();
+        while padded.len() % 4 != 0 {
+            padded.push(b' ');
+        }
+        let mut glb = b"glTF".to_vec();
+        glb.extend(2u32.to_le_bytes());
+        glb.extend(((12 + 8 + padded.len()) as u32).to_le_bytes());
+        glb.extend((padded.len() as u32).to_le_bytes());
+        glb.extend(0x4E4F_534Au32.to_le_bytes());
+        glb.extend(&padded);
+        let g = read(&glb).unwrap();
+        assert_eq!(g.mesh.triangles.len(), 2);
+        assert!(matches!(
+            read(&glb[..glb.len() - 10]),
+            Err(Error::Truncated { .. })
+        ));
+    }
+
+    #[test]
+    fn points_and_lines_are_skipped_with_a_warning() {
+        let g = read(&gltf_json(&QUAD, None, 0, PLAIN, ""));
+        assert!(matches!(g, Err(Error::Empty { .. })));
+    }
+
+    #[test]
+    fn unsupported_extensions_and_bad_indices() {
+        let draco = gltf_json(
+            &QUAD,
+            None,
+            4,
+            PLAIN,
+            r#""extensionsUsed":["KHR_draco_mesh_compression"],"extensionsRequired":["KHR_draco_mesh_compression"],"#,
+        );
+        let e = read(&draco).unwrap_err();
+        assert!(matches!(e, Error::Unsupported { .. }));
+        assert!(e.to_string().contains("Draco"));
+        let quant = gltf_json(
+            &QUAD[..3],
+            None,
+            4,
+            PLAIN,
+            r#""extensionsUsed":["KHR_mesh_quantization"],"extensionsRequired":["KHR_mesh_quantization"],"#,
+        );
+        assert!(read(&quant).is_ok());
+        let bad = gltf_json(&QUAD, Some((&[0, 1, 9], 5125)), 4, PLAIN, "");
+        assert!(matches!(read(&bad), Err(Error::Malformed { .. })));
+        assert!(matches!(read(b"{not json"), Err(Error::Malformed { .. })));
+        let external = String::from_utf8(gltf_json(&QUAD[..3], None, 4, PLAIN, "")).unwrap();
+        let cut = external.find("data:").unwrap();
+        let end = external[cut..].find('"').unwrap() + cut;
+        let ext = format!("{}mesh.bin{}", &external[..cut], &external[end..]);
+        let e = read(ext.as_bytes()).unwrap_err();
+        assert!(e.to_string().contains("mesh.bin"), "{e}");
+        let buf: Vec<u8> = QUAD[..3]
+            .iter()
+            .flatten()
+            .flat_map(|v| v.to_le_bytes())
+            .collect();
+        let mut files = BTreeMap::new();
+        files.insert("mesh.bin".to_string(), buf);
+        assert_eq!(
+            read_gltf(ext.as_bytes(), &files)
+                .unwrap()
+                .mesh
+                .triangles
+                .len(),
+            1
+        );
+    }
+
+    #[test]
+    fn quantized_normalized_positions_decode() {
+        // u16 normalized positions (KHR_mesh_quantization style).
+        let raw: Vec<u8> = [[0u16, 0, 0], [65535, 0, 0], [0, 65535, 0]]
+            .iter()
+            .flatten()
+            .flat_map(|v| v.to_le_bytes())
+            .chain([0, 0])
+            .collect();
+        let b64 = base64::engine::general_purpose::STANDARD.encode(&raw);
+        let json = format!(
+            r#"{{"asset":{{"version":"2.0"}},"extensionsUsed":["KHR_mesh_quantization"],"extensionsRequired":["KHR_mesh_quantization"],"nodes":[{{"mesh":0}}],"meshes":[{{"primitives":[{{"attributes":{{"POSITION":0}}}}]}}],"accessors":[{{"bufferView":0,"componentType":5123,"normalized":true,"count":3,"type":"VEC3"}}],"bufferViews":[{{"buffer":0,"byteLength":18,"byteStride":8}}],"buffers":[{{"byteLength":20,"uri":"data:application/gltf-buffer;base64,{b64}"}}]}}"#
+        );
+        // byteStride 8 with 6-byte elements: the third element ends at 2*8+6 = 22 > 18 → refused.
+        assert!(read(json.as_bytes()).is_err());
+        let json = json.replace(r#","byteStride":8"#, "");
+        let g = read(json.as_bytes()).unwrap();
+        assert_eq!(g.mesh.vertices[1], [1.0, 0.0, 0.0]);
+    }
 }
