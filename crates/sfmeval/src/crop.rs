@@ -145,12 +145,10 @@ impl Crop {
     pub fn parse(bytes: &[u8]) -> Result<Crop> {
         let crop: Crop = serde_json::from_slice(bytes)
             .map_err(|e| Error::InvalidOption(format!("crop file: {e}")))?;
-        if let Some(s) = &crop.schema {
-            if s != CROP_SCHEMA {
-                return Err(Error::InvalidOption(format!(
-                    "crop file schema is '{s}', expected '{CROP_SCHEMA}'"
-                )));
-            }
+        if let Some(s) = crop.schema.as_ref().filter(|s| *s != CROP_SCHEMA) {
+            return Err(Error::InvalidOption(format!(
+                "crop file schema is '{s}', expected '{CROP_SCHEMA}'"
+            )));
         }
         crop.validate()?;
         Ok(crop)
@@ -161,12 +159,10 @@ impl Crop {
         if let Some(v) = &self.volume {
             v.validate()?;
         }
-        if let Some(d) = self.max_distance {
-            if !(d.is_finite() && d >= 0.0) {
-                return Err(Error::InvalidOption(format!(
-                    "max distance must be ≥ 0, got {d}"
-                )));
-            }
+        if let Some(d) = self.max_distance.filter(|d| !(d.is_finite() && *d >= 0.0)) {
+            return Err(Error::InvalidOption(format!(
+                "max distance must be ≥ 0, got {d}"
+            )));
         }
         Ok(())
     }

@@ -105,7 +105,7 @@ pub struct InputInfo {
 }
 
 enum GtIndex {
-    Mesh(MeshIndex),
+    Mesh(Box<MeshIndex>),
     Cloud(CloudIndex),
 }
 
@@ -147,7 +147,7 @@ impl PreparedGroundTruth {
                 progress.start(Stage::Sampling, 1);
                 let s = sample_surface(m, samples, seed)?;
                 (
-                    GtIndex::Mesh(idx),
+                    GtIndex::Mesh(Box::new(idx)),
                     s,
                     m.vertices.len(),
                     m.triangles.len(),

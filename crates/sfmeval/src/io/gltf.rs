@@ -312,12 +312,13 @@ fn percent_decode(s: &str) -> String {
     let mut out = Vec::with_capacity(b.len());
     let mut i = 0;
     while i < b.len() {
-        if b[i] == b'%' && i + 2 < b.len() {
-            if let (Some(h), Some(l)) = (hex(b[i + 1]), hex(b[i + 2])) {
-                out.push((h * 16 + l) as u8);
-                i += 3;
-                continue;
-            }
+        let escaped = (b[i] == b'%' && i + 2 < b.len())
+            .then(|| hex(b[i + 1]).zip(hex(b[i + 2])))
+            .flatten();
+        if let Some((h, l)) = escaped {
+            out.push((h * 16 + l) as u8);
+            i += 3;
+            continue;
         }
         out.push(b[i]);
         i += 1;
@@ -661,7 +662,7 @@ mod tests {
                 }
             }
             let len = buf.len() - start;
-            while buf.len() % 4 != 0 {
+            while !buf.len().is_multiple_of(4) {
                 buf.push(0);
             }
             accessors.push_str(&format!(
@@ -763,7 +764,7 @@ mod tests {
     fn glb_container_round_trip() {
         let json = gltf_json(&QUAD, Some((&[0, 1, 2, 0, 2, 3], 5123)), 4, PLAIN, "");
         let mut padded = json.clone();
-        while padded.len() % 4 != 0 {
+        while !padded.len().is_multiple_of(4) {
             padded.push(b' ');
         }
         let mut glb = b"glTF".to_vec();

@@ -577,7 +577,7 @@ fn read_ascii_body(
     let mut tokens = Tokens { text: body, pos: 0 };
     for element in &header.elements {
         // Each entry needs at least one token of at least 2 bytes ("0 " or "0\n").
-        let available = (body.len().saturating_sub(tokens.pos) as u64 + 1) / 2;
+        let available = (body.len().saturating_sub(tokens.pos) as u64).div_ceil(2);
         let per_entry = element.properties.len().max(1) as u64;
         if element.count > available / per_entry {
             return Err(Error::CountMismatch {
