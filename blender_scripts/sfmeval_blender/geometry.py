@@ -176,3 +176,12 @@ def rotation_to_quaternion(r):
     if q[0] < 0:
         q = [-x for x in q]
     return q
+
+
+def quaternion_to_rotation(q):
+    """Rotation matrix of a quaternion (w, x, y, z), normalised first, in double precision."""
+    n = math.sqrt(sum(float(c) ** 2 for c in q))
+    w, x, y, z = (float(c) / n for c in q)
+    return [[1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
+            [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
+            [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)]]

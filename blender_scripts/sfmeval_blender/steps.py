@@ -695,6 +695,16 @@ def _r(x, nd=12):
     return round(float(x), nd)
 
 
+def dump_json(obj, path):
+    """JSON with one line per small numeric array (rotation rows, vectors)."""
+    import re
+    text = json.dumps(obj, indent=1)
+    text = re.sub(r"\[\s*([-0-9.eE+,\s]+?)\s*\]",
+                  lambda m: "[" + ", ".join(x.strip() for x in m.group(1).split(",")) + "]", text)
+    with open(path, "w") as f:
+        f.write(text + "\n")
+
+
 def gt_cameras(scene):
     cam = get_camera()
     meta = load(scene, "views") or []
@@ -704,11 +714,10 @@ def gt_cameras(scene):
     for m in meta:
         scene.frame_set(m["frame"])
         mw = cam.matrix_world
-        rot = [[mw[i][j] for j in range(3)] for i in range(3)]
-        # matrix_world may carry float noise in scale: orthonormalise through the quaternion
-        q = mw.to_quaternion().normalized()
-        rm = q.to_matrix()
-        rot = [[rm[i][j] for j in range(3)] for i in range(3)]
+        # Blender keeps the pose in float32: take its unit quaternion and build the rotation in
+        # double precision, so that the written matrix is orthonormal to ~1e-16.
+        q = mw.to_quaternion()
+        rot = geometry.quaternion_to_rotation([q.w, q.x, q.y, q.z])
         centre = [mw[0][3], mw[1][3], mw[2][3]]
         R, t, c = geometry.opencv_pose_gltf(rot, centre)
         images.append({"name": m["name"], "camera_id": 1,
@@ -776,9 +785,7 @@ def step_export(cfg, out_dir):
     os.makedirs(out_dir, exist_ok=True)
     export_glb(obj, os.path.join(out_dir, "ground_truth.glb"))
     cams = gt_cameras(scene)
-    with open(os.path.join(out_dir, "cameras.json"), "w") as f:
-        json.dump(cams, f, indent=1)
-        f.write("\n")
+    dump_json(cams, os.path.join(out_dir, "cameras.json"))
     if cfg["outputs"]["colmap_gt"]:
         write_colmap_text(cams, os.path.join(out_dir, "sparse_gt"))
     verts, ntri = evaluated_world_vertices(obj)
@@ -819,9 +826,7 @@ def step_export(cfg, out_dir):
                   "blend": "scene.blend" if cfg["outputs"]["save_blend"] else None},
         "created_utc": time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime()),
     }
-    with open(os.path.join(out_dir, "dataset.json"), "w") as f:
-        json.dump(ds, f, indent=1)
-        f.write("\n")
+    dump_json(ds, os.path.join(out_dir, "dataset.json"))
     if cfg["outputs"]["save_blend"]:
         bpy.ops.wm.save_as_mainfile(filepath=os.path.abspath(os.path.join(out_dir, "scene.blend")),
                                     copy=True)
