@@ -101,7 +101,7 @@ fn mutate(rng: &mut Rng, src: &[u8]) -> Vec<u8> {
 }
 
 /// Mutations per reader input.
-const N: usize = 2500;
+const N: usize = 10_000;
 
 fn hammer(label: &str, sources: &[Vec<u8>], seed: u64, mut read: impl FnMut(usize, &[u8])) {
     let mut rng = Rng(seed);
@@ -165,7 +165,7 @@ fn colmap_folder_never_panics() {
     let keys: Vec<String> = files.keys().cloned().collect();
     let src: Vec<Vec<u8>> = files.values().cloned().collect();
     let mut rng = Rng(3);
-    for _ in 0..N / 5 {
+    for _ in 0..N / 10 {
         let which = rng.below(src.len());
         let mut f = files.clone();
         f.insert(keys[which].clone(), mutate(&mut rng, &src[which]));

@@ -351,3 +351,97 @@ fn real_tool_outputs_agree_with_ground_truth_after_alignment() {
         assert!(r.relative.auc > 0.9, "{label}");
     }
 }
+
+/// Same models, same similarity, compared with the numpy/scipy implementation in
+/// `tests/python/test_pose_metrics.py` (its output is committed as `pose_expected.json`).
+#[test]
+fn agrees_with_numpy_reference() {
+    use crate::model::colmap;
+    let expected: serde_json::Value =
+        serde_json::from_slice(&fixture("pose_expected.json")).unwrap();
+    let gt = gt();
+    let read = |dir: &str| -> Reconstruction {
+        if dir.ends_with("_bin") {
+            let f = |n: &str| fixture(&format!("{dir}/{n}.bin"));
+            colmap::read_colmap_binary(&f("cameras"), &f("images"), Some(&f("points3D"))).unwrap()
+        } else {
+            let f = |n: &str| fixture(&format!("{dir}/{n}.txt"));
+            colmap::read_colmap_text(&f("cameras"), &f("images"), Some(&f("points3D"))).unwrap()
+        }
+    };
+    let obj = expected.as_object().unwrap();
+    assert_eq!(obj.len(), 4);
+    for (dir, want) in obj {
+        let est = read(dir);
+        let m: Vec<f64> = want["gt_from_recon"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .flat_map(|r| r.as_array().unwrap().iter().map(|v| v.as_f64().unwrap()))
+            .collect();
+        let mut mat = [[0.0; 4]; 4];
+        for (i, v) in m.iter().enumerate() {
+            mat[i / 4][i % 4] = *v;
+        }
+        let s = Similarity::from_matrix(mat).unwrap();
+        let r = evaluate_cameras(&gt, &est, &s, &PoseOptions::default()).unwrap();
+        let close = |a: f64, b: &serde_json::Value, tol: f64, what: &str| {
+            let b = b.as_f64().unwrap();
+            assert!((a - b).abs() <= tol, "{dir} {what}: sfmeval {a} numpy {b}");
+        };
+        assert_eq!(r.matched as u64, want["matched"].as_u64().unwrap());
+        close(r.scene_radius, &want["scene_radius"], 1e-12, "scene radius");
+        close(r.ate_rmse, &want["ate_rmse"], 1e-9, "ATE");
+        for im in &r.images {
+            let w = &want["images"][&im.name];
+            close(
+                im.rotation_error_deg,
+                &w["rotation_error_deg"],
+                1e-7,
+                "rotation",
+            );
+            close(im.center_error, &w["center_error"], 1e-9, "centre");
+        }
+        // Pairs in the same (i < j) order.
+        let rel_rot = want["relative_rotation_error_deg"].as_array().unwrap();
+        let rel_tr = want["relative_translation_error_deg"].as_array().unwrap();
+        assert_eq!(r.relative.pairs, rel_rot.len());
+        let mean = |v: &[serde_json::Value]| {
+            v.iter().map(|x| x.as_f64().unwrap()).sum::<f64>() / v.len() as f64
+        };
+        assert!(
+            (r.relative.rotation_error_deg.mean - mean(rel_rot)).abs() < 1e-7,
+            "{dir}"
+        );
+        assert!(
+            (r.relative.translation_error_deg.mean - mean(rel_tr)).abs() < 1e-7,
+            "{dir}"
+        );
+        let max =
+            |v: &[serde_json::Value]| v.iter().map(|x| x.as_f64().unwrap()).fold(0.0, f64::max);
+        assert!(
+            (r.relative.rotation_error_deg.max - max(rel_rot)).abs() < 1e-7,
+            "{dir}"
+        );
+        assert!(
+            (r.relative.translation_error_deg.max - max(rel_tr)).abs() < 1e-7,
+            "{dir}"
+        );
+        for (a, w) in r
+            .relative
+            .accuracy
+            .iter()
+            .zip(want["accuracy"].as_array().unwrap())
+        {
+            close(a.rra, &w["rra"], 1e-12, "RRA");
+            close(a.rta, &w["rta"], 1e-12, "RTA");
+        }
+        close(r.relative.auc, &want["auc"], 1e-12, "AUC");
+        close(
+            r.focal[0].error_percent,
+            &want["focal"][0]["error_percent"],
+            1e-9,
+            "focal",
+        );
+    }
+}
