@@ -8,6 +8,7 @@
 //! | Bundler `.out` v0.3 + `list.txt` | [`bundler::read_bundler`] |
 //! | OpenMVG `sfm_data.json` | [`openmvg::read_openmvg_json`] |
 //! | `cameras.json` (`sfmeval.cameras/1`) | [`cameras_json::read_cameras_json`] |
+//! | any of the above among a folder's files, by content and name | [`read_model_files`], [`detect_model_format`] |
 //!
 //! Poses are always `cam_from_world` in the OpenCV/COLMAP convention (x right, y down, z
 //! forward; `x_cam = R·X + t`), and intrinsics use COLMAP's pixel convention (the image centre is
@@ -396,6 +397,106 @@ pub fn choose_largest(models: Vec<(String, Reconstruction)>) -> Result<Reconstru
     Ok(chosen)
 }
 
+/// An SfM model format [`detect_model_format`] recognises.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ModelFormat {
+    /// A COLMAP model file (`cameras`/`images`/`points3D`, `.txt` or `.bin`).
+    Colmap,
+    /// VisualSfM NVM.
+    Nvm,
+    /// Bundler `.out`.
+    Bundler,
+    /// OpenMVG `sfm_data.json`.
+    OpenMvg,
+    /// `cameras.json` (`sfmeval.cameras/1`).
+    CamerasJson,
+}
+
+/// Recognises an SfM model file by content first (`NVM_V3`, `# Bundle file`, JSON with
+/// `sfm_data_version`/`views` or `"schema": "sfmeval.cameras/1"`), then by name.
+pub fn detect_model_format(name: &str, bytes: &[u8]) -> Option<ModelFormat> {
+    let base = name.rsplit(['/', '\\']).next().unwrap_or(name);
+    let head = bytes.get(..bytes.len().min(4096)).unwrap_or_default();
+    let head_text = String::from_utf8_lossy(head);
+    let trimmed = head_text.trim_start_matches('\u{feff}').trim_start();
+    if trimmed.starts_with("NVM_V3") {
+        return Some(ModelFormat::Nvm);
+    }
+    if trimmed.starts_with("# Bundle file") {
+        return Some(ModelFormat::Bundler);
+    }
+    if trimmed.starts_with('{') {
+        if head_text.contains("sfmeval.cameras/") {
+            return Some(ModelFormat::CamerasJson);
+        }
+        if head_text.contains("sfm_data_version") || head_text.contains("\"views\"") {
+            return Some(ModelFormat::OpenMvg);
+        }
+    }
+    let lower = base.to_ascii_lowercase();
+    match lower.as_str() {
+        "cameras.txt" | "images.txt" | "points3d.txt" | "cameras.bin" | "images.bin"
+        | "points3d.bin" => Some(ModelFormat::Colmap),
+        _ if lower.ends_with(".nvm") => Some(ModelFormat::Nvm),
+        _ if lower.ends_with(".out") => Some(ModelFormat::Bundler),
+        _ => None,
+    }
+}
+
+/// Reads an SfM model from a set of files (`relative path → bytes`): a COLMAP folder (one or
+/// several sub-models), or one NVM, Bundler `.out` (with its `list.txt` / `*.list.txt` beside
+/// it when present), OpenMVG `sfm_data.json` or `cameras.json` file. COLMAP wins when both are
+/// present. Fails with [`Error::UnknownFormat`] when nothing is recognised.
+pub fn read_model_files(
+    files: &std::collections::BTreeMap<String, Vec<u8>>,
+) -> Result<Reconstruction> {
+    let detected: Vec<(&String, &Vec<u8>, ModelFormat)> = files
+        .iter()
+        .filter_map(|(n, b)| detect_model_format(n, b).map(|f| (n, b, f)))
+        .collect();
+    if detected.iter().any(|d| d.2 == ModelFormat::Colmap) {
+        return colmap::read_colmap_folder(files);
+    }
+    let Some(&(name, bytes, format)) = detected.first() else {
+        return Err(Error::UnknownFormat(format!(
+            "no SfM model among {} file(s) (expected a COLMAP model, .nvm, Bundler .out, sfm_data.json or cameras.json)",
+            files.len()
+        )));
+    };
+    let mut rec = match format {
+        ModelFormat::Nvm => nvm::read_nvm(bytes)?,
+        ModelFormat::OpenMvg => openmvg::read_openmvg_json(bytes)?,
+        ModelFormat::CamerasJson => cameras_json::read_cameras_json(bytes)?,
+        ModelFormat::Bundler => {
+            let norm = name.replace('\\', "/");
+            let (dir, base) = norm.rsplit_once('/').unwrap_or(("", norm.as_str()));
+            let stem = base.strip_suffix(".out").unwrap_or(base);
+            let stem = stem.strip_suffix(".bundle").unwrap_or(stem);
+            let join = |f: &str| {
+                if dir.is_empty() {
+                    f.to_string()
+                } else {
+                    format!("{dir}/{f}")
+                }
+            };
+            let list = [join(&format!("{stem}.list.txt")), join("list.txt")]
+                .iter()
+                .find_map(|k| files.get(k))
+                .map(Vec::as_slice);
+            bundler::read_bundler(bytes, list)?
+        }
+        ModelFormat::Colmap => colmap::read_colmap_folder(files)?,
+    };
+    if detected.len() > 1 {
+        rec.warnings.push(format!(
+            "{} model files found; read '{}'",
+            detected.len(),
+            text::clip(name)
+        ));
+    }
+    Ok(rec)
+}
+
 #[cfg(test)]
 #[allow(clippy::unwrap_used, clippy::expect_used)]
 mod tests {
@@ -448,5 +549,51 @@ mod tests {
         assert_eq!(chosen.sub_models[0].name, "sparse/0");
         assert!(chosen.warnings[0].contains("sparse/1"));
         assert!(matches!(choose_largest(vec![]), Err(Error::Empty { .. })));
+    }
+
+    #[test]
+    fn read_model_files_dispatches_by_content_and_name() {
+        use crate::model::fuzz_tests::fixture;
+        use std::collections::BTreeMap;
+        let one = |name: &str, fix: &str| {
+            let mut m = BTreeMap::new();
+            m.insert(name.to_string(), fixture(fix));
+            m
+        };
+        let nvm = read_model_files(&one("run/model.NVM", "colmap38.nvm")).unwrap();
+        assert_eq!((nvm.format, nvm.images.len()), ("nvm", 6));
+        let om = read_model_files(&one(
+            "reconstruction/sfm_data.json",
+            "openmvg_sfm_data.json",
+        ))
+        .unwrap();
+        assert_eq!(om.format, "openmvg");
+        let cj = read_model_files(&one("x.json", "gt_cameras.json")).unwrap();
+        assert_eq!(cj.format, "cameras_json");
+        let mut b = one("out/colmap38.bundle.out", "colmap38.bundle.out");
+        b.insert("out/colmap38.list.txt".into(), fixture("colmap38.list.txt"));
+        let bu = read_model_files(&b).unwrap();
+        assert_eq!(bu.images[0].name, "0003.png");
+        let mut c = BTreeMap::new();
+        for f in ["cameras.txt", "images.txt", "points3D.txt"] {
+            c.insert(
+                format!("sparse/0/{f}"),
+                fixture(&format!("colmap_text/{f}")),
+            );
+        }
+        c.insert("notes.txt".into(), b"hello".to_vec());
+        assert_eq!(read_model_files(&c).unwrap().format, "colmap");
+        assert!(matches!(
+            read_model_files(&one("a.ply", "openmvg.ply")),
+            Err(Error::UnknownFormat(_))
+        ));
+        assert_eq!(
+            detect_model_format("x", b"NVM_V3\n"),
+            Some(ModelFormat::Nvm)
+        );
+        assert_eq!(
+            detect_model_format("points3D.BIN", b"\0"),
+            Some(ModelFormat::Colmap)
+        );
     }
 }
