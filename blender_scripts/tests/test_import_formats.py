@@ -95,3 +95,23 @@ def test_blend_file_with_modifier(tmp_path):
     assert meta["object"]["vertices"] == 98                  # 8-vertex cube subdivided twice
     gt, _ = glb_vertices(str(out / "ground_truth.glb"))
     assert (gt.max(0) - gt.min(0)).max() == pytest.approx(1.0, abs=1e-6)
+
+
+def test_fbx_written_by_blender(tmp_path):
+    path = tmp_path / "m.fbx"
+    script = (
+        "import bpy, sys\n"
+        "bpy.ops.wm.read_factory_settings(use_empty=True)\n"
+        "me = bpy.data.meshes.new('m')\n"
+        "me.from_pydata([(0,0,0),(2,0,0),(2,1,0),(0,1,0),(0,0,3),(2,0,3),(2,1,3),(0,1,3)], [],"
+        " [(0,1,2,3),(4,7,6,5),(0,4,5,1),(1,5,6,2),(2,6,7,3),(3,7,4,0)])\n"
+        "o = bpy.data.objects.new('m', me); bpy.context.scene.collection.objects.link(o)\n"
+        "bpy.ops.export_scene.fbx(filepath=sys.argv[1])\n")
+    proc = subprocess.run([sys.executable, "-c", script, str(path)], capture_output=True, text=True)
+    assert proc.returncode == 0, proc.stderr[-2000:]
+    out = _generate(tmp_path, path)
+    meta = load_json(out / "dataset.json")
+    assert meta["source"]["format"] == "fbx" and meta["object"]["vertices"] == 8
+    gt, _ = glb_vertices(str(out / "ground_truth.glb"))
+    ext = np.sort(gt.max(0) - gt.min(0))
+    assert ext == pytest.approx([1 / 3, 2 / 3, 1.0], abs=1e-5)     # 2×1×3 box, normalised
