@@ -417,13 +417,30 @@ CLASSES = (SFMEVAL_PG_ring, SFMEVAL_PG_settings, SFMEVAL_OT_import_object, SFMEV
            SFMEVAL_OT_load_config, SFMEVAL_OT_ring_add, SFMEVAL_OT_ring_remove, SFMEVAL_PT_panel)
 
 
+@bpy.app.handlers.persistent
+def _init_defaults(*_args):
+    """Fill a scene's empty settings with the default config (rings etc.)."""
+    try:
+        for scene in bpy.data.scenes:
+            if len(scene.sfmeval.rings) == 0:
+                config_to_props(cfgmod.resolve({}), scene.sfmeval)
+    except Exception:  # pragma: no cover - restricted context while loading
+        pass
+    return None
+
+
 def register():
     for cls in CLASSES:
         bpy.utils.register_class(cls)
     bpy.types.Scene.sfmeval = PointerProperty(type=SFMEVAL_PG_settings)
+    if _init_defaults not in bpy.app.handlers.load_post:
+        bpy.app.handlers.load_post.append(_init_defaults)
+    bpy.app.timers.register(_init_defaults, first_interval=0.2)
 
 
 def unregister():
+    if _init_defaults in bpy.app.handlers.load_post:
+        bpy.app.handlers.load_post.remove(_init_defaults)
     del bpy.types.Scene.sfmeval
     for cls in reversed(CLASSES):
         bpy.utils.unregister_class(cls)

@@ -114,8 +114,11 @@ def build_tiff(width, height, focal_mm, sensor_mm, make="sfmeval", model="Blende
 
 
 def insert_jpeg(jpeg_bytes, tiff):
-    """Insert an EXIF APP1 segment: after SOI (and after a JFIF APP0 if present); removes any
-    existing EXIF APP1."""
+    """Insert an EXIF APP1 segment right after SOI / the JFIF APP0 segment.
+
+    Drops any older EXIF, Blender's own APP1 ("NeoGeo") and comment (COM) segments: Cycles
+    stores render statistics (render time, memory) there, which would make the bytes of the
+    same image differ between runs."""
     if jpeg_bytes[:2] != b"\xff\xd8":
         raise ValueError("not a JPEG file")
     payload = b"Exif\0\0" + tiff
@@ -123,27 +126,33 @@ def insert_jpeg(jpeg_bytes, tiff):
         raise ValueError("EXIF too large")
     app1 = b"\xff\xe1" + struct.pack(">H", len(payload) + 2) + payload
     pos = 2
-    head = [jpeg_bytes[:2]]
-    inserted = False
+    out = [jpeg_bytes[:2]]
+    placed = False
     while pos + 4 <= len(jpeg_bytes) and jpeg_bytes[pos] == 0xFF:
         marker = jpeg_bytes[pos + 1]
-        if marker not in (0xE0, 0xE1):
+        if marker == 0xDA:                         # start of scan: the rest is entropy-coded data
             break
         seglen = struct.unpack(">H", jpeg_bytes[pos + 2:pos + 4])[0]
         seg = jpeg_bytes[pos:pos + 2 + seglen]
-        if marker == 0xE1 and seg[4:10] == b"Exif\0\0":
-            pass                                   # drop an old EXIF segment
-        else:
-            head.append(seg)
         pos += 2 + seglen
-    head.append(app1)
-    inserted = True
-    assert inserted
-    return b"".join(head) + jpeg_bytes[pos:]
+        if marker == 0xE0 and not placed:
+            out.append(seg)
+            out.append(app1)
+            placed = True
+            continue
+        if marker == 0xFE or (marker == 0xE1 and seg[4:10] in (b"Exif\0\0", b"NeoGeo")):
+            continue
+        if not placed:
+            out.append(app1)
+            placed = True
+        out.append(seg)
+    if not placed:
+        out.append(app1)
+    return b"".join(out) + jpeg_bytes[pos:]
 
 
 def insert_png(png_bytes, tiff):
-    """Insert an eXIf chunk before the first IDAT (PNG 1.5 extension)."""
+    """Insert an eXIf chunk before the first IDAT (PNG 1.5 extension); drops text chunks."""
     sig = b"\x89PNG\r\n\x1a\n"
     if not png_bytes.startswith(sig):
         raise ValueError("not a PNG file")
@@ -158,7 +167,7 @@ def insert_png(png_bytes, tiff):
         if ctype == b"IDAT" and chunk:
             out.append(chunk)
             chunk = b""
-        if ctype != b"eXIf":
+        if ctype not in (b"eXIf", b"tEXt", b"zTXt", b"iTXt"):   # drop render-time metadata
             out.append(png_bytes[pos:end])
         pos = end
     return b"".join(out)

@@ -30,17 +30,16 @@ def objects_with_role(role):
 
 
 def remove_role(role):
+    """Delete the objects a previous run of a step made (and their now unused data)."""
     for o in objects_with_role(role):
         data = o.data
         bpy.data.objects.remove(o, do_unlink=True)
-        if data is not None and data.users == 0:
-            for coll in (bpy.data.meshes, bpy.data.lights, bpy.data.cameras):
-                if data.rna_type.identifier == coll.rna_type.identifier or data in list(coll):
-                    try:
-                        coll.remove(data)
-                    except Exception:
-                        pass
-                    break
+        if data is None or data.users:
+            continue
+        coll = {"MESH": bpy.data.meshes, "LIGHT": bpy.data.lights,
+                "CAMERA": bpy.data.cameras}.get(getattr(data, "id_type", ""))
+        if coll is not None:
+            coll.remove(data)
 
 
 def link(obj, role):
@@ -436,6 +435,11 @@ def configure_render(scene, cfg):
         cy.denoiser = "OPENIMAGEDENOISE"
     scene.render.film_transparent = False
     scene.render.use_persistent_data = True
+    # No Blender metadata in the image files (it holds render times and paths, so the same
+    # config would give different bytes); the EXIF we write is the only metadata.
+    for prop in scene.render.bl_rna.properties.keys():
+        if prop.startswith("use_stamp"):
+            setattr(scene.render, prop, False)
     if r["threads"] > 0:
         scene.render.threads_mode = "FIXED"
         scene.render.threads = r["threads"]
