@@ -1,0 +1,135 @@
+#!/usr/bin/env python3
+"""Reproducible benchmark workloads (numpy only, seeded).
+
+Writes into OUT (default bench/data):
+  mesh_1m.ply / mesh_1m.glb     closed, non-symmetric bumpy sphere, ~1M triangles (binary PLY, GLB)
+  mesh_50k.ply / mesh_50k.glb   the same shape, ~50k triangles
+  cloud_{10k,100k,1m}.ply       points sampled area-uniformly on mesh_1m, 0.5 % (of the bbox
+                                diagonal) Gaussian noise, 5 % uniform outliers in the bbox
+  cloud_{...}_moved.ply         the same clouds moved by a known similarity (recon frame)
+  gt_from_recon.txt             that similarity's inverse mapping moved clouds back (row-major 4x4)
+Usage: bench/generate.py [--out DIR] [--quick]   (--quick: 50k mesh and 10k/100k clouds only)
+"""
+import argparse
+import json
+import struct
+from pathlib import Path
+
+import numpy as np
+
+
+def bumpy_sphere(n_lat, n_lon):
+    theta = np.linspace(0, np.pi, n_lat + 1)[1:-1]          # rings without the poles
+    phi = np.linspace(0, 2 * np.pi, n_lon, endpoint=False)
+    th, ph = np.meshgrid(theta, phi, indexing="ij")
+    dirs = np.stack([np.sin(th) * np.cos(ph), np.cos(th), np.sin(th) * np.sin(ph)], -1).reshape(-1, 3)
+    dirs = np.vstack([[0, 1, 0], dirs, [0, -1, 0]])
+    x, y, z = dirs.T
+    r = 1 + 0.18 * np.sin(3 * x + 0.5) * np.cos(2 * y) + 0.1 * z ** 3 + 0.04 * np.sin(9 * y + 2 * x)
+    v = dirs * r[:, None] * np.array([1.0, 0.8, 0.65])
+    rings = n_lat - 1
+    idx = lambda i, j: 1 + i * n_lon + (j % n_lon)
+    faces = []
+    j = np.arange(n_lon)
+    faces.append(np.stack([np.zeros(n_lon, int), idx(0, j + 1), idx(0, j)], -1))  # top cap
+    for i in range(rings - 1):
+        a, b, c, d = idx(i, j), idx(i, j + 1), idx(i + 1, j), idx(i + 1, j + 1)
+        faces.append(np.stack([a, b, d], -1))
+        faces.append(np.stack([a, d, c], -1))
+    last = len(v) - 1
+    faces.append(np.stack([np.full(n_lon, last), idx(rings - 1, j), idx(rings - 1, j + 1)], -1))
+    return v, np.vstack(faces).astype(np.uint32)
+
+
+def sample(v, f, n, rng):
+    a, b, c = v[f[:, 0]], v[f[:, 1]], v[f[:, 2]]
+    area = 0.5 * np.linalg.norm(np.cross(b - a, c - a), axis=1)
+    tri = rng.choice(len(f), size=n, p=area / area.sum())
+    u, w = rng.random(n), rng.random(n)
+    su = np.sqrt(u)
+    return (1 - su)[:, None] * a[tri] + (su * (1 - w))[:, None] * b[tri] + (su * w)[:, None] * c[tri]
+
+
+def write_ply(path, v, f=None):
+    head = f"ply\nformat binary_little_endian 1.0\ncomment sfmeval bench/generate.py\nelement vertex {len(v)}\nproperty float x\nproperty float y\nproperty float z\n"
+    if f is not None:
+        head += f"element face {len(f)}\nproperty list uchar uint vertex_indices\n"
+    head += "end_header\n"
+    with open(path, "wb") as fh:
+        fh.write(head.encode())
+        fh.write(np.asarray(v, dtype="<f4").tobytes())
+        if f is not None:
+            rec = np.empty(len(f), dtype=[("n", "u1"), ("i", "<u4", 3)])
+            rec["n"] = 3
+            rec["i"] = f
+            fh.write(rec.tobytes())
+
+
+def write_glb(path, v, f):
+    pos = np.asarray(v, dtype="<f4").tobytes()
+    ind = np.asarray(f, dtype="<u4").tobytes()
+    binary = pos + ind
+    gltf = {
+        "asset": {"version": "2.0", "generator": "sfmeval bench/generate.py"},
+        "scene": 0, "scenes": [{"nodes": [0]}], "nodes": [{"mesh": 0}],
+        "meshes": [{"primitives": [{"attributes": {"POSITION": 0}, "indices": 1}]}],
+        "accessors": [
+            {"bufferView": 0, "componentType": 5126, "count": len(v), "type": "VEC3",
+             "min": np.asarray(v, "<f4").min(0).tolist(), "max": np.asarray(v, "<f4").max(0).tolist()},
+            {"bufferView": 1, "componentType": 5125, "count": f.size, "type": "SCALAR"}],
+        "bufferViews": [{"buffer": 0, "byteOffset": 0, "byteLength": len(pos)},
+                        {"buffer": 0, "byteOffset": len(pos), "byteLength": len(ind)}],
+        "buffers": [{"byteLength": len(binary)}],
+    }
+    js = json.dumps(gltf).encode()
+    js += b" " * (-len(js) % 4)
+    binary += b"\0" * (-len(binary) % 4)
+    total = 12 + 8 + len(js) + 8 + len(binary)
+    with open(path, "wb") as fh:
+        fh.write(struct.pack("<III", 0x46546C67, 2, total))
+        fh.write(struct.pack("<II", len(js), 0x4E4F534A) + js)
+        fh.write(struct.pack("<II", len(binary), 0x004E4942) + binary)
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--out", default=str(Path(__file__).resolve().parent / "data"))
+    ap.add_argument("--quick", action="store_true")
+    args = ap.parse_args()
+    out = Path(args.out)
+    out.mkdir(parents=True, exist_ok=True)
+    rng = np.random.default_rng(20261125)
+    meshes = {"50k": (112, 224)} if args.quick else {"50k": (112, 224), "1m": (500, 1000)}
+    for name, (nl, nn) in meshes.items():
+        v, f = bumpy_sphere(nl, nn)
+        write_ply(out / f"mesh_{name}.ply", v, f)
+        write_glb(out / f"mesh_{name}.glb", v, f)
+        print(f"mesh_{name}: {len(v)} vertices, {len(f)} triangles")
+    ref = "1m" if "1m" in meshes else "50k"
+    v, f = bumpy_sphere(*meshes[ref])
+    v = np.asarray(v, "<f4").astype(np.float64)
+    lo, hi = v.min(0), v.max(0)
+    diag = np.linalg.norm(hi - lo)
+    # Known similarity: recon = inverse(gt_from_recon)(gt)
+    angle, axis = 0.9, np.array([0.2, -0.7, 0.4])
+    axis /= np.linalg.norm(axis)
+    K = np.array([[0, -axis[2], axis[1]], [axis[2], 0, -axis[0]], [-axis[1], axis[0], 0]])
+    R = np.eye(3) + np.sin(angle) * K + (1 - np.cos(angle)) * K @ K
+    s, t = 3.7, np.array([0.5, -2.0, 1.25])
+    T = np.eye(4)
+    T[:3, :3] = s * R
+    T[:3, 3] = t
+    np.savetxt(out / "gt_from_recon.txt", T, fmt="%.17g", header="gt_from_recon: maps cloud_*_moved.ply onto the mesh")
+    sizes = {"10k": 10_000, "100k": 100_000} if args.quick else {"10k": 10_000, "100k": 100_000, "1m": 1_000_000}
+    for name, n in sizes.items():
+        n_out = int(0.05 * n)
+        pts = sample(v, f, n - n_out, rng) + rng.normal(scale=0.005 * diag, size=(n - n_out, 3))
+        pts = np.vstack([pts, rng.uniform(lo, hi, size=(n_out, 3))])
+        rng.shuffle(pts)
+        write_ply(out / f"cloud_{name}.ply", pts)
+        write_ply(out / f"cloud_{name}_moved.ply", (pts - t) @ R / s)
+        print(f"cloud_{name}: {n} points ({n_out} outliers)")
+
+
+if __name__ == "__main__":
+    main()
