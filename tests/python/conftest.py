@@ -32,7 +32,7 @@ def run_eval(sfmeval_bin, report_schema, tmp_path):
     def run(gt, recon, *extra, expect_ok=True):
         report = tmp_path / "report.json"
         csv = tmp_path / "points.csv"
-        cmd = [sfmeval_bin, "eval", "--gt", str(gt), "--recon", str(recon), "--quiet",
+        cmd = [sfmeval_bin, "eval", "--gt", str(gt), "--recon", str(recon), "--quiet", "--align", "none",
                "--report", str(report), "--csv", str(csv), *map(str, extra)]
         p = subprocess.run(cmd, capture_output=True, text=True)
         if not expect_ok:

@@ -5,12 +5,17 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{Context as _, Result, bail};
 use clap::{Args, Parser, Subcommand};
+use sfmeval::align::{PointPair, parse_point_pairs};
 use sfmeval::crop::{Crop, Volume};
 use sfmeval::evaluate::{
     AlignmentInput, DEFAULT_SAMPLES, EvalOptions, InputInfo, PreparedGroundTruth, evaluate,
 };
 use sfmeval::geometry::{Aabb, GroundTruth};
 use sfmeval::io;
+use sfmeval::model::{self, Reconstruction};
+use sfmeval::pipeline::{
+    self, AlignRequest, GroundTruthInfo, ReconInput, RunOptions, read_reconstruction,
+};
 use sfmeval::transform::Similarity;
 
 use crate::files::{name_of, read, write_atomic};
@@ -29,6 +34,36 @@ pub struct Cli {
 enum Command {
     /// Evaluate a reconstruction against a ground truth and write the report.
     Eval(EvalArgs),
+    /// Align a reconstruction to the ground truth and print (or save) gt_from_recon.
+    Align {
+        #[command(flatten)]
+        input: InputArgs,
+        /// Write the 4×4 here (JSON with the alignment section when the name ends in .json,
+        /// else 16 numbers as text).
+        #[arg(long, value_name = "FILE")]
+        out: Option<PathBuf>,
+        /// Seed of the randomised stages.
+        #[arg(long, value_name = "S", default_value_t = 0)]
+        seed: u64,
+    },
+    /// Camera-pose errors of a reconstruction's cameras against the ground-truth cameras.
+    Cameras {
+        /// Ground-truth cameras (a dataset's cameras.json, or any model in the GT frame).
+        #[arg(long, value_name = "FILE")]
+        gt_cameras: PathBuf,
+        /// The reconstruction: a COLMAP model folder, .nvm, Bundler .out, sfm_data.json, cameras.json.
+        #[arg(long, value_name = "PATH")]
+        recon: PathBuf,
+        /// Use this gt_from_recon instead of aligning the camera centres.
+        #[arg(long, value_name = "FILE")]
+        transform: Option<PathBuf>,
+        /// Write the cameras section (JSON) here.
+        #[arg(long, value_name = "OUT.json")]
+        report: Option<PathBuf>,
+        /// Print the JSON instead of the summary.
+        #[arg(long)]
+        json: bool,
+    },
     /// Show what a file holds: format, counts, bounds.
     Info {
         /// A PLY, GLB, glTF or OBJ file.
@@ -45,17 +80,36 @@ enum Command {
     },
 }
 
+/// The inputs shared by `eval` and `align`.
 #[derive(Args, Debug)]
-struct EvalArgs {
+struct InputArgs {
     /// Ground truth: GLB, glTF, OBJ or PLY (mesh, or a dense cloud).
     #[arg(long, value_name = "FILE")]
     gt: PathBuf,
-    /// Reconstruction: a PLY point cloud.
-    #[arg(long, value_name = "FILE")]
+    /// Reconstruction: a PLY point cloud, a COLMAP model folder (sparse/ with sub-models is
+    /// fine), an .nvm, a Bundler .out, an OpenMVG sfm_data.json, or a cameras.json.
+    #[arg(long, value_name = "PATH")]
     recon: PathBuf,
-    /// A 4×4 row-major similarity gt_from_recon (JSON or 16 numbers as text).
+    /// Ground-truth cameras (the dataset's cameras.json): camera alignment and pose metrics.
+    #[arg(long, value_name = "FILE")]
+    gt_cameras: Option<PathBuf>,
+    /// Alignment: auto (cameras, else points, else global; then icp), cameras, points, global,
+    /// icp, given (needs --transform) or none. Default: given with --transform, else auto.
+    #[arg(long, value_name = "METHOD", value_parser = ["auto", "cameras", "points", "global", "icp", "given", "none"])]
+    align: Option<String>,
+    /// A 4×4 row-major similarity gt_from_recon (JSON or 16 numbers as text): used as is with
+    /// `--align given`, as the start of `--align icp`.
     #[arg(long, value_name = "FILE")]
     transform: Option<PathBuf>,
+    /// Point pairs for `--align points`: {"pairs": [{"recon": [x,y,z], "gt": [x,y,z]}, ...]}.
+    #[arg(long, value_name = "FILE")]
+    pairs: Option<PathBuf>,
+}
+
+#[derive(Args, Debug)]
+struct EvalArgs {
+    #[command(flatten)]
+    input: InputArgs,
     /// A crop file (sfmeval.crop/1 JSON).
     #[arg(long, value_name = "FILE", conflicts_with_all = ["crop_box", "crop_sphere"])]
     crop: Option<PathBuf>,
@@ -93,7 +147,7 @@ struct EvalArgs {
     /// Completeness samples drawn on a ground-truth mesh.
     #[arg(long, value_name = "N", default_value_t = DEFAULT_SAMPLES)]
     samples: usize,
-    /// Seed of the surface sampler.
+    /// Seed of the surface sampler and the randomised alignment stages.
     #[arg(long, value_name = "S", default_value_t = 0)]
     seed: u64,
     /// Also report distances signed by the closest triangle's normal (as CloudCompare's C2M).
@@ -137,6 +191,20 @@ pub fn run(cli: Cli) -> Result<()> {
             }
             eval(&args)
         }
+        Command::Align { input, out, seed } => align_cmd(&input, out.as_deref(), seed),
+        Command::Cameras {
+            gt_cameras,
+            recon,
+            transform,
+            report,
+            json,
+        } => cameras_cmd(
+            &gt_cameras,
+            &recon,
+            transform.as_deref(),
+            report.as_deref(),
+            json,
+        ),
         Command::Info { file } => info(&file),
         Command::Demo { json, report } => demo(json, report.as_deref()),
     }
@@ -185,6 +253,142 @@ fn crop_from_args(args: &EvalArgs) -> Result<Crop> {
     Ok(crop)
 }
 
+/// Reads every file under a folder (relative paths with `/`), or one file with its Bundler
+/// list / glTF neighbours.
+fn read_path_files(path: &Path) -> Result<BTreeMap<String, Vec<u8>>> {
+    let mut files = BTreeMap::new();
+    if path.is_dir() {
+        let mut stack = vec![path.to_path_buf()];
+        while let Some(dir) = stack.pop() {
+            let entries = std::fs::read_dir(&dir)
+                .with_context(|| format!("cannot list '{}'", dir.display()))?;
+            for entry in entries {
+                let p = entry
+                    .with_context(|| format!("cannot list '{}'", dir.display()))?
+                    .path();
+                if p.is_dir() {
+                    stack.push(p);
+                } else if is_model_file(&p) {
+                    let rel = p
+                        .strip_prefix(path)
+                        .unwrap_or(&p)
+                        .to_string_lossy()
+                        .replace('\\', "/");
+                    files.insert(rel, read(&p)?);
+                }
+            }
+        }
+        if files.is_empty() {
+            bail!(
+                "'{}' holds no SfM model or point cloud file",
+                path.display()
+            );
+        }
+    } else {
+        files.insert(name_of(path), read(path)?);
+        let lower = name_of(path).to_ascii_lowercase();
+        if lower.ends_with(".out") {
+            let dir = path.parent().unwrap_or(Path::new("."));
+            let stem = lower
+                .trim_end_matches(".out")
+                .trim_end_matches(".bundle")
+                .to_string();
+            let original = name_of(path);
+            let stem = &original[..stem.len().min(original.len())];
+            for list in [format!("{stem}.list.txt"), "list.txt".to_string()] {
+                if let Ok(b) = std::fs::read(dir.join(&list)) {
+                    files.insert(list, b);
+                }
+            }
+        }
+    }
+    Ok(files)
+}
+
+/// Files worth reading from a model folder (skips images and logs).
+fn is_model_file(p: &Path) -> bool {
+    let n = name_of(p).to_ascii_lowercase();
+    [".bin", ".txt", ".nvm", ".out", ".json", ".ply"]
+        .iter()
+        .any(|e| n.ends_with(e))
+}
+
+struct Loaded {
+    prepared: PreparedGroundTruth,
+    gt_info: GroundTruthInfo,
+    recon: ReconInput,
+    gt_cameras: Option<Reconstruction>,
+    pairs: Vec<PointPair>,
+    run_options: RunOptions,
+}
+
+fn load(input: &InputArgs, eval: EvalOptions, bars: &Bars) -> Result<Loaded> {
+    let transform = match &input.transform {
+        Some(path) => Some(
+            Similarity::parse(&read(path)?)
+                .with_context(|| format!("transform file '{}'", path.display()))?,
+        ),
+        None => None,
+    };
+    let method = input.align.clone().unwrap_or_else(|| {
+        if transform.is_some() {
+            "given".into()
+        } else {
+            "auto".into()
+        }
+    });
+    let align = match method.as_str() {
+        "none" => AlignRequest::None,
+        "given" => AlignRequest::Given(
+            transform.ok_or_else(|| anyhow::anyhow!("--align given needs --transform FILE"))?,
+        ),
+        other => AlignRequest::Stages(other.to_string()),
+    };
+    let pairs = match &input.pairs {
+        Some(p) => parse_point_pairs(&read(p)?)
+            .with_context(|| format!("point pairs '{}'", p.display()))?,
+        None => Vec::new(),
+    };
+    if method == "points" && pairs.is_empty() {
+        bail!("--align points needs --pairs FILE");
+    }
+    let gt_cameras = match &input.gt_cameras {
+        Some(p) => Some(
+            model::read_model_files(&read_path_files(p)?)
+                .with_context(|| format!("ground-truth cameras '{}'", p.display()))?,
+        ),
+        None => None,
+    };
+    let gt_bytes = read(&input.gt)?;
+    let external = gltf_neighbours(&input.gt, &gt_bytes);
+    let gt = io::read_ground_truth(&name_of(&input.gt), &gt_bytes, &external)
+        .with_context(|| format!("ground truth '{}'", input.gt.display()))?;
+    drop(gt_bytes);
+    let recon = read_reconstruction(&name_of(&input.recon), &read_path_files(&input.recon)?)
+        .with_context(|| format!("reconstruction '{}'", input.recon.display()))?;
+    let prepared = PreparedGroundTruth::new(&gt.ground_truth, eval.samples, eval.seed, bars)
+        .with_context(|| format!("ground truth '{}'", input.gt.display()))?;
+    let gt_info = GroundTruthInfo {
+        name: name_of(&input.gt),
+        format: gt.format.name().into(),
+        warnings: gt.warnings,
+    };
+    let run_options = RunOptions {
+        eval,
+        align,
+        icp_start: transform,
+        ..RunOptions::default()
+    };
+    Ok(Loaded {
+        prepared,
+        gt_info,
+        recon,
+        gt_cameras,
+        pairs,
+        run_options,
+    })
+}
+
 fn eval(args: &EvalArgs) -> Result<()> {
     let options = EvalOptions {
         tau: args.tau.clone(),
@@ -196,32 +400,18 @@ fn eval(args: &EvalArgs) -> Result<()> {
         crop: crop_from_args(args)?,
     };
     options.validate()?;
-    let alignment = match &args.transform {
-        Some(path) => AlignmentInput::given(
-            Similarity::parse(&read(path)?)
-                .with_context(|| format!("transform file '{}'", path.display()))?,
-        ),
-        None => AlignmentInput::none(),
-    };
-    let gt_bytes = read(&args.gt)?;
-    let external = gltf_neighbours(&args.gt, &gt_bytes);
-    let gt = io::read_ground_truth(&name_of(&args.gt), &gt_bytes, &external)
-        .with_context(|| format!("ground truth '{}'", args.gt.display()))?;
-    drop(gt_bytes);
-    let recon = io::read_point_cloud(&name_of(&args.recon), &read(&args.recon)?)
-        .with_context(|| format!("reconstruction '{}'", args.recon.display()))?;
-    let info = InputInfo {
-        recon_name: name_of(&args.recon),
-        recon_format: recon.format.name().into(),
-        recon_images: 0,
-        gt_name: name_of(&args.gt),
-        gt_format: gt.format.name().into(),
-        warnings: gt.warnings.iter().chain(&recon.warnings).cloned().collect(),
-    };
     let bars = Bars::new(args.quiet);
-    let prepared = PreparedGroundTruth::new(&gt.ground_truth, options.samples, options.seed, &bars)
-        .with_context(|| format!("ground truth '{}'", args.gt.display()))?;
-    let evaluation = evaluate(&prepared, &recon.cloud, &alignment, &options, &info, &bars)?;
+    let l = load(&args.input, options, &bars)?;
+    let evaluation = pipeline::run(
+        &l.prepared,
+        &l.gt_info,
+        &l.recon,
+        l.gt_cameras.as_ref(),
+        &l.pairs,
+        &l.run_options,
+        &bars,
+    )
+    .with_context(|| format!("evaluating '{}'", args.input.recon.display()))?;
     let report = &evaluation.report;
     let json = report.to_json();
     if let Some(path) = &args.report {
@@ -240,6 +430,97 @@ fn eval(args: &EvalArgs) -> Result<()> {
         print!("{json}");
     } else if !args.quiet {
         print!("{}", summary::render(report));
+    }
+    Ok(())
+}
+
+fn align_cmd(input: &InputArgs, out: Option<&Path>, seed: u64) -> Result<()> {
+    let eval = EvalOptions {
+        samples: 1,
+        seed,
+        ..EvalOptions::default()
+    };
+    let bars = Bars::new(false);
+    let l = load(input, eval, &bars)?;
+    let evaluation = pipeline::run(
+        &l.prepared,
+        &l.gt_info,
+        &l.recon,
+        l.gt_cameras.as_ref(),
+        &l.pairs,
+        &l.run_options,
+        &bars,
+    )?;
+    let a = &evaluation.report.alignment;
+    let text: String = a
+        .gt_from_recon
+        .iter()
+        .map(|r| {
+            r.iter()
+                .map(|v| format!("{v:.17e}"))
+                .collect::<Vec<_>>()
+                .join(" ")
+                + "\n"
+        })
+        .collect();
+    if let Some(p) = out {
+        if name_of(p).to_ascii_lowercase().ends_with(".json") {
+            let mut s = serde_json::to_string_pretty(a)?;
+            s.push('\n');
+            write_atomic(p, s.as_bytes())?;
+        } else {
+            write_atomic(
+                p,
+                format!("# gt_from_recon ({}), scale {}\n{text}", a.method, a.scale).as_bytes(),
+            )?;
+        }
+    }
+    println!(
+        "# gt_from_recon by {} (scale {}, rmse {:?}, converged {})",
+        a.method, a.scale, a.rmse, a.converged
+    );
+    print!("{text}");
+    for w in &evaluation.report.warnings {
+        eprintln!("warning: {w}");
+    }
+    Ok(())
+}
+
+fn cameras_cmd(
+    gt_cameras: &Path,
+    recon: &Path,
+    transform: Option<&Path>,
+    report: Option<&Path>,
+    json: bool,
+) -> Result<()> {
+    let gt = model::read_model_files(&read_path_files(gt_cameras)?)
+        .with_context(|| format!("ground-truth cameras '{}'", gt_cameras.display()))?;
+    let est = read_reconstruction(&name_of(recon), &read_path_files(recon)?)
+        .with_context(|| format!("reconstruction '{}'", recon.display()))?;
+    let est = est.model.ok_or_else(|| {
+        anyhow::anyhow!(
+            "reconstruction '{}' has no cameras (a bare point cloud)",
+            recon.display()
+        )
+    })?;
+    let given = match transform {
+        Some(p) => Some(
+            Similarity::parse(&read(p)?)
+                .with_context(|| format!("transform file '{}'", p.display()))?,
+        ),
+        None => None,
+    };
+    let (_, alignment, cams) = pipeline::cameras_only(&gt, &est, given, &RunOptions::default())?;
+    let value = serde_json::json!({"alignment": alignment, "cameras": cams});
+    let mut s = serde_json::to_string_pretty(&value)?;
+    s.push('\n');
+    if let Some(p) = report {
+        write_atomic(p, s.as_bytes())?;
+    }
+    if json {
+        print!("{s}");
+    } else {
+        print!("{}", summary::render_cameras(&value));
     }
     Ok(())
 }

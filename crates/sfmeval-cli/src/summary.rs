@@ -108,3 +108,46 @@ pub fn render(r: &Report) -> String {
     }
     s
 }
+
+/// Formats the `sfmeval cameras` result (alignment + cameras sections) for a person.
+pub fn render_cameras(v: &serde_json::Value) -> String {
+    let mut s = String::new();
+    let num = |p: &str| v.pointer(p).and_then(|x| x.as_f64()).unwrap_or(f64::NAN);
+    let _ = writeln!(
+        s,
+        "cameras         {} ground truth, {} registered, {} matched, {} model(s)",
+        num("/cameras/ground_truth"),
+        num("/cameras/registered"),
+        num("/cameras/matched"),
+        num("/cameras/models")
+    );
+    let _ = writeln!(
+        s,
+        "alignment       {} (scale {})",
+        v.pointer("/alignment/method")
+            .and_then(|m| m.as_str())
+            .unwrap_or("?"),
+        g(num("/alignment/scale"))
+    );
+    let _ = writeln!(
+        s,
+        "rotation error  mean {}°  median {}°  max {}°",
+        g(num("/cameras/rotation_error_deg/mean")),
+        g(num("/cameras/rotation_error_deg/median")),
+        g(num("/cameras/rotation_error_deg/max"))
+    );
+    let _ = writeln!(
+        s,
+        "centre error    mean {}  median {}  max {}  (ATE RMSE {})",
+        g(num("/cameras/center_error/mean")),
+        g(num("/cameras/center_error/median")),
+        g(num("/cameras/center_error/max")),
+        g(num("/cameras/ate_rmse"))
+    );
+    if let Some(w) = v.pointer("/cameras/warnings").and_then(|w| w.as_array()) {
+        for w in w.iter().filter_map(|w| w.as_str()) {
+            let _ = writeln!(s, "warning: {w}");
+        }
+    }
+    s
+}

@@ -21,6 +21,7 @@
 //! assert!((eval.report.accuracy.stats.mean - 0.2).abs() < 1e-12);
 //! ```
 
+pub mod align;
 pub mod colormap;
 pub mod crop;
 pub mod distance;
@@ -31,6 +32,7 @@ pub mod io;
 pub mod metrics;
 pub mod model;
 pub mod parallel;
+pub mod pipeline;
 pub mod pose;
 pub mod progress;
 pub mod report;

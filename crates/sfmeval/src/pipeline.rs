@@ -1,0 +1,257 @@
+//! One evaluation request as every front end makes it: read the inputs from named bytes, align
+//! (none, a given transform, or the alignment stages), measure, and add camera-pose metrics when
+//! both sides have cameras. The CLI, the wasm bindings and the runner all call [`run`], so they
+//! give the same report for the same inputs.
+
+use std::collections::BTreeMap;
+
+use crate::align::{self, AlignInput, AlignMethod, AlignOptions, CameraPair, PointPair};
+use crate::error::{Error, Result};
+use crate::evaluate::{
+    AlignmentInput, EvalOptions, Evaluation, InputInfo, PreparedGroundTruth, evaluate,
+};
+use crate::geometry::PointCloud;
+use crate::io;
+use crate::model::{self, Reconstruction};
+use crate::pose::{PoseOptions, evaluate_cameras_matched};
+use crate::progress::{Progress, Stage};
+use crate::transform::Similarity;
+
+/// A reconstruction as read: its cloud, and its cameras when the format has them.
+#[derive(Debug, Clone)]
+pub struct ReconInput {
+    /// The points to evaluate (camera-centre points removed).
+    pub cloud: PointCloud,
+    /// The SfM model, for formats with cameras.
+    pub model: Option<Reconstruction>,
+    /// Name shown in the report.
+    pub name: String,
+    /// `ply`, `colmap`, `nvm`, `bundler`, `openmvg`, `cameras_json`, ...
+    pub format: String,
+    /// Notes for the report.
+    pub warnings: Vec<String>,
+}
+
+/// Reads a reconstruction from named files: one point-cloud file (PLY, or the vertices of a
+/// mesh), or the files of an SfM model (a COLMAP folder with `sparse/N` sub-models, `.nvm`,
+/// Bundler `.out` + `list.txt`, OpenMVG `sfm_data.json`, `cameras.json`). `name` is shown in the
+/// report. PLY clouds lose the camera-centre points OpenMVG and Theia append.
+pub fn read_reconstruction(name: &str, files: &BTreeMap<String, Vec<u8>>) -> Result<ReconInput> {
+    if files.is_empty() {
+        return Err(Error::Empty {
+            what: format!("reconstruction '{name}' (no files)"),
+        });
+    }
+    let is_model = files
+        .iter()
+        .any(|(n, b)| model::detect_model_format(n, b).is_some());
+    if is_model {
+        let rec = model::read_model_files(files)?;
+        let cloud = rec.to_point_cloud();
+        let mut warnings = rec.warnings.clone();
+        if cloud.points.is_empty() {
+            warnings.push("the SfM model has no 3D points".into());
+        }
+        return Ok(ReconInput {
+            cloud,
+            name: name.to_string(),
+            format: rec.format.to_string(),
+            warnings,
+            model: Some(rec),
+        });
+    }
+    let (file_name, bytes) = match files
+        .iter()
+        .find(|(n, _)| n.to_ascii_lowercase().ends_with(".ply"))
+    {
+        Some(f) => f,
+        None => files.iter().next().ok_or_else(|| Error::Empty {
+            what: name.to_string(),
+        })?,
+    };
+    let loaded = io::read_point_cloud(file_name, bytes)?;
+    let mut warnings = loaded.warnings;
+    let stripped = model::strip::strip_camera_points(&loaded.cloud, None, name);
+    warnings.extend(stripped.warning);
+    Ok(ReconInput {
+        cloud: stripped.cloud,
+        model: None,
+        name: name.to_string(),
+        format: loaded.format.name().to_string(),
+        warnings,
+    })
+}
+
+/// How to bring the reconstruction into the ground-truth frame.
+#[derive(Debug, Clone, PartialEq)]
+pub enum AlignRequest {
+    /// The reconstruction is already in the ground-truth frame.
+    None,
+    /// Use this `gt_from_recon`.
+    Given(Similarity),
+    /// Run the alignment stages (`auto`, `cameras`, `points`, `global`, `icp`).
+    Stages(String),
+}
+
+/// Everything besides the inputs that changes the numbers.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RunOptions {
+    /// Measurement options.
+    pub eval: EvalOptions,
+    /// Alignment.
+    pub align: AlignRequest,
+    /// Start of an `icp`-only alignment.
+    pub icp_start: Option<Similarity>,
+    /// Pose metric options.
+    pub pose: PoseOptions,
+}
+
+impl Default for RunOptions {
+    fn default() -> Self {
+        RunOptions {
+            eval: EvalOptions::default(),
+            align: AlignRequest::Stages("auto".into()),
+            icp_start: None,
+            pose: PoseOptions::default(),
+        }
+    }
+}
+
+/// Names and formats of the ground truth, for the report.
+#[derive(Debug, Clone, Default)]
+pub struct GroundTruthInfo {
+    /// File name.
+    pub name: String,
+    /// Format name.
+    pub format: String,
+    /// Notes from reading.
+    pub warnings: Vec<String>,
+}
+
+fn camera_pairs(
+    gt_cams: &Reconstruction,
+    est: &Reconstruction,
+) -> (Vec<CameraPair>, model::matching::ImageMatches) {
+    let matches = model::matching::match_images(gt_cams, est);
+    let pairs = matches
+        .pairs
+        .iter()
+        .filter_map(|&(g, e)| {
+            let (gi, ei) = (gt_cams.images.get(g)?, est.images.get(e)?);
+            Some(CameraPair {
+                recon_center: ei.center(),
+                gt_center: gi.center(),
+                recon_rotation: Some(ei.cam_from_world.rotation),
+                gt_rotation: Some(gi.cam_from_world.rotation),
+            })
+        })
+        .collect();
+    (pairs, matches)
+}
+
+/// Aligns, measures and evaluates cameras. `gt_cameras` is the dataset's `cameras.json` (or any
+/// model in the ground-truth frame); `point_pairs` feed the `points` stage.
+pub fn run(
+    gt: &PreparedGroundTruth,
+    gt_info: &GroundTruthInfo,
+    recon: &ReconInput,
+    gt_cameras: Option<&Reconstruction>,
+    point_pairs: &[PointPair],
+    options: &RunOptions,
+    progress: &dyn Progress,
+) -> Result<Evaluation> {
+    let mut warnings: Vec<String> = gt_info
+        .warnings
+        .iter()
+        .chain(&recon.warnings)
+        .cloned()
+        .collect();
+    let (pairs, matches) = match (gt_cameras, &recon.model) {
+        (Some(g), Some(e)) => {
+            let (p, m) = camera_pairs(g, e);
+            (p, Some(m))
+        }
+        _ => (Vec::new(), None),
+    };
+    if gt_cameras.is_some() && recon.model.is_none() {
+        warnings.push("ground-truth cameras were given but the reconstruction has no cameras (a bare point cloud): no camera-based alignment or pose metrics".into());
+    }
+    let alignment = match &options.align {
+        AlignRequest::None => AlignmentInput::none(),
+        AlignRequest::Given(t) => AlignmentInput::given(*t),
+        AlignRequest::Stages(name) => {
+            let method = AlignMethod::parse(name)?;
+            progress.start(Stage::Alignment, 1);
+            let input = AlignInput {
+                recon: &recon.cloud.points,
+                cameras: &pairs,
+                point_pairs,
+                start: options.icp_start,
+            };
+            let opts = AlignOptions::default().with_seed(options.eval.seed);
+            let (t, report) = align::align(gt, &input, method, &opts)?;
+            progress.finish();
+            warnings.extend(align::stage_notes(&report));
+            AlignmentInput {
+                gt_from_recon: t,
+                report,
+            }
+        }
+    };
+    let info = InputInfo {
+        recon_name: recon.name.clone(),
+        recon_format: recon.format.clone(),
+        recon_images: recon.model.as_ref().map_or(0, |m| m.images.len() as u64),
+        gt_name: gt_info.name.clone(),
+        gt_format: gt_info.format.clone(),
+        warnings,
+    };
+    let mut evaluation = evaluate(gt, &recon.cloud, &alignment, &options.eval, &info, progress)?;
+    if let (Some(g), Some(e), Some(m)) = (gt_cameras, &recon.model, &matches) {
+        let cams = evaluate_cameras_matched(g, e, m, &alignment.gt_from_recon, &options.pose)?;
+        evaluation
+            .report
+            .warnings
+            .extend(cams.warnings.iter().map(|w| format!("cameras: {w}")));
+        evaluation.report.cameras = Some(
+            serde_json::to_value(&cams)
+                .map_err(|e| Error::InvalidOption(format!("camera report: {e}")))?,
+        );
+    }
+    Ok(evaluation)
+}
+
+/// Camera-pose metrics without a ground-truth geometry: aligns by the matched camera centres
+/// (LO-RANSAC, rotations when the centres are nearly collinear), or uses `given`.
+pub fn cameras_only(
+    gt_cameras: &Reconstruction,
+    recon: &Reconstruction,
+    given: Option<Similarity>,
+    options: &RunOptions,
+) -> Result<(
+    Similarity,
+    crate::report::AlignmentReport,
+    crate::pose::CamerasReport,
+)> {
+    let (pairs, matches) = camera_pairs(gt_cameras, recon);
+    let (t, report) = match given {
+        Some(t) => (t, AlignmentInput::given(t).report),
+        None => {
+            let opts = AlignOptions::default().with_seed(options.eval.seed);
+            let (t, stage) = align::align_cameras(&pairs, &opts.cameras)?;
+            let report = crate::report::AlignmentReport {
+                method: stage.method.clone(),
+                gt_from_recon: t.matrix,
+                scale: t.scale(),
+                rmse: stage.rmse,
+                inlier_ratio: stage.inlier_ratio,
+                iterations: stage.iterations,
+                converged: stage.converged,
+                stages: vec![stage],
+            };
+            (t, report)
+        }
+    };
+    let cams = evaluate_cameras_matched(gt_cameras, recon, &matches, &t, &options.pose)?;
+    Ok((t, report, cams))
+}
