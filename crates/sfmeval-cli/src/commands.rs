@@ -338,6 +338,7 @@ fn load(input: &InputArgs, eval: EvalOptions, bars: &Bars) -> Result<Loaded> {
         }
     });
     let align = match method.as_str() {
+        "none" if transform.is_some() => bail!("--align none ignores --transform: use --align given (the default with --transform)"),
         "none" => AlignRequest::None,
         "given" => AlignRequest::Given(
             transform.ok_or_else(|| anyhow::anyhow!("--align given needs --transform FILE"))?,
