@@ -82,8 +82,10 @@ def half_fov_min(cam_cfg):
 
 
 def auto_radius(bound_radius, cam_cfg, fill):
-    """Distance at which a sphere of `bound_radius` spans `fill` of the narrower half-FOV."""
-    return bound_radius / (fill * math.tan(half_fov_min(cam_cfg)))
+    """Distance at which the bounding sphere (radius `bound_radius` around the target) is seen
+    under `fill` × the sine of the narrower half field of view: with fill <= 1 the whole
+    object is inside every image whose camera looks at the target."""
+    return bound_radius / (fill * math.sin(half_fov_min(cam_cfg)))
 
 
 def _radius(value, auto):

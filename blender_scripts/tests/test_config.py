@@ -123,7 +123,7 @@ def test_cameras_look_at_the_target_and_are_reproducible():
         assert np.allclose(forward, to_target / np.linalg.norm(to_target), atol=1e-12)
         assert rot[2, 1] >= 0                            # image up points to world +Z
     ring = [v for v in a if v["group"] == "orbit0"]
-    assert all(math.isclose(v["eye"][2] - target[2], 2.5 * math.sin(math.radians(15)), abs_tol=1e-12)
+    assert all(math.isclose(v["eye"][2] - target[2], 2.5 * math.sin(math.radians(20)), abs_tol=1e-12)
                for v in ring)
 
 

@@ -49,8 +49,10 @@ def test_pycolmap_registers_all_and_matches_ground_truth(small_dataset, tmp_path
                      % (rec.num_reg_images(), len(names), rec.num_points3D(),
                         100 * np.median(rel), 100 * np.sqrt(np.mean(rel ** 2)), 100 * rel.max(),
                         radius))
-    # RMS over all cameras below 0.5 % of the orbit radius; no single camera worse than 1.5 %
-    # (pycolmap refines focal and distortion freely: its worst camera on 36 views of the
-    # small preset lands at 0.7-1.0 %).
+    # RMS (and so median) over the cameras below 0.5 % of the orbit radius, no camera above
+    # 1.5 %. Measured on the small preset: median 0.16-0.24 %, RMS 0.21-0.34 %, worst camera
+    # 0.45-0.9 % — the worst camera depends on tiny changes of the images, and stays there even
+    # with the exact intrinsics given to pycolmap, while the GT itself is consistent with the
+    # images to ~1e-4 (test_dataset), so it is SIFT localisation noise at 640×360 / 16 spp.
     assert np.sqrt(np.mean(rel ** 2)) < 0.005
     assert rel.max() < 0.015
