@@ -7,8 +7,8 @@ import sys
 import numpy as np
 import pytest
 
-from conftest import load_json, requires_bpy
-from helpers import umeyama
+from blender_testlib import load_json, requires_bpy
+from blender_testlib import umeyama
 
 pytestmark = requires_bpy
 

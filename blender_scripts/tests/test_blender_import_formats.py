@@ -9,8 +9,8 @@ import sys
 import numpy as np
 import pytest
 
-from conftest import load_json, requires_bpy, run_generate
-from helpers import glb_vertices
+from blender_testlib import load_json, requires_bpy, run_generate
+from blender_testlib import glb_vertices
 
 pytestmark = requires_bpy
 

@@ -4,7 +4,7 @@ import os
 
 import pytest
 
-from conftest import requires_bpy, run_generate
+from blender_testlib import requires_bpy, run_generate
 
 
 def _fails(args, out, match, code=None):

@@ -10,7 +10,7 @@ import zipfile
 
 import pytest
 
-from conftest import BLENDER_SCRIPTS, have_bpy
+from blender_testlib import BLENDER_SCRIPTS, have_bpy
 
 SCRIPT = r'''
 import bpy, sys, os, json

@@ -1,6 +1,57 @@
-"""Numpy helpers for the tests: projection, GLB loading, Umeyama similarity."""
+"""Utilities of the blender_scripts tests (a unique module name: the repository runs several
+test folders in one pytest session, so no `conftest`/`helpers` imports across folders)."""
+
+import importlib.util
+import json
+import os
+import shutil
+import subprocess
+import sys
+import time
 
 import numpy as np
+import pytest
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+BLENDER_SCRIPTS = os.path.dirname(HERE)
+GENERATE = os.path.join(BLENDER_SCRIPTS, "generate.py")
+REPO = os.path.dirname(BLENDER_SCRIPTS)
+if BLENDER_SCRIPTS not in sys.path:
+    sys.path.insert(0, BLENDER_SCRIPTS)
+
+
+def have_bpy():
+    return importlib.util.find_spec("bpy") is not None
+
+
+def run_generate(args, python=None, timeout=900):
+    """Run the headless generator with the PyPI bpy module (this interpreter by default)."""
+    cmd = [python or sys.executable, GENERATE] + list(args)
+    t0 = time.perf_counter()
+    proc = subprocess.run(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                          timeout=timeout)
+    proc.seconds = time.perf_counter() - t0
+    return proc
+
+
+def run_blender(args, timeout=900):
+    """Run the headless generator inside Debian's `blender` executable."""
+    exe = shutil.which("blender")
+    cmd = [exe, "-b", "--factory-startup", "-noaudio", "-P", GENERATE, "--"] + list(args)
+    t0 = time.perf_counter()
+    proc = subprocess.run(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                          timeout=timeout)
+    proc.seconds = time.perf_counter() - t0
+    return proc
+
+
+requires_bpy = pytest.mark.skipif(not have_bpy(), reason="PyPI bpy is not installed in this Python "
+                                  "(pip install -r requirements/blender.txt)")
+
+
+def load_json(path):
+    with open(path) as f:
+        return json.load(f)
 
 
 def camera_matrices(cams):

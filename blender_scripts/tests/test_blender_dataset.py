@@ -9,8 +9,8 @@ import numpy as np
 import pytest
 from PIL import Image
 
-from conftest import BLENDER_SCRIPTS, REPO, load_json, requires_bpy, run_generate
-from helpers import bilinear, camera_matrices, glb_vertices, project
+from blender_testlib import BLENDER_SCRIPTS, REPO, load_json, requires_bpy, run_generate
+from blender_testlib import bilinear, camera_matrices, glb_vertices, project
 
 pytestmark = requires_bpy
 

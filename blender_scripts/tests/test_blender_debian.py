@@ -9,8 +9,8 @@ import numpy as np
 import pytest
 from PIL import Image
 
-from conftest import load_json, requires_bpy, run_blender, run_generate
-from helpers import camera_matrices, glb_vertices, project
+from blender_testlib import load_json, requires_bpy, run_blender, run_generate
+from blender_testlib import camera_matrices, glb_vertices, project
 
 TINY = '''preset = "small"
 [render]
