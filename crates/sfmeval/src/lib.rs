@@ -22,6 +22,7 @@
 //! ```
 
 pub mod align;
+pub mod align;
 pub mod colormap;
 pub mod crop;
 pub mod distance;

@@ -64,7 +64,7 @@ impl Default for IcpOptions {
             with_scale: true,
             initial_gate: 0.1,
             gate_sigmas: 3.0,
-            tolerance: 1e-7,
+            tolerance: 1e-5,
             max_scale_step: 0.05,
             max_scale_drift: 0.25,
             min_overlap: 0.2,
@@ -76,13 +76,24 @@ impl IcpOptions {
     fn validate(&self) -> Result<()> {
         let pos = |v: f64| v.is_finite() && v > 0.0;
         if self.max_iterations == 0 || self.max_points < 3 || self.coarse_points < 3 {
-            return Err(Error::InvalidOption("ICP needs ≥ 1 iteration and ≥ 3 points".into()));
+            return Err(Error::InvalidOption(
+                "ICP needs ≥ 1 iteration and ≥ 3 points".into(),
+            ));
         }
-        if !(pos(self.initial_gate) && pos(self.gate_sigmas) && pos(self.tolerance) && pos(self.max_scale_step) && pos(self.max_scale_drift)) {
-            return Err(Error::InvalidOption("ICP gate, tolerance and scale bounds must be > 0".into()));
+        if !(pos(self.initial_gate)
+            && pos(self.gate_sigmas)
+            && pos(self.tolerance)
+            && pos(self.max_scale_step)
+            && pos(self.max_scale_drift))
+        {
+            return Err(Error::InvalidOption(
+                "ICP gate, tolerance and scale bounds must be > 0".into(),
+            ));
         }
         if !(self.min_overlap >= 0.0 && self.min_overlap <= 1.0) {
-            return Err(Error::InvalidOption("ICP minimum overlap must be in [0, 1]".into()));
+            return Err(Error::InvalidOption(
+                "ICP minimum overlap must be in [0, 1]".into(),
+            ));
         }
         Ok(())
     }
@@ -101,7 +112,6 @@ pub(crate) fn next_gate(dists: &[f64], gate: f64, sigmas: f64, floor: f64) -> f6
 /// Result of one similarity update.
 pub(crate) struct Update {
     pub t: Similarity,
-    pub inliers: usize,
     pub hit_drift: bool,
 }
 
@@ -139,7 +149,9 @@ pub(crate) fn update(
         (s_ref, s_ref)
     };
     let s_new = s.clamp(lo, hi);
-    let hit_drift = with_scale && (s_new <= s_ref / (1.0 + drift) * (1.0 + 1e-12) || s_new >= s_ref * (1.0 + drift) * (1.0 - 1e-12));
+    let hit_drift = with_scale
+        && (s_new <= s_ref / (1.0 + drift) * (1.0 + 1e-12)
+            || s_new >= s_ref * (1.0 + drift) * (1.0 - 1e-12));
     let t = if s_new != s {
         // Same rotation, clamped scale, the translation that is optimal for them.
         let n = a.len() as f64;
@@ -152,24 +164,33 @@ pub(crate) fn update(
     } else {
         t
     };
-    Some(Update { t, inliers: a.len(), hit_drift })
+    Some(Update { t, hit_drift })
 }
 
 /// RMS displacement of `corners` between two transforms.
 pub(crate) fn motion(a: &Similarity, b: &Similarity, corners: &[Point3]) -> f64 {
-    let ss: f64 = corners.iter().map(|c| super::points::sq_dist(a.apply(*c), b.apply(*c))).sum();
+    let ss: f64 = corners
+        .iter()
+        .map(|c| super::points::sq_dist(a.apply(*c), b.apply(*c)))
+        .sum();
     (ss / corners.len().max(1) as f64).sqrt()
 }
 
 pub(crate) fn box_corners(points: &[Point3]) -> Vec<Point3> {
     match Aabb::of(points) {
-        Some(b) => (0..8).map(|k| [0, 1, 2].map(|a| if k >> a & 1 == 1 { b.max[a] } else { b.min[a] })).collect(),
+        Some(b) => (0..8)
+            .map(|k| [0, 1, 2].map(|a| if k >> a & 1 == 1 { b.max[a] } else { b.min[a] }))
+            .collect(),
         None => Vec::new(),
     }
 }
 
 /// Closest ground-truth points of the transformed points (parallel, order-preserving).
-pub(crate) fn correspondences(gt: &PreparedGroundTruth, t: &Similarity, pts: &[Point3]) -> Vec<(Point3, f64)> {
+pub(crate) fn correspondences(
+    gt: &PreparedGroundTruth,
+    t: &Similarity,
+    pts: &[Point3],
+) -> Vec<(Point3, f64)> {
     let moved: Vec<Point3> = pts.iter().map(|p| t.apply(*p)).collect();
     crate::parallel::map(&moved, &NoProgress, |p| gt.closest_point(*p))
 }
@@ -191,44 +212,111 @@ pub(crate) fn finite_subsample(recon: &[Point3], m: usize, seed: u64) -> (Vec<Po
 /// The `icp` stage from `start`. Returns the refined transform, or `start` itself with a note
 /// when the guard rejects the result. Errors only on invalid options or fewer than 3 finite
 /// reconstruction points.
-pub fn refine_icp(gt: &PreparedGroundTruth, recon: &[Point3], start: &Similarity, opts: &IcpOptions) -> Result<(Similarity, AlignmentStage)> {
+pub fn refine_icp(
+    gt: &PreparedGroundTruth,
+    recon: &[Point3],
+    start: &Similarity,
+    opts: &IcpOptions,
+) -> Result<(Similarity, AlignmentStage)> {
     opts.validate()?;
     if start.matrix.iter().flatten().any(|v| !v.is_finite()) || !(start.scale() > 0.0) {
-        return Err(Error::InvalidOption("ICP start transform is not a finite similarity".into()));
+        return Err(Error::InvalidOption(
+            "ICP start transform is not a finite similarity".into(),
+        ));
     }
     let (pts, skipped) = finite_subsample(recon, opts.max_points, opts.seed);
     if pts.len() < 3 {
-        return Err(Error::Empty { what: format!("reconstruction for ICP ({} finite points)", pts.len()) });
+        return Err(Error::Empty {
+            what: format!("reconstruction for ICP ({} finite points)", pts.len()),
+        });
     }
     let mut notes = Vec::new();
     if skipped > 0 {
-        notes.push(format!("{skipped} non-finite reconstruction point(s) ignored"));
+        notes.push(format!(
+            "{skipped} non-finite reconstruction point(s) ignored"
+        ));
     }
     let diag = gt.aabb.diagonal();
     let floor = 1e-12 * diag;
     let corners = box_corners(&pts);
     let s0 = start.scale();
-    let coarse_n = opts.coarse_points.min(pts.len());
+    // Phases of growing size: the coarse part, ×3 each phase, then all points.
+    let mut phases = Vec::new();
+    let mut n = opts.coarse_points.min(pts.len());
+    while n < pts.len() {
+        phases.push(n);
+        n = n.saturating_mul(16);
+    }
+    phases.push(pts.len());
+    let phase_tol = opts.tolerance.max(5e-5);
 
     let mut t = *start;
     let mut gate = opts.initial_gate * diag;
-    let mut fine = coarse_n == pts.len();
+    let mut phase = 0usize;
     let mut iterations = 0u64;
     let mut converged = false;
     let mut hit_drift = false;
-    let mut last: Option<(Vec<(Point3, f64)>, f64)> = None; // fine-phase correspondences and gate
+    let mut last: Option<(Vec<(Point3, f64)>, f64)> = None; // last-phase correspondences and gate
     let mut start_cover: Option<f64> = None;
     let mut failure: Option<String> = None;
+    // Active set: points farther than 2 × gate at the last full pass are skipped until the
+    // transform has moved any point by more than that gate (exactly the same result).
+    let mut active: Vec<usize> = Vec::new();
+    let mut full_pass = true;
+    let mut full_gate = gate;
+    let mut travelled = 0.0;
+    let mut prev_step: Option<[f64; 7]> = None;
+    // An extrapolated transform is kept only if it lowers the truncated cost; otherwise the
+    // plain step is restored and extrapolation is off for the rest of the phase.
+    let mut pending: Option<(Similarity, f64, f64)> = None; // (plain step, cost before, its gate)
+    let mut extrapolate_ok = true;
     while (iterations as usize) < opts.max_iterations {
-        let src = if fine { &pts[..] } else { &pts[..coarse_n] };
-        let corr = correspondences(gt, &t, src);
+        let n = phases[phase];
+        if full_pass || travelled > full_gate {
+            active = (0..n).collect();
+        }
+        let src: Vec<Point3> = active.iter().map(|&i| pts[i]).collect();
+        let corr = correspondences(gt, &t, &src);
         let dists: Vec<f64> = corr.iter().map(|c| c.1).collect();
+        if let Some((plain, cost_before, g)) = pending.take()
+            && truncated_cost(&dists, g, n) >= cost_before
+        {
+            travelled += max_motion(&t, &plain, &corners);
+            t = plain;
+            extrapolate_ok = false;
+            iterations += 1;
+            continue;
+        }
         if start_cover.is_none() {
             start_cover = Some(covered_spread(&corr, gate));
         }
         gate = next_gate(&dists, gate, opts.gate_sigmas, floor);
+        let (src, corr) = if active.len() == n && (full_pass || travelled > full_gate) {
+            // A full pass: shrink the active set.
+            full_pass = false;
+            travelled = 0.0;
+            full_gate = gate;
+            let keep: Vec<usize> = (0..n).filter(|&k| corr[k].1 <= 2.0 * gate).collect();
+            active = keep.iter().map(|&k| active[k]).collect();
+            (
+                keep.iter().map(|&k| src[k]).collect::<Vec<_>>(),
+                keep.iter().map(|&k| corr[k]).collect::<Vec<_>>(),
+            )
+        } else {
+            (src, corr)
+        };
         iterations += 1;
-        let Some(u) = update(src, &corr, gate, t.scale(), s0, opts.max_scale_step, opts.max_scale_drift, opts.with_scale) else {
+        let cost_here = truncated_cost(&corr.iter().map(|c| c.1).collect::<Vec<_>>(), gate, n);
+        let Some(u) = update(
+            &src,
+            &corr,
+            gate,
+            t.scale(),
+            s0,
+            opts.max_scale_step,
+            opts.max_scale_drift,
+            opts.with_scale,
+        ) else {
             failure = Some(format!(
                 "fewer than 3 correspondences within {:.3e} of the ground truth (is the start transform far off?)",
                 gate
@@ -237,17 +325,54 @@ pub fn refine_icp(gt: &PreparedGroundTruth, recon: &[Point3], start: &Similarity
         };
         let moved = motion(&t, &u.t, &corners) / diag;
         hit_drift = u.hit_drift;
-        t = u.t;
-        if fine {
+        let last_phase = phase + 1 == phases.len();
+        if last_phase {
             last = Some((corr, gate));
         }
-        let tol = if fine { opts.tolerance } else { (opts.tolerance * 1e3).max(1e-5) };
+        let step = step_params(&t, &u.t, &corners);
+        travelled += max_motion(&t, &u.t, &corners);
+        let old = t;
+        t = u.t;
+        let tol = if last_phase {
+            opts.tolerance
+        } else {
+            phase_tol
+        };
         if moved < tol {
-            if fine {
+            if last_phase {
                 converged = true;
                 break;
             }
-            fine = true;
+            phase += 1;
+            full_pass = true;
+            prev_step = None;
+            extrapolate_ok = true;
+            continue;
+        }
+        // Extrapolate along two consecutive, nearly parallel, shrinking steps (Besl & McKay).
+        match prev_step {
+            Some(prev) if !hit_drift && extrapolate_ok => {
+                let (a, b) = (norm7(&step), norm7(&prev));
+                let cos = dot7(&step, &prev) / (a * b);
+                if cos > 20f64.to_radians().cos() && a < b {
+                    let rho = a / b;
+                    let lambda = (rho / (1.0 - rho)).min(25.0);
+                    let ext = extrapolate(&old, &t, &corners, lambda);
+                    let s = ext.scale();
+                    if (s0 / (1.0 + opts.max_scale_drift)..=s0 * (1.0 + opts.max_scale_drift))
+                        .contains(&s)
+                        || !opts.with_scale
+                    {
+                        travelled += max_motion(&t, &ext, &corners);
+                        pending = Some((t, cost_here, gate));
+                        t = ext;
+                    }
+                    prev_step = None;
+                } else {
+                    prev_step = Some(step);
+                }
+            }
+            _ => prev_step = Some(step),
         }
     }
     // Statistics of the last fine-phase correspondences (or one extra pass if there were none).
@@ -260,7 +385,11 @@ pub fn refine_icp(gt: &PreparedGroundTruth, recon: &[Point3], start: &Similarity
     };
     let inside: Vec<f64> = corr.iter().map(|c| c.1).filter(|d| *d <= gate).collect();
     let inlier_ratio = inside.len() as f64 / pts.len() as f64;
-    let rmse = if inside.is_empty() { None } else { Some((inside.iter().map(|d| d * d).sum::<f64>() / inside.len() as f64).sqrt()) };
+    let rmse = if inside.is_empty() {
+        None
+    } else {
+        Some((inside.iter().map(|d| d * d).sum::<f64>() / inside.len() as f64).sqrt())
+    };
     let s1 = t.scale();
     if failure.is_none() {
         if hit_drift {
@@ -287,11 +416,85 @@ pub fn refine_icp(gt: &PreparedGroundTruth, recon: &[Point3], start: &Similarity
     }
     if let Some(why) = failure {
         notes.push(format!("rejected, kept the start transform: {why}"));
-        let stage = make_stage("icp", start, rmse, Some(inlier_ratio), iterations, false, Some(notes.join("; ")));
+        let stage = make_stage(
+            "icp",
+            start,
+            rmse,
+            Some(inlier_ratio),
+            iterations,
+            false,
+            Some(notes.join("; ")),
+        );
         return Ok((*start, stage));
     }
-    let stage = make_stage("icp", &t, rmse, Some(inlier_ratio), iterations, converged, (!notes.is_empty()).then(|| notes.join("; ")));
+    let stage = make_stage(
+        "icp",
+        &t,
+        rmse,
+        Some(inlier_ratio),
+        iterations,
+        converged,
+        (!notes.is_empty()).then(|| notes.join("; ")),
+    );
     Ok((t, stage))
+}
+
+/// Mean of min(d², gate²) over `n` points, of which those not in `dists` lie beyond the gate.
+fn truncated_cost(dists: &[f64], gate: f64, n: usize) -> f64 {
+    let g2 = gate * gate;
+    let inside: f64 = dists.iter().map(|d| (d * d).min(g2)).sum();
+    (inside + n.saturating_sub(dists.len()) as f64 * g2) / n.max(1) as f64
+}
+
+/// Largest displacement of any point of the box spanned by `corners` between two transforms
+/// (the displacement is affine, so its norm peaks at a corner).
+fn max_motion(a: &Similarity, b: &Similarity, corners: &[Point3]) -> f64 {
+    corners
+        .iter()
+        .map(|c| super::points::sq_dist(a.apply(*c), b.apply(*c)).sqrt())
+        .fold(0.0, f64::max)
+}
+
+fn centre_of(corners: &[Point3]) -> Vector3<f64> {
+    corners.iter().fold(Vector3::zeros(), |s, c| s + to_v(*c)) / corners.len().max(1) as f64
+}
+
+/// A step between two transforms as 7 numbers in ground-truth units: rotation vector and log
+/// scale times the mapped box's half-diagonal, and the motion of the box centre.
+fn step_params(a: &Similarity, b: &Similarity, corners: &[Point3]) -> [f64; 7] {
+    let c = centre_of(corners);
+    let ca = to_v(a.apply([c.x, c.y, c.z]));
+    let cb = to_v(b.apply([c.x, c.y, c.z]));
+    let radius = corners.first().map_or(1.0, |k| (to_v(*k) - c).norm()) * b.scale();
+    let dr = super::to_m(&b.rotation()) * super::to_m(&a.rotation()).transpose();
+    let w = nalgebra::Rotation3::from_matrix_unchecked(dr).scaled_axis() * radius;
+    let ls = (b.scale() / a.scale()).ln() * radius;
+    let d = cb - ca;
+    [w.x, w.y, w.z, ls, d.x, d.y, d.z]
+}
+
+fn dot7(a: &[f64; 7], b: &[f64; 7]) -> f64 {
+    a.iter().zip(b).map(|(x, y)| x * y).sum()
+}
+
+fn norm7(a: &[f64; 7]) -> f64 {
+    dot7(a, a).sqrt()
+}
+
+/// `b` pushed `lambda` further along the step from `a` to `b`.
+fn extrapolate(a: &Similarity, b: &Similarity, corners: &[Point3], lambda: f64) -> Similarity {
+    let c = centre_of(corners);
+    let cp = [c.x, c.y, c.z];
+    let ca = to_v(a.apply(cp));
+    let cb = to_v(b.apply(cp));
+    let rb = super::to_m(&b.rotation());
+    let dr = rb * super::to_m(&a.rotation()).transpose();
+    let w = nalgebra::Rotation3::from_matrix_unchecked(dr).scaled_axis();
+    let r = nalgebra::Rotation3::new(w * lambda).matrix() * rb;
+    let s = b.scale() * (b.scale() / a.scale()).powf(lambda);
+    let target = cb + (cb - ca) * lambda;
+    let t = target - s * r * c;
+    Similarity::from_parts(s, super::from_m(&r), [t.x, t.y, t.z])
 }
 
 /// Spread of the ground-truth points that the gated correspondences reach.

@@ -21,6 +21,9 @@ pub mod points;
 pub mod ransac;
 pub mod umeyama;
 
+#[cfg(test)]
+mod tests;
+
 pub use auto::{AlignInput, AlignMethod, AlignOptions, align, stage_notes};
 pub use global::{GlobalOptions, align_global};
 pub use icp::{IcpOptions, refine_icp};
@@ -132,7 +135,11 @@ pub(crate) fn centroid_cov(points: &[Point3]) -> Option<(Vector3<f64>, Matrix3<f
 pub(crate) fn sorted_eigen(cov: &Matrix3<f64>) -> ([f64; 3], Matrix3<f64>) {
     let e = cov.symmetric_eigen();
     let mut idx = [0usize, 1, 2];
-    idx.sort_by(|&a, &b| e.eigenvalues[b].total_cmp(&e.eigenvalues[a]).then(a.cmp(&b)));
+    idx.sort_by(|&a, &b| {
+        e.eigenvalues[b]
+            .total_cmp(&e.eigenvalues[a])
+            .then(a.cmp(&b))
+    });
     let vals = idx.map(|i| e.eigenvalues[i].max(0.0));
     let vecs = Matrix3::from_columns(&idx.map(|i| e.eigenvectors.column(i).into_owned()));
     (vals, vecs)
@@ -143,7 +150,11 @@ pub(crate) fn planarity_ratio(points: &[Point3]) -> f64 {
     match centroid_cov(points) {
         Some((_, cov)) => {
             let (l, _) = sorted_eigen(&cov);
-            if l[0] > 0.0 { (l[1] / l[0]).sqrt() } else { 0.0 }
+            if l[0] > 0.0 {
+                (l[1] / l[0]).sqrt()
+            } else {
+                0.0
+            }
         }
         None => 0.0,
     }

@@ -26,17 +26,36 @@ struct PairsFile {
 /// Parses a point-pairs file: `{"pairs": [{"recon": [x, y, z], "gt": [x, y, z]}, ...]}`
 /// (a bare list of pairs is accepted too).
 pub fn parse_point_pairs(bytes: &[u8]) -> Result<Vec<PointPair>> {
-    let text = std::str::from_utf8(bytes).map_err(|_| Error::malformed("point pairs", "not UTF-8 text"))?;
+    let text = std::str::from_utf8(bytes)
+        .map_err(|_| Error::malformed("point pairs", "not UTF-8 text"))?;
     let trimmed = text.trim_start();
     let pairs = if trimmed.starts_with('[') {
         serde_json::from_str::<Vec<PointPair>>(text)
     } else {
         serde_json::from_str::<PairsFile>(text).map(|f| f.pairs)
     }
-    .map_err(|e| Error::malformed("point pairs", format!("{e} (expected {{\"pairs\": [{{\"recon\": [x, y, z], \"gt\": [x, y, z]}}, ...]}})")))?;
-    if let Some(i) = pairs.iter().position(|p| !(is_finite(&p.recon) && is_finite(&p.gt))) {
-        let count = pairs.iter().filter(|p| !(is_finite(&p.recon) && is_finite(&p.gt))).count();
-        return Err(Error::NonFinite { format: "point pairs", what: "pair", count, first_index: i });
+    .map_err(|e| {
+        Error::malformed(
+            "point pairs",
+            format!(
+                "{e} (expected {{\"pairs\": [{{\"recon\": [x, y, z], \"gt\": [x, y, z]}}, ...]}})"
+            ),
+        )
+    })?;
+    if let Some(i) = pairs
+        .iter()
+        .position(|p| !(is_finite(&p.recon) && is_finite(&p.gt)))
+    {
+        let count = pairs
+            .iter()
+            .filter(|p| !(is_finite(&p.recon) && is_finite(&p.gt)))
+            .count();
+        return Err(Error::NonFinite {
+            format: "point pairs",
+            what: "pair",
+            count,
+            first_index: i,
+        });
     }
     Ok(pairs)
 }
@@ -56,9 +75,20 @@ pub fn align_points(pairs: &[PointPair]) -> Result<(Similarity, AlignmentStage)>
     }
     let src: Vec<Point3> = pairs.iter().map(|p| p.recon).collect();
     let dst: Vec<Point3> = pairs.iter().map(|p| p.gt).collect();
-    if let Some(i) = pairs.iter().position(|p| !(is_finite(&p.recon) && is_finite(&p.gt))) {
-        let count = pairs.iter().filter(|p| !(is_finite(&p.recon) && is_finite(&p.gt))).count();
-        return Err(Error::NonFinite { format: "point pairs", what: "pair", count, first_index: i });
+    if let Some(i) = pairs
+        .iter()
+        .position(|p| !(is_finite(&p.recon) && is_finite(&p.gt)))
+    {
+        let count = pairs
+            .iter()
+            .filter(|p| !(is_finite(&p.recon) && is_finite(&p.gt)))
+            .count();
+        return Err(Error::NonFinite {
+            format: "point pairs",
+            what: "pair",
+            count,
+            first_index: i,
+        });
     }
     for (name, set) in [("reconstruction", &src), ("ground-truth", &dst)] {
         let r = planarity_ratio(set);
@@ -70,7 +100,11 @@ pub fn align_points(pairs: &[PointPair]) -> Result<(Similarity, AlignmentStage)>
         }
     }
     let t = super::umeyama(&src, &dst, true)?;
-    let ss: f64 = src.iter().zip(&dst).map(|(a, b)| sq_dist(t.apply(*a), *b)).sum();
+    let ss: f64 = src
+        .iter()
+        .zip(&dst)
+        .map(|(a, b)| sq_dist(t.apply(*a), *b))
+        .sum();
     let rmse = (ss / pairs.len() as f64).sqrt();
     let stage = make_stage("points", &t, Some(rmse), Some(1.0), 1, true, None);
     Ok((t, stage))
@@ -96,19 +130,49 @@ mod tests {
         assert!((t.scale() - 2.0).abs() < 1e-12);
         assert!(stage.rmse.unwrap() < 1e-12);
         assert_eq!(stage.method, "points");
-        assert_eq!(parse_point_pairs(b"[{\"recon\": [0,0,0], \"gt\": [1,1,1]}]").unwrap().len(), 1);
+        assert_eq!(
+            parse_point_pairs(b"[{\"recon\": [0,0,0], \"gt\": [1,1,1]}]")
+                .unwrap()
+                .len(),
+            1
+        );
     }
 
     #[test]
     fn bad_pairs() {
-        assert!(matches!(parse_point_pairs(b"{\"pairs\": 3}"), Err(Error::Malformed { .. })));
-        assert!(matches!(parse_point_pairs(b"{\"pairs\": [{\"recon\": [0,0], \"gt\": [1,1,1]}]}"), Err(Error::Malformed { .. })));
+        assert!(matches!(
+            parse_point_pairs(b"{\"pairs\": 3}"),
+            Err(Error::Malformed { .. })
+        ));
+        assert!(matches!(
+            parse_point_pairs(b"{\"pairs\": [{\"recon\": [0,0], \"gt\": [1,1,1]}]}"),
+            Err(Error::Malformed { .. })
+        ));
         assert!(parse_point_pairs(b"\xff").is_err());
-        let two = [PointPair { recon: [0.0; 3], gt: [0.0; 3] }, PointPair { recon: [1.0, 0.0, 0.0], gt: [1.0, 0.0, 0.0] }];
+        let two = [
+            PointPair {
+                recon: [0.0; 3],
+                gt: [0.0; 3],
+            },
+            PointPair {
+                recon: [1.0, 0.0, 0.0],
+                gt: [1.0, 0.0, 0.0],
+            },
+        ];
         assert!(matches!(align_points(&two), Err(Error::InvalidOption(_))));
-        let line: Vec<PointPair> = (0..5).map(|i| PointPair { recon: [f64::from(i), 0.0, 0.0], gt: [0.0, f64::from(i), 0.0] }).collect();
+        let line: Vec<PointPair> = (0..5)
+            .map(|i| PointPair {
+                recon: [f64::from(i), 0.0, 0.0],
+                gt: [0.0, f64::from(i), 0.0],
+            })
+            .collect();
         assert!(matches!(align_points(&line), Err(Error::Geometry(_))));
-        let same: Vec<PointPair> = (0..5).map(|_| PointPair { recon: [1.0, 2.0, 3.0], gt: [1.0, 2.0, 3.0] }).collect();
+        let same: Vec<PointPair> = (0..5)
+            .map(|_| PointPair {
+                recon: [1.0, 2.0, 3.0],
+                gt: [1.0, 2.0, 3.0],
+            })
+            .collect();
         assert!(matches!(align_points(&same), Err(Error::Geometry(_))));
         let mut nan = line.clone();
         nan[0].gt[1] = f64::NAN;

@@ -9,7 +9,10 @@ use rand::{Rng as _, SeedableRng as _};
 use rand_chacha::ChaCha8Rng;
 
 use super::points::sq_dist;
-use super::{Rotation, from_m, is_finite, make_stage, planarity_ratio, project_to_rotation, rotation_angle_deg, to_m, to_v};
+use super::{
+    Rotation, from_m, is_finite, make_stage, planarity_ratio, project_to_rotation,
+    rotation_angle_deg, to_m, to_v,
+};
 use crate::error::{Error, Result};
 use crate::geometry::Point3;
 use crate::report::AlignmentStage;
@@ -31,14 +34,23 @@ pub struct CameraPair {
 impl CameraPair {
     /// A pair of centres only.
     pub fn centers(recon_center: Point3, gt_center: Point3) -> Self {
-        CameraPair { recon_center, gt_center, recon_rotation: None, gt_rotation: None }
+        CameraPair {
+            recon_center,
+            gt_center,
+            recon_rotation: None,
+            gt_rotation: None,
+        }
     }
 
     fn finite(&self) -> bool {
         is_finite(&self.recon_center)
             && is_finite(&self.gt_center)
-            && self.recon_rotation.is_none_or(|r| r.iter().flatten().all(|v| v.is_finite()))
-            && self.gt_rotation.is_none_or(|r| r.iter().flatten().all(|v| v.is_finite()))
+            && self
+                .recon_rotation
+                .is_none_or(|r| r.iter().flatten().all(|v| v.is_finite()))
+            && self
+                .gt_rotation
+                .is_none_or(|r| r.iter().flatten().all(|v| v.is_finite()))
     }
 
     /// The `gt_from_recon` rotation this pair implies (`R = R_gtᵀ · R_recon`), if both known.
@@ -83,16 +95,24 @@ impl Default for CamerasOptions {
 impl CamerasOptions {
     fn validate(&self) -> Result<()> {
         if !(self.threshold_fraction > 0.0 && self.threshold_fraction.is_finite()) {
-            return Err(Error::InvalidOption("camera inlier threshold fraction must be > 0".into()));
+            return Err(Error::InvalidOption(
+                "camera inlier threshold fraction must be > 0".into(),
+            ));
         }
         if self.max_iterations == 0 {
-            return Err(Error::InvalidOption("camera RANSAC needs at least one iteration".into()));
+            return Err(Error::InvalidOption(
+                "camera RANSAC needs at least one iteration".into(),
+            ));
         }
         if !(self.confidence > 0.0 && self.confidence < 1.0) {
-            return Err(Error::InvalidOption("RANSAC confidence must be in (0, 1)".into()));
+            return Err(Error::InvalidOption(
+                "RANSAC confidence must be in (0, 1)".into(),
+            ));
         }
         if !(self.collinear_ratio >= 0.0 && self.rotation_threshold_deg > 0.0) {
-            return Err(Error::InvalidOption("collinear ratio must be ≥ 0 and rotation threshold > 0".into()));
+            return Err(Error::InvalidOption(
+                "collinear ratio must be ≥ 0 and rotation threshold > 0".into(),
+            ));
         }
         Ok(())
     }
@@ -116,13 +136,20 @@ fn evaluate(t: &Similarity, pairs: &[CameraPair], thr2: f64) -> Model {
             cost += thr2;
         }
     }
-    Model { t: *t, cost, inliers }
+    Model {
+        t: *t,
+        cost,
+        inliers,
+    }
 }
 
 fn better(a: &Model, b: &Option<Model>) -> bool {
     match b {
         None => true,
-        Some(b) => a.inliers.len() > b.inliers.len() || (a.inliers.len() == b.inliers.len() && a.cost < b.cost),
+        Some(b) => {
+            a.inliers.len() > b.inliers.len()
+                || (a.inliers.len() == b.inliers.len() && a.cost < b.cost)
+        }
     }
 }
 
@@ -136,7 +163,11 @@ fn needed_iterations(inliers: usize, n: usize, sample: i32, confidence: f64, max
         return max;
     }
     let k = (1.0 - confidence).ln() / (1.0 - p_good).ln();
-    if k.is_finite() { (k.ceil() as usize).clamp(1, max) } else { max }
+    if k.is_finite() {
+        (k.ceil() as usize).clamp(1, max)
+    } else {
+        max
+    }
 }
 
 /// Fits the full similarity to the given pair indices by Umeyama.
@@ -147,13 +178,21 @@ fn fit_centres(pairs: &[CameraPair], idx: &[usize]) -> Result<Similarity> {
 }
 
 /// Fits scale and translation with the rotation fixed (least squares).
-fn fit_scale_translation(r: &Matrix3<f64>, pairs: &[CameraPair], idx: &[usize]) -> Option<Similarity> {
+fn fit_scale_translation(
+    r: &Matrix3<f64>,
+    pairs: &[CameraPair],
+    idx: &[usize],
+) -> Option<Similarity> {
     if idx.len() < 2 {
         return None;
     }
     let n = idx.len() as f64;
-    let mu_a = idx.iter().fold(nalgebra::Vector3::zeros(), |s, &i| s + to_v(pairs[i].recon_center)) / n;
-    let mu_b = idx.iter().fold(nalgebra::Vector3::zeros(), |s, &i| s + to_v(pairs[i].gt_center)) / n;
+    let mu_a = idx.iter().fold(nalgebra::Vector3::zeros(), |s, &i| {
+        s + to_v(pairs[i].recon_center)
+    }) / n;
+    let mu_b = idx.iter().fold(nalgebra::Vector3::zeros(), |s, &i| {
+        s + to_v(pairs[i].gt_center)
+    }) / n;
     let (mut num, mut den) = (0.0, 0.0);
     for &i in idx {
         let a = r * (to_v(pairs[i].recon_center) - mu_a);
@@ -173,42 +212,68 @@ fn rms(t: &Similarity, pairs: &[CameraPair], idx: &[usize]) -> f64 {
     if idx.is_empty() {
         return 0.0;
     }
-    (idx.iter().map(|&i| sq_dist(t.apply(pairs[i].recon_center), pairs[i].gt_center)).sum::<f64>() / idx.len() as f64).sqrt()
+    (idx.iter()
+        .map(|&i| sq_dist(t.apply(pairs[i].recon_center), pairs[i].gt_center))
+        .sum::<f64>()
+        / idx.len() as f64)
+        .sqrt()
 }
 
 /// The `cameras` stage. Pairs with a non-finite value are skipped (and counted in the note).
 /// Errors when fewer than 3 usable pairs remain (2 with orientations), when all centres
 /// coincide, or when the centres are collinear and no orientations are given.
-pub fn align_cameras(pairs: &[CameraPair], opts: &CamerasOptions) -> Result<(Similarity, AlignmentStage)> {
+pub fn align_cameras(
+    pairs: &[CameraPair],
+    opts: &CamerasOptions,
+) -> Result<(Similarity, AlignmentStage)> {
     opts.validate()?;
     let mut notes = Vec::new();
     let usable: Vec<CameraPair> = pairs.iter().copied().filter(CameraPair::finite).collect();
     if usable.len() < pairs.len() {
-        notes.push(format!("{} camera pair(s) with non-finite poses skipped", pairs.len() - usable.len()));
+        notes.push(format!(
+            "{} camera pair(s) with non-finite poses skipped",
+            pairs.len() - usable.len()
+        ));
     }
     let n = usable.len();
     if n == 0 {
-        return Err(Error::Empty { what: "matched cameras (none with a finite pose)".into() });
+        return Err(Error::Empty {
+            what: "matched cameras (none with a finite pose)".into(),
+        });
     }
     let gt_centres: Vec<Point3> = usable.iter().map(|p| p.gt_center).collect();
     let recon_centres: Vec<Point3> = usable.iter().map(|p| p.recon_center).collect();
-    let spread = |pts: &[Point3]| {
-        super::centroid_cov(pts).map_or(0.0, |(_, cov)| cov.trace().sqrt())
-    };
+    let spread =
+        |pts: &[Point3]| super::centroid_cov(pts).map_or(0.0, |(_, cov)| cov.trace().sqrt());
     let gt_spread = spread(&gt_centres);
-    let magnitude = gt_centres.iter().flatten().fold(0.0f64, |m, v| m.max(v.abs()));
+    let magnitude = gt_centres
+        .iter()
+        .flatten()
+        .fold(0.0f64, |m, v| m.max(v.abs()));
     if !(gt_spread > 1e-12 * magnitude.max(1e-300)) {
-        return Err(Error::Geometry(format!("all {n} matched ground-truth camera centres coincide: no scale or rotation can be found from them")));
+        return Err(Error::Geometry(format!(
+            "all {n} matched ground-truth camera centres coincide: no scale or rotation can be found from them"
+        )));
     }
-    let r_mag = recon_centres.iter().flatten().fold(0.0f64, |m, v| m.max(v.abs()));
+    let r_mag = recon_centres
+        .iter()
+        .flatten()
+        .fold(0.0f64, |m, v| m.max(v.abs()));
     if !(spread(&recon_centres) > 1e-12 * r_mag.max(1e-300)) {
-        return Err(Error::Geometry(format!("all {n} matched reconstructed camera centres coincide: no scale or rotation can be found from them")));
+        return Err(Error::Geometry(format!(
+            "all {n} matched reconstructed camera centres coincide: no scale or rotation can be found from them"
+        )));
     }
     let thr = opts.threshold_fraction * gt_spread;
     let thr2 = thr * thr;
-    let have_rotations = usable.iter().filter(|p| p.implied_rotation().is_some()).count();
+    let have_rotations = usable
+        .iter()
+        .filter(|p| p.implied_rotation().is_some())
+        .count();
 
-    let collinear_all = n < 3 || planarity_ratio(&gt_centres) < opts.collinear_ratio || planarity_ratio(&recon_centres) < opts.collinear_ratio;
+    let collinear_all = n < 3
+        || planarity_ratio(&gt_centres) < opts.collinear_ratio
+        || planarity_ratio(&recon_centres) < opts.collinear_ratio;
     let mut best: Option<Model> = None;
     let mut iterations = 0usize;
     let mut stopped = false;
@@ -231,10 +296,14 @@ pub fn align_cameras(pairs: &[CameraPair], opts: &CamerasOptions) -> Result<(Sim
             let sample = [i, j, k];
             let tri = sample.map(|s| usable[s].recon_center);
             let tri_gt = sample.map(|s| usable[s].gt_center);
-            if planarity_ratio(&tri) < opts.collinear_ratio || planarity_ratio(&tri_gt) < opts.collinear_ratio {
+            if planarity_ratio(&tri) < opts.collinear_ratio
+                || planarity_ratio(&tri_gt) < opts.collinear_ratio
+            {
                 continue;
             }
-            let Ok(t) = fit_centres(&usable, &sample) else { continue };
+            let Ok(t) = fit_centres(&usable, &sample) else {
+                continue;
+            };
             let mut m = evaluate(&t, &usable, thr2);
             if better(&m, &best) {
                 // Local optimisation: refit on the inliers while it improves.
@@ -242,19 +311,30 @@ pub fn align_cameras(pairs: &[CameraPair], opts: &CamerasOptions) -> Result<(Sim
                     if m.inliers.len() < 3 {
                         break;
                     }
-                    let Ok(t2) = fit_centres(&usable, &m.inliers) else { break };
+                    let Ok(t2) = fit_centres(&usable, &m.inliers) else {
+                        break;
+                    };
                     let m2 = evaluate(&t2, &usable, thr2);
-                    if better(&m2, &Some(Model { t: m.t, cost: m.cost, inliers: m.inliers.clone() })) {
+                    if better(
+                        &m2,
+                        &Some(Model {
+                            t: m.t,
+                            cost: m.cost,
+                            inliers: m.inliers.clone(),
+                        }),
+                    ) {
                         m = m2;
                     } else {
                         break;
                     }
                 }
-                needed = needed_iterations(m.inliers.len(), n, 3, opts.confidence, opts.max_iterations);
+                needed =
+                    needed_iterations(m.inliers.len(), n, 3, opts.confidence, opts.max_iterations);
                 best = Some(m);
             }
         }
-        stopped = iterations < opts.max_iterations || best.as_ref().is_some_and(|b| b.inliers.len() == n);
+        stopped =
+            iterations < opts.max_iterations || best.as_ref().is_some_and(|b| b.inliers.len() == n);
     }
 
     // Collinear inliers leave the rotation about their line free: use the orientations.
@@ -262,13 +342,19 @@ pub fn align_cameras(pairs: &[CameraPair], opts: &CamerasOptions) -> Result<(Sim
         let idx = &b.inliers;
         let a: Vec<Point3> = idx.iter().map(|&i| usable[i].recon_center).collect();
         let g: Vec<Point3> = idx.iter().map(|&i| usable[i].gt_center).collect();
-        idx.len() < 3 || planarity_ratio(&a) < opts.collinear_ratio || planarity_ratio(&g) < opts.collinear_ratio
+        idx.len() < 3
+            || planarity_ratio(&a) < opts.collinear_ratio
+            || planarity_ratio(&g) < opts.collinear_ratio
     });
     if best_collinear {
         if have_rotations < 2 {
             return Err(Error::Geometry(format!(
                 "the {n} matched camera centres are {} and camera orientations are not available for at least 2 of them: the rotation is undetermined",
-                if n < 3 { "fewer than 3" } else { "(nearly) collinear" }
+                if n < 3 {
+                    "fewer than 3"
+                } else {
+                    "(nearly) collinear"
+                }
             )));
         }
         notes.push(format!(
@@ -281,7 +367,9 @@ pub fn align_cameras(pairs: &[CameraPair], opts: &CamerasOptions) -> Result<(Sim
         best = Some(evaluate_subset(t, inliers, &usable, thr2));
     }
     let Some(best) = best else {
-        return Err(Error::Geometry("no camera triple gave a valid similarity".into()));
+        return Err(Error::Geometry(
+            "no camera triple gave a valid similarity".into(),
+        ));
     };
     let rmse = rms(&best.t, &usable, &best.inliers);
     let ratio = best.inliers.len() as f64 / n as f64;
@@ -301,31 +389,50 @@ pub fn align_cameras(pairs: &[CameraPair], opts: &CamerasOptions) -> Result<(Sim
 }
 
 fn evaluate_subset(t: Similarity, inliers: Vec<usize>, pairs: &[CameraPair], thr2: f64) -> Model {
-    let cost = inliers.iter().map(|&i| sq_dist(t.apply(pairs[i].recon_center), pairs[i].gt_center).min(thr2)).sum();
+    let cost = inliers
+        .iter()
+        .map(|&i| sq_dist(t.apply(pairs[i].recon_center), pairs[i].gt_center).min(thr2))
+        .sum();
     Model { t, cost, inliers }
 }
 
 /// Rotation by consensus of the per-camera implied rotations (chordal mean of the largest
 /// agreeing set), then scale and translation by RANSAC over pairs of centres with that
 /// rotation, refined by least squares on the inliers.
-fn with_rotations(pairs: &[CameraPair], thr2: f64, opts: &CamerasOptions) -> Result<(Similarity, Vec<usize>, usize)> {
-    let implied: Vec<(usize, Matrix3<f64>)> = pairs.iter().enumerate().filter_map(|(i, p)| p.implied_rotation().map(|r| (i, r))).collect();
+fn with_rotations(
+    pairs: &[CameraPair],
+    thr2: f64,
+    opts: &CamerasOptions,
+) -> Result<(Similarity, Vec<usize>, usize)> {
+    let implied: Vec<(usize, Matrix3<f64>)> = pairs
+        .iter()
+        .enumerate()
+        .filter_map(|(i, p)| p.implied_rotation().map(|r| (i, r)))
+        .collect();
     let mut best_group: Vec<usize> = Vec::new();
     for (_, ri) in &implied {
         let group: Vec<usize> = implied
             .iter()
-            .filter(|(_, rj)| rotation_angle_deg(&from_m(ri), &from_m(rj)) <= opts.rotation_threshold_deg)
+            .filter(|(_, rj)| {
+                rotation_angle_deg(&from_m(ri), &from_m(rj)) <= opts.rotation_threshold_deg
+            })
             .map(|(j, _)| *j)
             .collect();
         if group.len() > best_group.len() {
             best_group = group;
         }
     }
-    let sum = best_group.iter().filter_map(|&i| pairs[i].implied_rotation()).fold(Matrix3::zeros(), |s, r| s + r);
-    let r = project_to_rotation(&sum).ok_or_else(|| Error::Geometry("camera orientations do not agree on a rotation".into()))?;
+    let sum = best_group
+        .iter()
+        .filter_map(|&i| pairs[i].implied_rotation())
+        .fold(Matrix3::zeros(), |s, r| s + r);
+    let r = project_to_rotation(&sum)
+        .ok_or_else(|| Error::Geometry("camera orientations do not agree on a rotation".into()))?;
     let cand = best_group;
     if cand.len() < 2 {
-        return Err(Error::Geometry("fewer than 2 cameras agree on the rotation: scale is undetermined".into()));
+        return Err(Error::Geometry(
+            "fewer than 2 cameras agree on the rotation: scale is undetermined".into(),
+        ));
     }
     let mut rng = ChaCha8Rng::seed_from_u64(opts.seed ^ 0x5eed);
     let mut best: Option<Model> = None;
@@ -340,16 +447,31 @@ fn with_rotations(pairs: &[CameraPair], thr2: f64, opts: &CamerasOptions) -> Res
         if j >= i {
             j += 1;
         }
-        let Some(t) = fit_scale_translation(&r, &sub, &[i, j]) else { continue };
+        let Some(t) = fit_scale_translation(&r, &sub, &[i, j]) else {
+            continue;
+        };
         let mut model = evaluate(&t, &sub, thr2);
         if better(&model, &best) {
             if let Some(t2) = fit_scale_translation(&r, &sub, &model.inliers) {
                 let m2 = evaluate(&t2, &sub, thr2);
-                if !better(&model, &Some(Model { t: m2.t, cost: m2.cost, inliers: m2.inliers.clone() })) {
+                if !better(
+                    &model,
+                    &Some(Model {
+                        t: m2.t,
+                        cost: m2.cost,
+                        inliers: m2.inliers.clone(),
+                    }),
+                ) {
                     model = m2;
                 }
             }
-            needed = needed_iterations(model.inliers.len(), m, 2, opts.confidence, opts.max_iterations);
+            needed = needed_iterations(
+                model.inliers.len(),
+                m,
+                2,
+                opts.confidence,
+                opts.max_iterations,
+            );
             best = Some(model);
         }
     }
@@ -364,7 +486,13 @@ mod tests {
     use nalgebra::{Rotation3, Unit, Vector3};
 
     fn rot(axis: [f64; 3], deg: f64) -> Rotation {
-        from_m(Rotation3::from_axis_angle(&Unit::new_normalize(Vector3::new(axis[0], axis[1], axis[2])), deg.to_radians()).matrix())
+        from_m(
+            Rotation3::from_axis_angle(
+                &Unit::new_normalize(Vector3::new(axis[0], axis[1], axis[2])),
+                deg.to_radians(),
+            )
+            .matrix(),
+        )
     }
 
     /// Orbit cameras looking at the origin; returns (gt centre, gt cam_from_world).
@@ -372,7 +500,11 @@ mod tests {
         (0..n)
             .map(|i| {
                 let a = i as f64 / n as f64 * std::f64::consts::TAU;
-                let c = if flat { [i as f64 * 0.5 - 3.0, 1.0, 4.0] } else { [3.0 * a.cos(), 0.5 + 0.3 * (3.0 * a).sin(), 3.0 * a.sin()] };
+                let c = if flat {
+                    [i as f64 * 0.5 - 3.0, 1.0, 4.0]
+                } else {
+                    [3.0 * a.cos(), 0.5 + 0.3 * (3.0 * a).sin(), 3.0 * a.sin()]
+                };
                 (c, rot([0.1, 1.0, 0.2 * (i as f64)], a.to_degrees()))
             })
             .collect()
@@ -405,7 +537,10 @@ mod tests {
         assert!((stage.inlier_ratio.unwrap() - 0.75).abs() < 1e-12);
         assert!(stage.converged && stage.rmse.unwrap() < 1e-9);
         // Deterministic.
-        assert_eq!(align_cameras(&pairs, &CamerasOptions::default()).unwrap().0, t);
+        assert_eq!(
+            align_cameras(&pairs, &CamerasOptions::default()).unwrap().0,
+            t
+        );
     }
 
     #[test]
@@ -426,9 +561,18 @@ mod tests {
         let truth = Similarity::from_parts(2.0, rot([0.0, 1.0, 0.0], 30.0), [0.0; 3]);
         let cams = orbit(10, true);
         // Collinear without rotations.
-        let no_rot: Vec<CameraPair> = make_pairs(&truth, &cams).iter().map(|p| CameraPair::centers(p.recon_center, p.gt_center)).collect();
-        assert!(matches!(align_cameras(&no_rot, &o), Err(Error::Geometry(_))));
-        assert!(matches!(align_cameras(&no_rot[..2], &o), Err(Error::Geometry(_))));
+        let no_rot: Vec<CameraPair> = make_pairs(&truth, &cams)
+            .iter()
+            .map(|p| CameraPair::centers(p.recon_center, p.gt_center))
+            .collect();
+        assert!(matches!(
+            align_cameras(&no_rot, &o),
+            Err(Error::Geometry(_))
+        ));
+        assert!(matches!(
+            align_cameras(&no_rot[..2], &o),
+            Err(Error::Geometry(_))
+        ));
         assert!(matches!(align_cameras(&[], &o), Err(Error::Empty { .. })));
         let same = vec![CameraPair::centers([1.0; 3], [2.0; 3]); 5];
         assert!(matches!(align_cameras(&same, &o), Err(Error::Geometry(_))));

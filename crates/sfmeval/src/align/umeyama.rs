@@ -27,7 +27,12 @@ pub fn umeyama(src: &[Point3], dst: &[Point3], with_scale: bool) -> Result<Simil
 }
 
 /// [`umeyama`] with non-negative per-pair weights (`None` = all 1).
-pub fn umeyama_weighted(src: &[Point3], dst: &[Point3], weights: Option<&[f64]>, with_scale: bool) -> Result<Similarity> {
+pub fn umeyama_weighted(
+    src: &[Point3],
+    dst: &[Point3],
+    weights: Option<&[f64]>,
+    with_scale: bool,
+) -> Result<Similarity> {
     if src.len() != dst.len() {
         return Err(Error::InvalidOption(format!(
             "umeyama needs matched pairs: {} source and {} target points",
@@ -37,15 +42,34 @@ pub fn umeyama_weighted(src: &[Point3], dst: &[Point3], weights: Option<&[f64]>,
     }
     if let Some(w) = weights {
         if w.len() != src.len() {
-            return Err(Error::InvalidOption(format!("{} weights for {} pairs", w.len(), src.len())));
+            return Err(Error::InvalidOption(format!(
+                "{} weights for {} pairs",
+                w.len(),
+                src.len()
+            )));
         }
         if w.iter().any(|w| !(w.is_finite() && *w >= 0.0)) {
-            return Err(Error::InvalidOption("weights must be finite and ≥ 0".into()));
+            return Err(Error::InvalidOption(
+                "weights must be finite and ≥ 0".into(),
+            ));
         }
     }
-    if let Some(i) = src.iter().zip(dst).position(|(a, b)| !(is_finite(a) && is_finite(b))) {
-        let count = src.iter().zip(dst).filter(|(a, b)| !(is_finite(a) && is_finite(b))).count();
-        return Err(Error::NonFinite { format: "alignment", what: "point pair", count, first_index: i });
+    if let Some(i) = src
+        .iter()
+        .zip(dst)
+        .position(|(a, b)| !(is_finite(a) && is_finite(b)))
+    {
+        let count = src
+            .iter()
+            .zip(dst)
+            .filter(|(a, b)| !(is_finite(a) && is_finite(b)))
+            .count();
+        return Err(Error::NonFinite {
+            format: "alignment",
+            what: "point pair",
+            count,
+            first_index: i,
+        });
     }
     let w = |i: usize| weights.map_or(1.0, |w| w[i]);
     let used = (0..src.len()).filter(|&i| w(i) > 0.0).count();
@@ -78,7 +102,9 @@ pub fn umeyama_weighted(src: &[Point3], dst: &[Point3], weights: Option<&[f64]>,
     var_s /= total;
     let (l, _) = super::sorted_eigen(&cov_s);
     if !(l[0] > 0.0) {
-        return Err(Error::Geometry("all source points coincide: no similarity is defined".into()));
+        return Err(Error::Geometry(
+            "all source points coincide: no similarity is defined".into(),
+        ));
     }
     if (l[1] / l[0]).sqrt() < COLLINEAR_RATIO {
         return Err(Error::Geometry(
@@ -150,15 +176,35 @@ mod tests {
     #[test]
     fn bad_inputs_are_errors() {
         let a = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0]];
-        assert!(matches!(umeyama(&a, &a, true), Err(Error::InvalidOption(_))));
-        let line = [[0.0, 0.0, 0.0], [1.0, 1.0, 1.0], [2.0, 2.0, 2.0], [3.0, 3.0, 3.0]];
-        assert!(matches!(umeyama(&line, &line, true), Err(Error::Geometry(_))));
+        assert!(matches!(
+            umeyama(&a, &a, true),
+            Err(Error::InvalidOption(_))
+        ));
+        let line = [
+            [0.0, 0.0, 0.0],
+            [1.0, 1.0, 1.0],
+            [2.0, 2.0, 2.0],
+            [3.0, 3.0, 3.0],
+        ];
+        assert!(matches!(
+            umeyama(&line, &line, true),
+            Err(Error::Geometry(_))
+        ));
         let same = [[1.0, 2.0, 3.0]; 4];
-        assert!(matches!(umeyama(&same, &line, true), Err(Error::Geometry(_))));
+        assert!(matches!(
+            umeyama(&same, &line, true),
+            Err(Error::Geometry(_))
+        ));
         let tri = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]];
-        assert!(matches!(umeyama(&tri, &same[..3], true), Err(Error::Geometry(_))));
+        assert!(matches!(
+            umeyama(&tri, &same[..3], true),
+            Err(Error::Geometry(_))
+        ));
         let nan = [[f64::NAN, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]];
-        assert!(matches!(umeyama(&nan, &tri, true), Err(Error::NonFinite { .. })));
+        assert!(matches!(
+            umeyama(&nan, &tri, true),
+            Err(Error::NonFinite { .. })
+        ));
         assert!(umeyama(&tri, &a, true).is_err());
         // Weighted: zero weights drop pairs.
         assert!(umeyama_weighted(&tri, &tri, Some(&[1.0, 1.0, 0.0]), true).is_err());
