@@ -7,9 +7,7 @@ use anyhow::{Context as _, Result, bail};
 use clap::{Args, Parser, Subcommand};
 use sfmeval::align::{PointPair, parse_point_pairs};
 use sfmeval::crop::{Crop, Volume};
-use sfmeval::evaluate::{
-    AlignmentInput, DEFAULT_SAMPLES, EvalOptions, InputInfo, PreparedGroundTruth, evaluate,
-};
+use sfmeval::evaluate::{DEFAULT_SAMPLES, EvalOptions, PreparedGroundTruth};
 use sfmeval::geometry::{Aabb, GroundTruth};
 use sfmeval::io;
 use sfmeval::model::{self, Reconstruction};
@@ -93,9 +91,10 @@ struct InputArgs {
     /// Ground-truth cameras (the dataset's cameras.json): camera alignment and pose metrics.
     #[arg(long, value_name = "FILE")]
     gt_cameras: Option<PathBuf>,
-    /// Alignment: auto (cameras, else points, else global; then icp), cameras, points, global,
-    /// icp, given (needs --transform) or none. Default: given with --transform, else auto.
-    #[arg(long, value_name = "METHOD", value_parser = ["auto", "cameras", "points", "global", "icp", "given", "none"])]
+    /// Alignment: auto (cameras, else points, else global; then icp), cameras, points, global
+    /// (alone, or refined: cameras+icp, points+icp, global+icp), icp (from --transform or the
+    /// identity), given (needs --transform) or none. Default: given with --transform, else auto.
+    #[arg(long, value_name = "METHOD", value_parser = ["auto", "cameras", "points", "global", "icp", "cameras+icp", "points+icp", "global+icp", "given", "none"])]
     align: Option<String>,
     /// A 4×4 row-major similarity gt_from_recon (JSON or 16 numbers as text): used as is with
     /// `--align given`, as the start of `--align icp`.
@@ -338,7 +337,9 @@ fn load(input: &InputArgs, eval: EvalOptions, bars: &Bars) -> Result<Loaded> {
         }
     });
     let align = match method.as_str() {
-        "none" if transform.is_some() => bail!("--align none ignores --transform: use --align given (the default with --transform)"),
+        "none" if transform.is_some() => bail!(
+            "--align none ignores --transform: use --align given (the default with --transform)"
+        ),
         "none" => AlignRequest::None,
         "given" => AlignRequest::Given(
             transform.ok_or_else(|| anyhow::anyhow!("--align given needs --transform FILE"))?,
@@ -514,6 +515,8 @@ fn cameras_cmd(
     let (_, alignment, cams) = pipeline::cameras_only(&gt, &est, given, &RunOptions::default())?;
     let value = serde_json::json!({"alignment": alignment, "cameras": cams});
     let mut s = serde_json::to_string_pretty(&value)?;
+    let mut shown = value.clone();
+    shown["standalone"] = serde_json::Value::Bool(true);
     s.push('\n');
     if let Some(p) = report {
         write_atomic(p, s.as_bytes())?;
@@ -521,7 +524,7 @@ fn cameras_cmd(
     if json {
         print!("{s}");
     } else {
-        print!("{}", summary::render_cameras(&value));
+        print!("{}", summary::render_cameras(&shown));
     }
     Ok(())
 }
@@ -592,26 +595,57 @@ fn info(path: &Path) -> Result<()> {
 }
 
 const DEMO_GT: &[u8] = include_bytes!("../../../data/demo/ground_truth.glb");
-const DEMO_RECON: &[u8] = include_bytes!("../../../data/demo/sparse.ply");
-const DEMO_TRANSFORM: &[u8] = include_bytes!("../../../data/demo/gt_from_recon.txt");
+const DEMO_CAMERAS: &[u8] = include_bytes!("../../../data/demo/cameras.json");
+const DEMO_MODEL: [(&str, &[u8]); 3] = [
+    (
+        "sparse/cameras.txt",
+        include_bytes!("../../../data/demo/sparse/cameras.txt"),
+    ),
+    (
+        "sparse/images.txt",
+        include_bytes!("../../../data/demo/sparse/images.txt"),
+    ),
+    (
+        "sparse/points3D.txt",
+        include_bytes!("../../../data/demo/sparse/points3D.txt"),
+    ),
+];
 
+/// The demo: 36 rendered views of the built-in statue (Blender), reconstructed by pycolmap,
+/// evaluated with `auto` alignment (camera centres, then ICP) and camera-pose metrics.
 fn demo(json: bool, report_path: Option<&Path>) -> Result<()> {
     let gt = io::read_ground_truth("ground_truth.glb", DEMO_GT, &BTreeMap::new())?;
-    let recon = io::read_point_cloud("sparse.ply", DEMO_RECON)?;
-    let options = EvalOptions::default();
-    let alignment = AlignmentInput::given(Similarity::parse(DEMO_TRANSFORM)?);
-    let info = InputInfo {
-        recon_name: "sparse.ply".into(),
-        recon_format: "ply".into(),
-        recon_images: 0,
-        gt_name: "ground_truth.glb".into(),
-        gt_format: "glb".into(),
-        warnings: Vec::new(),
-    };
+    let files: BTreeMap<String, Vec<u8>> = DEMO_MODEL
+        .iter()
+        .map(|(n, b)| (n.to_string(), b.to_vec()))
+        .collect();
+    let recon = read_reconstruction("sparse", &files)?;
+    let gt_cameras = model::read_model_files(&BTreeMap::from([(
+        "cameras.json".to_string(),
+        DEMO_CAMERAS.to_vec(),
+    )]))?;
+    let options = RunOptions::default();
     let bars = Bars::new(false);
-    let prepared =
-        PreparedGroundTruth::new(&gt.ground_truth, options.samples, options.seed, &bars)?;
-    let evaluation = evaluate(&prepared, &recon.cloud, &alignment, &options, &info, &bars)?;
+    let prepared = PreparedGroundTruth::new(
+        &gt.ground_truth,
+        options.eval.samples,
+        options.eval.seed,
+        &bars,
+    )?;
+    let gt_info = GroundTruthInfo {
+        name: "ground_truth.glb".into(),
+        format: "glb".into(),
+        warnings: gt.warnings,
+    };
+    let evaluation = pipeline::run(
+        &prepared,
+        &gt_info,
+        &recon,
+        Some(&gt_cameras),
+        &[],
+        &options,
+        &bars,
+    )?;
     if let Some(p) = report_path {
         write_atomic(p, evaluation.report.to_json().as_bytes())?;
     }

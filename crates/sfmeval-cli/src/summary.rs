@@ -103,6 +103,10 @@ pub fn render(r: &Report) -> String {
             t.f_score
         );
     }
+    if let Some(c) = &r.cameras {
+        let v = serde_json::json!({"cameras": c, "alignment": r.alignment});
+        s.push_str(&render_cameras(&v));
+    }
     for w in &r.warnings {
         let _ = writeln!(s, "warning: {w}");
     }
@@ -123,11 +127,23 @@ pub fn render_cameras(v: &serde_json::Value) -> String {
     );
     let _ = writeln!(
         s,
-        "alignment       {} (scale {})",
-        v.pointer("/alignment/method")
+        "pose alignment  {} (scale {}); focal error {} %",
+        v.pointer("/cameras/alignment/stage")
+            .or_else(|| v.pointer("/alignment/method"))
             .and_then(|m| m.as_str())
             .unwrap_or("?"),
-        g(num("/alignment/scale"))
+        g(v.pointer("/cameras/alignment/scale")
+            .and_then(|x| x.as_f64())
+            .unwrap_or(num("/alignment/scale"))),
+        v.pointer("/cameras/focal")
+            .and_then(|f| f.as_array())
+            .map(|f| f
+                .iter()
+                .filter_map(|c| c.get("error_percent").and_then(|e| e.as_f64()))
+                .map(|e| format!("{e:.3}"))
+                .collect::<Vec<_>>()
+                .join(", "))
+            .unwrap_or_default()
     );
     let _ = writeln!(
         s,
@@ -138,11 +154,12 @@ pub fn render_cameras(v: &serde_json::Value) -> String {
     );
     let _ = writeln!(
         s,
-        "centre error    mean {}  median {}  max {}  (ATE RMSE {})",
+        "centre error    mean {}  median {}  max {}  (ATE RMSE {}, mean {} % of scene radius)",
         g(num("/cameras/center_error/mean")),
         g(num("/cameras/center_error/median")),
         g(num("/cameras/center_error/max")),
-        g(num("/cameras/ate_rmse"))
+        g(num("/cameras/ate_rmse")),
+        g(num("/cameras/center_error_percent/mean"))
     );
     if let Some(w) = v.pointer("/cameras/warnings").and_then(|w| w.as_array()) {
         for w in w.iter().filter_map(|w| w.as_str()) {

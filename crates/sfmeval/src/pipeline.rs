@@ -180,7 +180,12 @@ pub fn run(
         AlignRequest::None => AlignmentInput::none(),
         AlignRequest::Given(t) => AlignmentInput::given(*t),
         AlignRequest::Stages(name) => {
-            let method = AlignMethod::parse(name)?;
+            // `cameras`, `points`, `global` run alone; `cameras+icp` (etc.) and `auto` refine.
+            let (base, refine) = match name.strip_suffix("+icp") {
+                Some(b) => (b, true),
+                None => (name.as_str(), name == "auto" || name == "icp"),
+            };
+            let method = AlignMethod::parse(base)?;
             progress.start(Stage::Alignment, 1);
             let input = AlignInput {
                 recon: &recon.cloud.points,
@@ -188,7 +193,11 @@ pub fn run(
                 point_pairs,
                 start: options.icp_start,
             };
-            let opts = AlignOptions::default().with_seed(options.eval.seed);
+            let opts = AlignOptions {
+                refine,
+                ..AlignOptions::default()
+            }
+            .with_seed(options.eval.seed);
             let (t, report) = align::align(gt, &input, method, &opts)?;
             progress.finish();
             warnings.extend(align::stage_notes(&report));
@@ -208,15 +217,32 @@ pub fn run(
     };
     let mut evaluation = evaluate(gt, &recon.cloud, &alignment, &options.eval, &info, progress)?;
     if let (Some(g), Some(e), Some(m)) = (gt_cameras, &recon.model, &matches) {
-        let cams = evaluate_cameras_matched(g, e, m, &alignment.gt_from_recon, &options.pose)?;
+        // Poses are measured after the camera stage when there is one (as ATE aligns the
+        // trajectory itself); the point refinement may move the scale by the SfM's own
+        // camera/point inconsistency (e.g. a focal error), which the point metrics then show.
+        let camera_stage = alignment
+            .report
+            .stages
+            .iter()
+            .find(|s| s.method == "cameras");
+        let (t, used) = match camera_stage {
+            Some(stage) => (Similarity::from_matrix(stage.gt_from_recon)?, "cameras"),
+            None => (alignment.gt_from_recon, alignment.report.method.as_str()),
+        };
+        let cams = evaluate_cameras_matched(g, e, m, &t, &options.pose)?;
         evaluation
             .report
             .warnings
             .extend(cams.warnings.iter().map(|w| format!("cameras: {w}")));
-        evaluation.report.cameras = Some(
-            serde_json::to_value(&cams)
-                .map_err(|e| Error::InvalidOption(format!("camera report: {e}")))?,
-        );
+        let mut value = serde_json::to_value(&cams)
+            .map_err(|e| Error::InvalidOption(format!("camera report: {e}")))?;
+        if let Some(obj) = value.as_object_mut() {
+            obj.insert(
+                "alignment".into(),
+                serde_json::json!({"stage": used, "gt_from_recon": t.matrix, "scale": t.scale()}),
+            );
+        }
+        evaluation.report.cameras = Some(value);
     }
     Ok(evaluation)
 }
