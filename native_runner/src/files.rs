@@ -1,0 +1,311 @@
+//! Files: atomic writes (write to a temporary name, then rename), reading a model folder into
+//! the core's `name → bytes` map, the sparse PLY and the COLMAP text writers.
+
+use std::collections::BTreeMap;
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+
+use anyhow::{Context, Result};
+use sfmeval::model::Reconstruction;
+
+/// Writes `bytes` to `path` through a temporary file in the same folder and a rename, so a
+/// reader sees either the old file or the whole new one.
+pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
+    let dir = path.parent().unwrap_or(Path::new("."));
+    std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
+    let name = path
+        .file_name()
+        .map(|n| n.to_string_lossy().to_string())
+        .unwrap_or_else(|| "file".into());
+    let tmp = dir.join(format!(".{name}.tmp-{}", std::process::id()));
+    std::fs::write(&tmp, bytes).with_context(|| format!("writing {}", tmp.display()))?;
+    std::fs::rename(&tmp, path).with_context(|| format!("renaming to {}", path.display()))?;
+    Ok(())
+}
+
+/// A unique temporary sibling name for `path` (`.NAME.partial-PID-N`).
+pub fn partial_name(path: &Path) -> PathBuf {
+    use std::sync::atomic::{AtomicU64, Ordering};
+    static N: AtomicU64 = AtomicU64::new(0);
+    let n = N.fetch_add(1, Ordering::Relaxed);
+    let name = path
+        .file_name()
+        .map(|n| n.to_string_lossy().to_string())
+        .unwrap_or_default();
+    path.with_file_name(format!(".{name}.partial-{}-{n}", std::process::id()))
+}
+
+/// Moves the finished folder `tmp` to `dest`, replacing an older `dest`: the old one is first
+/// renamed aside, so `dest` is at every moment either the old or the new complete folder.
+pub fn replace_dir(tmp: &Path, dest: &Path) -> Result<()> {
+    if dest.exists() {
+        let old = partial_name(dest);
+        std::fs::rename(dest, &old).with_context(|| format!("moving {} aside", dest.display()))?;
+        std::fs::rename(tmp, dest).with_context(|| format!("renaming to {}", dest.display()))?;
+        std::fs::remove_dir_all(&old).with_context(|| format!("removing {}", old.display()))?;
+    } else {
+        std::fs::rename(tmp, dest).with_context(|| format!("renaming to {}", dest.display()))?;
+    }
+    Ok(())
+}
+
+/// Copies a folder tree.
+pub fn copy_dir(src: &Path, dst: &Path) -> Result<()> {
+    std::fs::create_dir_all(dst).with_context(|| format!("creating {}", dst.display()))?;
+    for e in std::fs::read_dir(src).with_context(|| format!("reading {}", src.display()))? {
+        let e = e?;
+        let (from, to) = (e.path(), dst.join(e.file_name()));
+        if e.file_type()?.is_dir() {
+            copy_dir(&from, &to)?;
+        } else {
+            std::fs::copy(&from, &to)
+                .with_context(|| format!("copying {} to {}", from.display(), to.display()))?;
+        }
+    }
+    Ok(())
+}
+
+/// Every file under `dir` that can be part of an SfM model or a cloud, keyed by its path
+/// relative to `dir` with `/` separators (how the core expects COLMAP `sparse/N/` folders).
+pub fn read_model_dir(dir: &Path) -> Result<BTreeMap<String, Vec<u8>>> {
+    let mut out = BTreeMap::new();
+    walk(dir, dir, &mut out)?;
+    Ok(out)
+}
+
+fn walk(root: &Path, dir: &Path, out: &mut BTreeMap<String, Vec<u8>>) -> Result<()> {
+    let mut entries: Vec<_> = std::fs::read_dir(dir)
+        .with_context(|| format!("reading {}", dir.display()))?
+        .filter_map(|e| e.ok())
+        .collect();
+    entries.sort_by_key(|e| e.file_name());
+    for e in entries {
+        let p = e.path();
+        if p.is_dir() {
+            walk(root, &p, out)?;
+            continue;
+        }
+        let lower = p.to_string_lossy().to_ascii_lowercase();
+        if [".bin", ".txt", ".nvm", ".out", ".json", ".ply"]
+            .iter()
+            .any(|x| lower.ends_with(x))
+        {
+            let rel = p
+                .strip_prefix(root)
+                .unwrap_or(&p)
+                .components()
+                .map(|c| c.as_os_str().to_string_lossy().to_string())
+                .collect::<Vec<_>>()
+                .join("/");
+            let bytes = std::fs::read(&p).with_context(|| format!("reading {}", p.display()))?;
+            out.insert(rel, bytes);
+        }
+    }
+    Ok(())
+}
+
+/// A binary little-endian PLY of points (float x y z, uchar red green blue), as COLMAP writes.
+pub fn sparse_ply(points: &[[f64; 3]], colors: Option<&[[u8; 3]]>) -> Vec<u8> {
+    let mut out = format!(
+        "ply\nformat binary_little_endian 1.0\ncomment written by sfmeval-runner\nelement vertex {}\nproperty float x\nproperty float y\nproperty float z\nproperty uchar red\nproperty uchar green\nproperty uchar blue\nend_header\n",
+        points.len()
+    )
+    .into_bytes();
+    out.reserve(points.len() * 15);
+    for (i, p) in points.iter().enumerate() {
+        for v in p {
+            out.extend_from_slice(&(*v as f32).to_le_bytes());
+        }
+        let c = colors
+            .and_then(|c| c.get(i))
+            .copied()
+            .unwrap_or([255, 255, 255]);
+        out.extend_from_slice(&c);
+    }
+    out
+}
+
+/// A COLMAP text model (cameras.txt, images.txt, points3D.txt) of `rec`, for tools whose own
+/// output is another format (NVM, Bundler). Image and point ids are 1-based indices.
+pub fn colmap_text(rec: &Reconstruction) -> BTreeMap<&'static str, String> {
+    let mut cams = String::from(
+        "# Camera list written by sfmeval-runner\n# CAMERA_ID, MODEL, WIDTH, HEIGHT, PARAMS[]\n",
+    );
+    for c in &rec.cameras {
+        let params: Vec<String> = if c.params.is_empty() {
+            vec![c.fx, c.fy, c.cx, c.cy]
+                .iter()
+                .map(|v| v.to_string())
+                .collect()
+        } else {
+            c.params.iter().map(|v| v.to_string()).collect()
+        };
+        let model = if c.params.is_empty() {
+            "PINHOLE"
+        } else {
+            c.model.as_str()
+        };
+        let _ = writeln!(
+            cams,
+            "{} {} {} {} {}",
+            c.id,
+            model,
+            c.width,
+            c.height,
+            params.join(" ")
+        );
+    }
+    let mut imgs = String::from(
+        "# Image list written by sfmeval-runner\n# IMAGE_ID, QW, QX, QY, QZ, TX, TY, TZ, CAMERA_ID, NAME\n# POINTS2D[] as (X, Y, POINT3D_ID)\n",
+    );
+    for (i, im) in rec.images.iter().enumerate() {
+        let q = quaternion(&im.cam_from_world.rotation);
+        let t = im.cam_from_world.translation;
+        let _ = writeln!(
+            imgs,
+            "{} {} {} {} {} {} {} {} {} {}",
+            i + 1,
+            q[0],
+            q[1],
+            q[2],
+            q[3],
+            t[0],
+            t[1],
+            t[2],
+            im.camera_id,
+            im.name
+        );
+        let obs: Vec<String> = im
+            .observations
+            .iter()
+            .map(|o| {
+                let id = o.point.map_or(-1, |p| p as i64 + 1);
+                format!("{} {} {id}", o.xy[0], o.xy[1])
+            })
+            .collect();
+        let _ = writeln!(imgs, "{}", obs.join(" "));
+    }
+    let mut pts = String::from(
+        "# 3D point list written by sfmeval-runner\n# POINT3D_ID, X, Y, Z, R, G, B, ERROR, TRACK[] as (IMAGE_ID, POINT2D_IDX)\n",
+    );
+    for (i, p) in rec.points.iter().enumerate() {
+        let c = p.color.unwrap_or([255, 255, 255]);
+        let track: Vec<String> = p
+            .track
+            .iter()
+            .map(|t| format!("{} {}", t.image + 1, t.keypoint))
+            .collect();
+        let _ = writeln!(
+            pts,
+            "{} {} {} {} {} {} {} {} {}",
+            i + 1,
+            p.xyz[0],
+            p.xyz[1],
+            p.xyz[2],
+            c[0],
+            c[1],
+            c[2],
+            p.error.unwrap_or(0.0),
+            track.join(" ")
+        );
+    }
+    BTreeMap::from([
+        ("cameras.txt", cams),
+        ("images.txt", imgs),
+        ("points3D.txt", pts),
+    ])
+}
+
+/// Unit quaternion `[w, x, y, z]` of a rotation matrix (Shepperd's method).
+pub fn quaternion(r: &[[f64; 3]; 3]) -> [f64; 4] {
+    let tr = r[0][0] + r[1][1] + r[2][2];
+    let q = if tr > 0.0 {
+        let s = (tr + 1.0).sqrt() * 2.0;
+        [
+            0.25 * s,
+            (r[2][1] - r[1][2]) / s,
+            (r[0][2] - r[2][0]) / s,
+            (r[1][0] - r[0][1]) / s,
+        ]
+    } else if r[0][0] > r[1][1] && r[0][0] > r[2][2] {
+        let s = (1.0 + r[0][0] - r[1][1] - r[2][2]).sqrt() * 2.0;
+        [
+            (r[2][1] - r[1][2]) / s,
+            0.25 * s,
+            (r[0][1] + r[1][0]) / s,
+            (r[0][2] + r[2][0]) / s,
+        ]
+    } else if r[1][1] > r[2][2] {
+        let s = (1.0 + r[1][1] - r[0][0] - r[2][2]).sqrt() * 2.0;
+        [
+            (r[0][2] - r[2][0]) / s,
+            (r[0][1] + r[1][0]) / s,
+            0.25 * s,
+            (r[1][2] + r[2][1]) / s,
+        ]
+    } else {
+        let s = (1.0 + r[2][2] - r[0][0] - r[1][1]).sqrt() * 2.0;
+        [
+            (r[1][0] - r[0][1]) / s,
+            (r[0][2] + r[2][0]) / s,
+            (r[1][2] + r[2][1]) / s,
+            0.25 * s,
+        ]
+    };
+    let n = q.iter().map(|v| v * v).sum::<f64>().sqrt();
+    let sign = if q[0] < 0.0 { -1.0 } else { 1.0 };
+    q.map(|v| sign * v / n)
+}
+
+#[cfg(test)]
+#[allow(clippy::unwrap_used, clippy::expect_used)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn quaternion_round_trip() {
+        for q in [
+            [1.0, 0.0, 0.0, 0.0],
+            [0.5, 0.5, -0.5, 0.5],
+            [0.1, -0.7, 0.2, 0.67],
+        ] {
+            let n = (q as [f64; 4]).iter().map(|v| v * v).sum::<f64>().sqrt();
+            let q = q.map(|v| v / n);
+            let r = sfmeval::model::quaternion_to_matrix(q).unwrap();
+            let back = quaternion(&r);
+            for k in 0..4 {
+                assert!((back[k] - q[k]).abs() < 1e-12, "{q:?} {back:?}");
+            }
+        }
+    }
+
+    #[test]
+    fn colmap_text_reads_back() {
+        let files: BTreeMap<String, Vec<u8>> = [
+            ("cameras.txt", "1 PINHOLE 640 360 700 700 320 180\n"),
+            ("images.txt", "1 1 0 0 0 0 0 5 1 a.jpg\n10 20 1 30 40 -1\n2 0.7071067811865476 0 0.7071067811865476 0 1 0 5 1 b.jpg\n11 21 1\n"),
+            ("points3D.txt", "1 0.1 0.2 0.3 10 20 30 0.5 1 0 2 0\n"),
+        ]
+        .into_iter()
+        .map(|(k, v)| (k.to_string(), v.as_bytes().to_vec()))
+        .collect();
+        let rec = sfmeval::model::read_model_files(&files).unwrap();
+        let written: BTreeMap<String, Vec<u8>> = colmap_text(&rec)
+            .into_iter()
+            .map(|(k, v)| (k.to_string(), v.into_bytes()))
+            .collect();
+        let back = sfmeval::model::read_model_files(&written).unwrap();
+        assert_eq!(back.images.len(), 2);
+        assert_eq!(back.points.len(), 1);
+        assert_eq!(back.points[0].track.len(), 2);
+        for (a, b) in rec.images.iter().zip(&back.images) {
+            assert_eq!(a.name, b.name);
+            for k in 0..3 {
+                assert!((a.center()[k] - b.center()[k]).abs() < 1e-9);
+            }
+        }
+        let ply = sparse_ply(&[[1.0, 2.0, 3.0]], None);
+        let cloud = sfmeval::io::read_point_cloud("x.ply", &ply).unwrap();
+        assert_eq!(cloud.cloud.points, vec![[1.0, 2.0, 3.0]]);
+    }
+}

@@ -1,0 +1,205 @@
+//! `sfmeval-runner table1`: the seed experiment in one command. Renders the five built-in
+//! datasets with the Blender generator (`blender_scripts/generate.py` in the venv's bpy), runs
+//! every pipeline on them and writes the comparison table. `--quick` renders them with the
+//! small preset's settings (36 views, 640×360, 16 spp). Rendered datasets and finished runs
+//! are reused unless `--fresh`.
+
+use std::path::{Path, PathBuf};
+use std::time::{Duration, Instant};
+
+use anyhow::{Context, Result, bail};
+
+use crate::Table1Args;
+use crate::dataset::Dataset;
+use crate::exec::{Step, run_step};
+use crate::files::{partial_name, replace_dir, write_atomic};
+
+/// The seed paper's five datasets, as generator presets.
+pub const PRESETS: [&str; 5] = ["statue", "vase", "bicycle", "hydrant", "vehicle"];
+
+/// Generator overrides of `--quick`: the `small` preset's camera, views and sampling.
+pub const QUICK: [&str; 6] = [
+    "camera.resolution=[640, 360]",
+    "render.samples=16",
+    "render.denoise=false",
+    "views.fill=1.0",
+    "views.orbits=[{elevation_deg=20.0, count=18}, {elevation_deg=45.0, count=18, azimuth_offset_deg=10.0}]",
+    "views.sphere.count=0",
+];
+
+/// The `blender_scripts` folder: given, `$SFMEVAL_BLENDER_SCRIPTS`, beside an ancestor of the
+/// binary, or under the working directory.
+pub fn find_blender_scripts(given: Option<&Path>) -> Result<PathBuf> {
+    let ok = |p: &Path| p.join("generate.py").is_file();
+    if let Some(p) = given {
+        if ok(p) {
+            return Ok(p.to_path_buf());
+        }
+        bail!("{} has no generate.py", p.display());
+    }
+    let mut candidates: Vec<PathBuf> = Vec::new();
+    if let Some(p) = std::env::var_os("SFMEVAL_BLENDER_SCRIPTS") {
+        candidates.push(PathBuf::from(p));
+    }
+    if let Ok(exe) = std::env::current_exe() {
+        candidates.extend(exe.ancestors().skip(1).map(|d| d.join("blender_scripts")));
+    }
+    candidates.push(PathBuf::from("blender_scripts"));
+    candidates
+        .into_iter()
+        .find(|p| ok(p))
+        .context("blender_scripts/generate.py not found: pass --blender-scripts DIR")
+}
+
+/// Renders one dataset into `dest` (through a temporary folder), returning the seconds spent.
+fn generate(
+    python: &Path,
+    scripts: &Path,
+    preset: &str,
+    quick: bool,
+    sets: &[String],
+    dest: &Path,
+) -> Result<f64> {
+    let tmp = partial_name(dest);
+    if tmp.exists() {
+        std::fs::remove_dir_all(&tmp)?;
+    }
+    let mut argv = vec![
+        python.to_string_lossy().to_string(),
+        scripts.join("generate.py").to_string_lossy().to_string(),
+        "--preset".into(),
+        preset.into(),
+        "--set".into(),
+        "outputs.depth=false".into(),
+        "--set".into(),
+        "outputs.masks=false".into(),
+    ];
+    let mut overrides: Vec<String> = Vec::new();
+    if quick {
+        overrides.extend(QUICK.iter().map(|s| s.to_string()));
+        overrides.push(format!("dataset.name=\"{preset}-quick\""));
+    }
+    overrides.extend(sets.iter().cloned());
+    for s in overrides {
+        argv.push("--set".into());
+        argv.push(s);
+    }
+    argv.push("--out".into());
+    argv.push(tmp.to_string_lossy().to_string());
+    let parent = dest.parent().unwrap_or(Path::new("."));
+    let log = parent.join(format!(
+        "{}.log",
+        dest.file_name()
+            .map(|n| n.to_string_lossy().to_string())
+            .unwrap_or_default()
+    ));
+    let step = Step::new(&format!("generate {preset}"), argv, parent);
+    eprintln!(
+        "table1: rendering {preset} → {} (log {})",
+        dest.display(),
+        log.display()
+    );
+    let r = run_step(&step, &log, Instant::now() + Duration::from_secs(48 * 3600));
+    if !r.success() {
+        let _ = std::fs::remove_dir_all(&tmp);
+        bail!("{} (see {})", r.failure_reason(), log.display());
+    }
+    replace_dir(&tmp, dest)?;
+    Ok(r.wall_seconds)
+}
+
+/// The whole experiment.
+pub fn table1(a: &Table1Args) -> Result<()> {
+    let t0 = Instant::now();
+    let python = crate::find_python(a.tools.python.as_deref());
+    let scripts = find_blender_scripts(a.blender_scripts.as_deref())?;
+    let presets: Vec<String> = if a.presets.is_empty() {
+        PRESETS.iter().map(|s| s.to_string()).collect()
+    } else {
+        a.presets.clone()
+    };
+    let ds_root = a.out.join("datasets");
+    let runs = a.out.join("runs");
+    let table = a.out.join("table");
+    std::fs::create_dir_all(&ds_root).with_context(|| format!("creating {}", ds_root.display()))?;
+    let mut timing = serde_json::Map::new();
+    let mut gen_times = serde_json::Map::new();
+    let mut datasets = Vec::new();
+    for p in &presets {
+        let name = if a.quick {
+            format!("{p}-quick")
+        } else {
+            p.clone()
+        };
+        let dest = ds_root.join(&name);
+        let complete = dest.join("dataset.json").is_file() && dest.join("cameras.json").is_file();
+        if complete && !a.fresh {
+            eprintln!("table1: reusing {}", dest.display());
+        } else {
+            let secs = generate(&python, &scripts, p, a.quick, &a.sets, &dest)?;
+            gen_times.insert(name.clone(), secs.into());
+        }
+        datasets.push(Dataset::open(&dest)?);
+    }
+    let gen_seconds = t0.elapsed().as_secs_f64();
+    timing.insert("render_seconds".into(), gen_times.into());
+    let customs = crate::pipelines::parse_customs(&a.tools.customs)?;
+    let specs = crate::pipelines::parse_list(&a.pipelines, &customs)?;
+    let env = crate::make_env(&a.tools, &runs)?;
+    let opts = crate::run::BatchOptions {
+        out: runs.clone(),
+        timeout: Duration::from_secs_f64(a.timeout.max(1.0)),
+        jobs: a.jobs.max(1),
+        resume: !a.fresh,
+        retry_failed: false,
+        shard: None,
+        intrinsics: if a.intrinsics == "known" {
+            crate::adapters::Intrinsics::Known
+        } else {
+            crate::adapters::Intrinsics::Exif
+        },
+        seed: 0,
+        keep_scratch: false,
+        verbose: true,
+    };
+    let t_runs = Instant::now();
+    let summary = crate::run::run_batch(&datasets, &specs, &customs, &env, &opts)?;
+    let runs_seconds = t_runs.elapsed().as_secs_f64();
+    let t_rep = Instant::now();
+    let rows = crate::report::report(&crate::report::ReportArgs {
+        runs: vec![runs.clone()],
+        out: table.clone(),
+        datasets: Vec::new(),
+        eval: crate::eval_options(&a.eval)?,
+        align: a.eval.align.clone(),
+        verbose: false,
+    })?;
+    let report_seconds = t_rep.elapsed().as_secs_f64();
+    timing.insert("datasets_seconds".into(), gen_seconds.into());
+    timing.insert("runs_seconds".into(), runs_seconds.into());
+    timing.insert("report_seconds".into(), report_seconds.into());
+    timing.insert("total_seconds".into(), t0.elapsed().as_secs_f64().into());
+    let doc = serde_json::json!({
+        "quick": a.quick,
+        "presets": presets,
+        "pipelines": specs.iter().map(|s| s.name.clone()).collect::<Vec<_>>(),
+        "runs_executed": summary.ran,
+        "runs_reused": summary.skipped,
+        "timing": timing,
+    });
+    let mut json = serde_json::to_string_pretty(&doc)?;
+    json.push('\n');
+    write_atomic(&a.out.join("table1.json"), json.as_bytes())?;
+    let t1 = std::fs::read_to_string(table.join("table1.md")).unwrap_or_default();
+    println!("{t1}");
+    eprintln!(
+        "table1: {} runs; datasets {:.0} s, runs {:.0} s, report {:.0} s, total {:.0} s; tables in {}",
+        rows.len(),
+        gen_seconds,
+        runs_seconds,
+        report_seconds,
+        t0.elapsed().as_secs_f64(),
+        table.display()
+    );
+    Ok(())
+}
