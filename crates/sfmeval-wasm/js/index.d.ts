@@ -1,0 +1,129 @@
+// Type declarations of the `sfmeval` npm package.
+import type {
+  GroundTruth as RawGroundTruth,
+  Reconstruction as RawReconstruction,
+  Cameras as RawCameras,
+} from './sfmeval_wasm.js';
+import * as rawBindings from './sfmeval_wasm.js';
+
+/** File contents by (relative) file name. */
+export type Files = Record<string, Uint8Array | ArrayBuffer | ArrayBufferView | string>;
+
+/** A 3D point. */
+export type Vec3 = [number, number, number];
+
+/** Crop volume in the ground-truth frame (`sfmeval.crop/1`). */
+export type Volume =
+  | { kind: 'box'; min: Vec3; max: Vec3 }
+  | { kind: 'oriented_box'; center: Vec3; half_extents: Vec3; rotation: [Vec3, Vec3, Vec3] }
+  | { kind: 'sphere'; center: Vec3; radius: number };
+
+/** A crop: an optional volume and an optional maximum distance to the ground truth. */
+export interface Crop {
+  schema?: 'sfmeval.crop/1';
+  volume?: Volume;
+  max_distance?: number;
+}
+
+/** One correspondence for the `points` alignment stage. */
+export interface PointPair {
+  recon: Vec3;
+  gt: Vec3;
+}
+
+/** Options of an evaluation, named as in the report (same meaning as the CLI's flags). */
+export interface EvalOptions {
+  /** Thresholds in ground-truth units. */
+  tau?: number[];
+  /** Thresholds in percent of the ground-truth bounding-box diagonal (default 0.5, 1, 2). */
+  tau_percent_of_diagonal?: number[];
+  /** Completeness samples on a mesh ground truth (default 1 000 000). */
+  samples?: number;
+  /** Seed of the surface sampler and the randomised alignment stages. */
+  seed?: number;
+  /** Also compute distances signed by the closest triangle's normal. */
+  signed?: boolean;
+  /** Histogram bins (default 50). */
+  histogram_bins?: number;
+  /** The crop, applied in the ground-truth frame after the transform. */
+  crop?: Crop;
+  /** Alignment: default `given` with a transform, else `auto`. */
+  align?: 'auto' | 'cameras' | 'points' | 'global' | 'icp' | 'given' | 'none';
+  /** `gt_from_recon`: a row-major 4×4, 16 numbers, or the text of a transform file. */
+  transform?: number[][] | number[] | string;
+  /** Point pairs for `align: 'points'`. */
+  pairs?: PointPair[];
+}
+
+/** Progress callback: stage label, units done, units total. */
+export type ProgressCallback = (stage: string, done: number, total: number) => void;
+
+/** The result of {@link evaluate}. */
+export interface EvaluationResult {
+  /** The `sfmeval.report/1` JSON text, byte for byte what `sfmeval eval --report` writes. */
+  readonly reportJson: string;
+  /** The parsed report. */
+  readonly report: any;
+  /** Every reconstructed point in the ground-truth frame, `x0, y0, z0, ...`. */
+  pointsInGt(): Float64Array;
+  /** The same as 32-bit floats (WebGL). */
+  pointsInGtF32(): Float32Array;
+  /** Unsigned distance of every point. */
+  distances(): Float64Array;
+  /** Signed distances when `signed` was set and the ground truth is a mesh. */
+  signedDistances(): Float64Array | undefined;
+  /** Per point: 0 kept, 1 outside the crop volume, 2 farther than `max_distance`. */
+  status(): Uint8Array;
+  /** Distances of the completeness samples to the kept points. */
+  completenessDistances(): Float64Array;
+  /** Viridis heat-map colours `r, g, b` per point, saturating at `clip` (default: accuracy p95). */
+  colors(clip?: number): Uint8Array;
+  /** Binary PLY of the kept points coloured by error, as `sfmeval eval --colored`. */
+  coloredPly(clip?: number): Uint8Array;
+  /** Per-point distances CSV, as `sfmeval eval --csv`. */
+  csv(): string;
+  /** `gt_from_recon`, row-major, 16 numbers. */
+  gtFromRecon(): Float64Array;
+  /** The accuracy 95th percentile (the CLI's default colour clip). */
+  defaultClip(): number;
+  /** Frees the wasm memory of this result. */
+  free(): void;
+}
+
+/** Loads the WebAssembly module (browser: fetched next to this file; Node: read from disk). */
+export function init(input?: RequestInfo | URL | Response | BufferSource | WebAssembly.Module): Promise<void>;
+/** Synchronous initialisation from bytes or a compiled module. */
+export function initSync(module: BufferSource | WebAssembly.Module): void;
+/** The core's version. */
+export function version(): string;
+/** Reads a ground truth (GLB, glTF + buffers, OBJ, PLY mesh or cloud). */
+export function loadGroundTruth(files: Files | RawGroundTruth): RawGroundTruth;
+/** Reads a reconstruction (PLY, or an SfM model's files). */
+export function loadReconstruction(files: Files | RawReconstruction, name?: string): RawReconstruction;
+/** Reads ground-truth cameras. */
+export function loadCameras(files: Files | RawCameras): RawCameras;
+/** Aligns and measures, as `sfmeval eval`. Throws an `Error` with the core's message. */
+export function evaluate(args: {
+  gt: Files | RawGroundTruth;
+  recon: Files | RawReconstruction;
+  gtCameras?: Files | RawCameras;
+  options?: EvalOptions;
+  onProgress?: ProgressCallback;
+}): EvaluationResult;
+/** Parses and validates the text of a crop file. */
+export function parseCrop(text: string): Crop;
+/** Validates a crop and returns its crop-file text. */
+export function cropFile(crop: Crop): string;
+/** Parses a transform file's text into a row-major 4×4. */
+export function parseTransform(text: string): number[][];
+/** Parses a point-pairs file. */
+export function parsePointPairs(text: string): PointPair[];
+
+export const GroundTruth: typeof rawBindings.GroundTruth;
+export type GroundTruth = RawGroundTruth;
+export const Reconstruction: typeof rawBindings.Reconstruction;
+export type Reconstruction = RawReconstruction;
+export const Cameras: typeof rawBindings.Cameras;
+export type Cameras = RawCameras;
+/** The raw wasm-bindgen bindings. */
+export const raw: typeof rawBindings;

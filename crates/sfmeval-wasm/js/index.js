@@ -1,0 +1,161 @@
+// sfmeval: the WebAssembly build of the sfmeval core with a small JS API.
+// Every number comes from the Rust core; this file only moves bytes and names around.
+import initWasm, * as wasm from './sfmeval_wasm.js';
+
+let ready = null;
+
+const isNode = typeof process !== 'undefined' && !!(process.versions && process.versions.node);
+
+/**
+ * Loads the WebAssembly module. Call once (later calls return the same promise).
+ * In browsers the .wasm is fetched next to this file; in Node it is read from disk.
+ * `input` may be a URL, a Response, bytes or a compiled WebAssembly.Module.
+ */
+export function init(input) {
+  if (!ready) {
+    ready = (async () => {
+      let source = input;
+      if (source === undefined && isNode) {
+        const fs = await import('node:fs/promises');
+        source = await fs.readFile(new URL('./sfmeval_wasm_bg.wasm', import.meta.url));
+      }
+      await initWasm(source === undefined ? undefined : { module_or_path: source });
+    })();
+  }
+  return ready;
+}
+
+/** Synchronous initialisation from bytes or a compiled module (e.g. inside a worker). */
+export function initSync(module) {
+  wasm.initSync({ module });
+  ready = Promise.resolve();
+}
+
+/** The core's version (the report's `tool.version`). */
+export function version() {
+  return wasm.version();
+}
+
+function toBytes(v, name) {
+  if (v instanceof Uint8Array) return v;
+  if (v instanceof ArrayBuffer) return new Uint8Array(v);
+  if (ArrayBuffer.isView(v)) return new Uint8Array(v.buffer, v.byteOffset, v.byteLength);
+  if (typeof v === 'string') return new TextEncoder().encode(v);
+  throw new TypeError(`file '${name}' must be a Uint8Array, ArrayBuffer or string`);
+}
+
+function fileMap(files) {
+  const out = {};
+  for (const [name, bytes] of Object.entries(files)) out[name] = toBytes(bytes, name);
+  return out;
+}
+
+const isBuffer = (n) => /\.bin$/i.test(n) && !/^(cameras|images|points3D|frames|rigs)\.bin$/i.test(n.split('/').pop());
+
+/**
+ * Reads a ground truth. `files` maps file names to bytes: one GLB/glTF/OBJ/PLY file, plus the
+ * external buffers of a `.gltf` by their URI.
+ */
+export function loadGroundTruth(files) {
+  if (files instanceof wasm.GroundTruth) return files;
+  const map = fileMap(files);
+  const names = Object.keys(map);
+  const main = names.find((n) => /\.(glb|gltf|ply|obj)$/i.test(n)) ?? names.find((n) => !isBuffer(n)) ?? names[0];
+  if (main === undefined) throw new Error('ground truth: no file given');
+  const external = {};
+  for (const n of names) if (n !== main) external[n] = map[n];
+  return new wasm.GroundTruth(main.split('/').pop(), map[main], external);
+}
+
+/**
+ * Reads a reconstruction. `files` maps (relative) file names to bytes: one PLY, or the files
+ * of an SfM model (COLMAP cameras/images/points3D .bin or .txt, .nvm, Bundler .out + list.txt,
+ * sfm_data.json, cameras.json). `name` is shown in the report (default: the only file's name).
+ */
+export function loadReconstruction(files, name) {
+  if (files instanceof wasm.Reconstruction) return files;
+  const map = fileMap(files);
+  const names = Object.keys(map);
+  if (name === undefined) {
+    name = names.length === 1 ? names[0].split('/').pop() : (names[0] ?? 'reconstruction').split('/')[0];
+  }
+  return new wasm.Reconstruction(name, map);
+}
+
+/** Reads ground-truth cameras (a dataset's cameras.json or any model in the ground-truth frame). */
+export function loadCameras(files) {
+  if (files instanceof wasm.Cameras) return files;
+  return new wasm.Cameras(fileMap(files));
+}
+
+function wrap(e) {
+  const r = {
+    /** The report JSON text, byte for byte what `sfmeval eval --report` writes. */
+    reportJson: e.reportJson(),
+    get report() { return JSON.parse(this.reportJson); },
+    pointsInGt: () => e.pointsInGt(),
+    pointsInGtF32: () => e.pointsInGtF32(),
+    distances: () => e.distances(),
+    signedDistances: () => e.signedDistances(),
+    status: () => e.status(),
+    completenessDistances: () => e.completenessDistances(),
+    colors: (clip = e.defaultClip()) => e.colors(clip),
+    coloredPly: (clip = e.defaultClip()) => e.coloredPly(clip),
+    csv: () => e.csv(),
+    gtFromRecon: () => e.gtFromRecon(),
+    defaultClip: () => e.defaultClip(),
+    free: () => e.free(),
+  };
+  return r;
+}
+
+/**
+ * Aligns and measures a reconstruction against a ground truth, as `sfmeval eval`.
+ * `gt` and `recon` are loaded objects or file maps `{name: bytes}`; `gtCameras` (optional, files
+ * or a loaded `Cameras`, which is consumed) are attached to the ground truth.
+ * `options` uses the report's option names: `tau`, `tau_percent_of_diagonal`, `samples`, `seed`,
+ * `signed`, `histogram_bins`, `crop` (a crop-file object), plus `align` (`auto`, `cameras`,
+ * `points`, `global`, `icp`, `given`, `none`), `transform` (4×4 or transform-file text) and
+ * `pairs` (`[{recon: [x,y,z], gt: [x,y,z]}, ...]`).
+ * `onProgress(stage, done, total)` is called during the long steps.
+ */
+export function evaluate({ gt, recon, gtCameras, options, onProgress } = {}) {
+  if (!gt) throw new TypeError('evaluate: gt is required');
+  if (!recon) throw new TypeError('evaluate: recon is required');
+  const g = loadGroundTruth(gt);
+  const r = loadReconstruction(recon);
+  if (gtCameras) g.setCameras(loadCameras(gtCameras));
+  try {
+    return wrap(wasm.evaluate(g, r, options ?? {}, onProgress));
+  } finally {
+    if (g !== gt) g.free();
+    if (r !== recon) r.free();
+  }
+}
+
+/** Parses and validates the text of a crop file (`sfmeval.crop/1`). */
+export function parseCrop(text) {
+  return wasm.parseCrop(text);
+}
+
+/** Validates a crop object and returns its crop-file text (what `sfmeval eval --crop` reads). */
+export function cropFile(crop) {
+  return wasm.cropFile(crop);
+}
+
+/** Parses a transform (16 numbers as text, or JSON) into a row-major 4×4 array. */
+export function parseTransform(text) {
+  const m = wasm.parseTransform(text);
+  return [0, 1, 2, 3].map((i) => Array.from(m.slice(4 * i, 4 * i + 4)));
+}
+
+/** Parses a point-pairs file. */
+export function parsePointPairs(text) {
+  return wasm.parsePointPairs(text);
+}
+
+export const GroundTruth = wasm.GroundTruth;
+export const Reconstruction = wasm.Reconstruction;
+export const Cameras = wasm.Cameras;
+/** The raw wasm-bindgen bindings. */
+export const raw = wasm;

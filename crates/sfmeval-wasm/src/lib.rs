@@ -1,0 +1,597 @@
+//! # sfmeval-wasm
+//!
+//! Thin wasm-bindgen bindings over the sfmeval core, for the npm package `sfmeval` and the
+//! browser page. Bytes go in (`Uint8Array`), options go in as plain JS objects (deserialised with
+//! serde-wasm-bindgen into the core's own option types), and the `sfmeval.report/1` JSON plus
+//! typed arrays come out. Every number is computed by the core (`crates/sfmeval`) exactly as the
+//! CLI computes it; errors become JS `Error`s carrying the core's message.
+
+use std::collections::BTreeMap;
+use std::sync::atomic::{AtomicU64, Ordering};
+
+use js_sys::{Float32Array, Float64Array, Function, Object, Uint8Array, Uint32Array};
+use serde::Serialize as _;
+use sfmeval::align::{PointPair, parse_point_pairs};
+use sfmeval::colormap::distance_color;
+use sfmeval::crop::Crop;
+use sfmeval::evaluate::{EvalOptions, PreparedGroundTruth};
+use sfmeval::geometry::{Aabb, GroundTruth as CoreGroundTruth};
+use sfmeval::io::{self, LoadedGroundTruth};
+use sfmeval::pipeline::{self, AlignRequest, GroundTruthInfo, ReconInput, RunOptions};
+use sfmeval::progress::{Progress, Stage};
+use sfmeval::transform::Similarity;
+use wasm_bindgen::prelude::*;
+
+/// Installs the panic hook so that a Rust panic shows its message in the console.
+#[wasm_bindgen(start)]
+pub fn start() {
+    console_error_panic_hook::set_once();
+}
+
+/// The version of the sfmeval core (the report's `tool.version`).
+#[wasm_bindgen]
+pub fn version() -> String {
+    sfmeval::report::Tool::default().version
+}
+
+fn js_err(context: &str, e: impl std::fmt::Display) -> JsError {
+    if context.is_empty() {
+        JsError::new(&e.to_string())
+    } else {
+        JsError::new(&format!("{context}: {e}"))
+    }
+}
+
+/// Reads a JS object `{name: Uint8Array, ...}` into named bytes.
+fn files_of(files: &Object) -> Result<BTreeMap<String, Vec<u8>>, JsError> {
+    let mut out = BTreeMap::new();
+    for entry in Object::entries(files).iter() {
+        let pair: js_sys::Array = entry.into();
+        let name = pair
+            .get(0)
+            .as_string()
+            .ok_or_else(|| JsError::new("file names must be strings"))?;
+        let bytes = pair.get(1);
+        if !bytes.is_instance_of::<Uint8Array>() {
+            return Err(JsError::new(&format!("file '{name}' must be a Uint8Array")));
+        }
+        out.insert(name, Uint8Array::from(bytes).to_vec());
+    }
+    Ok(out)
+}
+
+fn points_f64(points: &[[f64; 3]]) -> Float64Array {
+    let flat: Vec<f64> = points.iter().flatten().copied().collect();
+    Float64Array::from(flat.as_slice())
+}
+
+/// A ground truth read from bytes (GLB, glTF with its external buffers, OBJ, PLY mesh or cloud).
+/// Its BVH and completeness samples are prepared on the first evaluation and reused while the
+/// sample count and seed stay the same.
+#[wasm_bindgen]
+pub struct GroundTruth {
+    loaded: LoadedGroundTruth,
+    name: String,
+    prepared: Option<(usize, u64, PreparedGroundTruth)>,
+    cameras: Option<sfmeval::model::Reconstruction>,
+}
+
+#[wasm_bindgen]
+impl GroundTruth {
+    /// Reads `bytes` named `name`; `external` is an optional object `{uri: Uint8Array}` with the
+    /// external buffers of a `.gltf`.
+    #[wasm_bindgen(constructor)]
+    pub fn new(
+        name: &str,
+        bytes: &Uint8Array,
+        external: Option<Object>,
+    ) -> Result<GroundTruth, JsError> {
+        let external = match external {
+            Some(o) => files_of(&o)?,
+            None => BTreeMap::new(),
+        };
+        let loaded = io::read_ground_truth(name, &bytes.to_vec(), &external)
+            .map_err(|e| js_err(&format!("ground truth '{name}'"), e))?;
+        Ok(GroundTruth {
+            loaded,
+            name: name.to_string(),
+            prepared: None,
+            cameras: None,
+        })
+    }
+
+    /// File name given when reading.
+    #[wasm_bindgen(getter)]
+    pub fn name(&self) -> String {
+        self.name.clone()
+    }
+
+    /// Format read (`glb`, `gltf`, `obj`, `ply`).
+    #[wasm_bindgen(getter)]
+    pub fn format(&self) -> String {
+        self.loaded.format.name().to_string()
+    }
+
+    /// Whether the ground truth is a triangle mesh (else a point cloud).
+    #[wasm_bindgen(getter, js_name = isMesh)]
+    pub fn is_mesh(&self) -> bool {
+        matches!(self.loaded.ground_truth, CoreGroundTruth::Mesh(_))
+    }
+
+    /// Vertices (or cloud points), `x0, y0, z0, x1, ...`, in the ground-truth frame.
+    pub fn vertices(&self) -> Float64Array {
+        points_f64(self.loaded.ground_truth.points())
+    }
+
+    /// Triangle vertex indices (empty for a cloud).
+    pub fn triangles(&self) -> Uint32Array {
+        match &self.loaded.ground_truth {
+            CoreGroundTruth::Mesh(m) => {
+                let flat: Vec<u32> = m.triangles.iter().flatten().copied().collect();
+                Uint32Array::from(flat.as_slice())
+            }
+            CoreGroundTruth::Cloud(_) => Uint32Array::new_with_length(0),
+        }
+    }
+
+    /// Bounding box `[xmin, ymin, zmin, xmax, ymax, zmax]`.
+    pub fn bounds(&self) -> Vec<f64> {
+        Aabb::of(self.loaded.ground_truth.points())
+            .map(|b| b.min.iter().chain(&b.max).copied().collect())
+            .unwrap_or_default()
+    }
+
+    /// Notes from reading.
+    #[wasm_bindgen(getter)]
+    pub fn warnings(&self) -> Vec<String> {
+        self.loaded.warnings.clone()
+    }
+
+    /// Attaches the ground-truth cameras used by later evaluations (camera alignment and pose
+    /// metrics). Takes ownership: the `Cameras` object cannot be used afterwards.
+    #[wasm_bindgen(js_name = setCameras)]
+    pub fn set_cameras(&mut self, cameras: Cameras) {
+        self.cameras = Some(cameras.model);
+    }
+
+    /// Removes the attached ground-truth cameras.
+    #[wasm_bindgen(js_name = clearCameras)]
+    pub fn clear_cameras(&mut self) {
+        self.cameras = None;
+    }
+
+    /// Whether ground-truth cameras are attached.
+    #[wasm_bindgen(getter, js_name = hasCameras)]
+    pub fn has_cameras(&self) -> bool {
+        self.cameras.is_some()
+    }
+}
+
+/// A reconstruction read from its files: a PLY cloud, or an SfM model's files (COLMAP
+/// `cameras/images/points3D` `.bin`/`.txt`, `.nvm`, Bundler `.out` + `list.txt`,
+/// `sfm_data.json`, `cameras.json`).
+#[wasm_bindgen]
+pub struct Reconstruction {
+    input: ReconInput,
+}
+
+#[wasm_bindgen]
+impl Reconstruction {
+    /// Reads `files` (`{relativePath: Uint8Array}`); `name` is shown in the report.
+    #[wasm_bindgen(constructor)]
+    pub fn new(name: &str, files: &Object) -> Result<Reconstruction, JsError> {
+        let files = files_of(files)?;
+        let input = pipeline::read_reconstruction(name, &files)
+            .map_err(|e| js_err(&format!("reconstruction '{name}'"), e))?;
+        Ok(Reconstruction { input })
+    }
+
+    /// Name shown in the report.
+    #[wasm_bindgen(getter)]
+    pub fn name(&self) -> String {
+        self.input.name.clone()
+    }
+
+    /// Format read (`ply`, `colmap`, `nvm`, ...).
+    #[wasm_bindgen(getter)]
+    pub fn format(&self) -> String {
+        self.input.format.clone()
+    }
+
+    /// Number of points.
+    #[wasm_bindgen(getter, js_name = pointCount)]
+    pub fn point_count(&self) -> usize {
+        self.input.cloud.points.len()
+    }
+
+    /// Registered images (0 for a bare cloud).
+    #[wasm_bindgen(getter)]
+    pub fn images(&self) -> usize {
+        self.input.model.as_ref().map_or(0, |m| m.images.len())
+    }
+
+    /// Points in the reconstruction's own frame, `x0, y0, z0, x1, ...`.
+    pub fn positions(&self) -> Float64Array {
+        points_f64(&self.input.cloud.points)
+    }
+
+    /// Per-point RGB colours (`r0, g0, b0, ...`), when the file has them.
+    pub fn colors(&self) -> Option<Uint8Array> {
+        self.input.cloud.colors.as_ref().map(|c| {
+            let flat: Vec<u8> = c.iter().flatten().copied().collect();
+            Uint8Array::from(flat.as_slice())
+        })
+    }
+
+    /// Notes from reading.
+    #[wasm_bindgen(getter)]
+    pub fn warnings(&self) -> Vec<String> {
+        self.input.warnings.clone()
+    }
+}
+
+/// Ground-truth cameras (a dataset's `cameras.json`, or any SfM model in the ground-truth
+/// frame), for camera alignment and pose metrics.
+#[wasm_bindgen]
+pub struct Cameras {
+    model: sfmeval::model::Reconstruction,
+}
+
+#[wasm_bindgen]
+impl Cameras {
+    /// Reads `files` (`{name: Uint8Array}`).
+    #[wasm_bindgen(constructor)]
+    pub fn new(files: &Object) -> Result<Cameras, JsError> {
+        let files = files_of(files)?;
+        let model = sfmeval::model::read_model_files(&files)
+            .map_err(|e| js_err("ground-truth cameras", e))?;
+        Ok(Cameras { model })
+    }
+
+    /// Number of images.
+    #[wasm_bindgen(getter)]
+    pub fn images(&self) -> usize {
+        self.model.images.len()
+    }
+}
+
+/// Forwards the core's progress to a JS callback `(stage, done, total)`.
+struct JsProgress {
+    stage: AtomicU64,
+    done: AtomicU64,
+    total: AtomicU64,
+}
+
+const STAGES: [Stage; 6] = [
+    Stage::IndexGroundTruth,
+    Stage::Accuracy,
+    Stage::Sampling,
+    Stage::IndexReconstruction,
+    Stage::Completeness,
+    Stage::Alignment,
+];
+
+thread_local! {
+    static CALLBACK: std::cell::RefCell<Option<Function>> = const { std::cell::RefCell::new(None) };
+}
+
+impl JsProgress {
+    fn new() -> Self {
+        JsProgress {
+            stage: AtomicU64::new(0),
+            done: AtomicU64::new(0),
+            total: AtomicU64::new(0),
+        }
+    }
+
+    fn emit(&self) {
+        let label = STAGES
+            .get(self.stage.load(Ordering::Relaxed) as usize)
+            .map_or("", |s| s.label());
+        let (done, total) = (
+            self.done.load(Ordering::Relaxed),
+            self.total.load(Ordering::Relaxed),
+        );
+        CALLBACK.with(|c| {
+            if let Some(f) = c.borrow().as_ref() {
+                let _ = f.call3(
+                    &JsValue::NULL,
+                    &JsValue::from_str(label),
+                    &JsValue::from_f64(done as f64),
+                    &JsValue::from_f64(total as f64),
+                );
+            }
+        });
+    }
+}
+
+impl Progress for JsProgress {
+    fn start(&self, stage: Stage, total: u64) {
+        let i = STAGES.iter().position(|s| *s == stage).unwrap_or(0);
+        self.stage.store(i as u64, Ordering::Relaxed);
+        self.done.store(0, Ordering::Relaxed);
+        self.total.store(total, Ordering::Relaxed);
+        self.emit();
+    }
+    fn advance(&self, n: u64) {
+        self.done.fetch_add(n, Ordering::Relaxed);
+        self.emit();
+    }
+    fn finish(&self) {
+        self.done
+            .store(self.total.load(Ordering::Relaxed), Ordering::Relaxed);
+        self.emit();
+    }
+}
+
+/// Sets the callback for the duration of one call and removes it afterwards.
+struct CallbackGuard;
+
+impl CallbackGuard {
+    fn set(f: Option<Function>) -> CallbackGuard {
+        CALLBACK.with(|c| *c.borrow_mut() = f);
+        CallbackGuard
+    }
+}
+
+impl Drop for CallbackGuard {
+    fn drop(&mut self) {
+        CALLBACK.with(|c| *c.borrow_mut() = None);
+    }
+}
+
+/// The alignment part of the options, as the CLI's `--align`, `--transform` and `--pairs`.
+#[derive(serde::Deserialize, Default)]
+#[serde(deny_unknown_fields)]
+struct AlignOptions {
+    /// `auto`, `cameras`, `points`, `global`, `icp`, `given` or `none`.
+    align: Option<String>,
+    /// A row-major 4×4 `gt_from_recon`, or the text of a transform file.
+    transform: Option<serde_json::Value>,
+    /// Point pairs for the `points` stage.
+    pairs: Option<Vec<PointPair>>,
+}
+
+/// Splits the JS options object into the core's [`EvalOptions`] and the alignment request.
+fn parse_options(options: JsValue) -> Result<(EvalOptions, AlignOptions), JsError> {
+    if options.is_undefined() || options.is_null() {
+        return Ok((EvalOptions::default(), AlignOptions::default()));
+    }
+    let mut value: serde_json::Value =
+        serde_wasm_bindgen::from_value(options).map_err(|e| js_err("options", e.to_string()))?;
+    let map = value
+        .as_object_mut()
+        .ok_or_else(|| JsError::new("options must be an object"))?;
+    let mut align = serde_json::Map::new();
+    for key in ["align", "transform", "pairs"] {
+        if let Some(v) = map.remove(key).filter(|v| !v.is_null()) {
+            align.insert(key.into(), v);
+        }
+    }
+    let eval: EvalOptions =
+        serde_json::from_value(value).map_err(|e| js_err("options", e.to_string()))?;
+    let align: AlignOptions = serde_json::from_value(serde_json::Value::Object(align))
+        .map_err(|e| js_err("options", e.to_string()))?;
+    Ok((eval, align))
+}
+
+fn parse_transform(v: &serde_json::Value) -> Result<Similarity, JsError> {
+    let text = match v {
+        serde_json::Value::String(s) => s.clone(),
+        other => other.to_string(),
+    };
+    Similarity::parse(text.as_bytes()).map_err(|e| js_err("transform", e))
+}
+
+/// Builds the alignment request exactly as the CLI does from `--align` and `--transform`.
+fn align_request(a: &AlignOptions) -> Result<(AlignRequest, Option<Similarity>), JsError> {
+    let transform = a.transform.as_ref().map(parse_transform).transpose()?;
+    let method = a.align.clone().unwrap_or_else(|| {
+        if transform.is_some() {
+            "given".into()
+        } else {
+            "auto".into()
+        }
+    });
+    let request = match method.as_str() {
+        "none" if transform.is_some() => {
+            return Err(JsError::new(
+                "align 'none' ignores the transform: use align 'given' (the default with a transform)",
+            ));
+        }
+        "none" => AlignRequest::None,
+        "given" => AlignRequest::Given(
+            transform.ok_or_else(|| JsError::new("align 'given' needs a transform"))?,
+        ),
+        "points" if a.pairs.as_ref().is_none_or(|p| p.is_empty()) => {
+            return Err(JsError::new("align 'points' needs point pairs"));
+        }
+        other => AlignRequest::Stages(other.to_string()),
+    };
+    Ok((request, transform))
+}
+
+/// The result of [`evaluate`]: the report and per-point arrays for the viewer and exports.
+#[wasm_bindgen]
+pub struct Evaluation {
+    inner: sfmeval::evaluate::Evaluation,
+}
+
+#[wasm_bindgen]
+impl Evaluation {
+    /// The `sfmeval.report/1` JSON, byte for byte what `sfmeval eval --report` writes.
+    #[wasm_bindgen(js_name = reportJson)]
+    pub fn report_json(&self) -> String {
+        self.inner.report.to_json()
+    }
+
+    /// Every reconstructed point in the ground-truth frame (`x0, y0, z0, ...`), input order.
+    #[wasm_bindgen(js_name = pointsInGt)]
+    pub fn points_in_gt(&self) -> Float64Array {
+        points_f64(&self.inner.points_in_gt)
+    }
+
+    /// The same points as 32-bit floats (for WebGL buffers).
+    #[wasm_bindgen(js_name = pointsInGtF32)]
+    pub fn points_in_gt_f32(&self) -> Float32Array {
+        let flat: Vec<f32> = self
+            .inner
+            .points_in_gt
+            .iter()
+            .flatten()
+            .map(|&v| v as f32)
+            .collect();
+        Float32Array::from(flat.as_slice())
+    }
+
+    /// Unsigned distance of every point to the ground truth.
+    pub fn distances(&self) -> Float64Array {
+        Float64Array::from(self.inner.distances.as_slice())
+    }
+
+    /// Signed distances, when the options asked for them (mesh ground truth).
+    #[wasm_bindgen(js_name = signedDistances)]
+    pub fn signed_distances(&self) -> Option<Float64Array> {
+        self.inner
+            .signed_distances
+            .as_ref()
+            .map(|d| Float64Array::from(d.as_slice()))
+    }
+
+    /// Per-point status: 0 kept, 1 outside the crop volume, 2 farther than the max distance.
+    pub fn status(&self) -> Uint8Array {
+        let s: Vec<u8> = self.inner.status.iter().map(|s| *s as u8).collect();
+        Uint8Array::from(s.as_slice())
+    }
+
+    /// Distances of the completeness samples (inside the crop volume) to the kept points.
+    #[wasm_bindgen(js_name = completenessDistances)]
+    pub fn completeness_distances(&self) -> Float64Array {
+        Float64Array::from(self.inner.completeness_distances.as_slice())
+    }
+
+    /// Heat-map colours (`r0, g0, b0, ...`, viridis) of every point, saturating at `clip`
+    /// (the colours of the coloured PLY).
+    pub fn colors(&self, clip: f64) -> Uint8Array {
+        let flat: Vec<u8> = self
+            .inner
+            .distances
+            .iter()
+            .flat_map(|&d| distance_color(d, clip))
+            .collect();
+        Uint8Array::from(flat.as_slice())
+    }
+
+    /// The kept points coloured by error as binary PLY, as `sfmeval eval --colored`.
+    #[wasm_bindgen(js_name = coloredPly)]
+    pub fn colored_ply(&self, clip: f64) -> Uint8Array {
+        Uint8Array::from(io::write::colored_ply(&self.inner, clip).as_slice())
+    }
+
+    /// Per-point distances as CSV, as `sfmeval eval --csv`.
+    pub fn csv(&self) -> String {
+        io::write::distances_csv(&self.inner)
+    }
+
+    /// The accuracy 95th percentile: the default colour clip of the CLI.
+    #[wasm_bindgen(js_name = defaultClip)]
+    pub fn default_clip(&self) -> f64 {
+        self.inner.report.accuracy.stats.percentiles.p95
+    }
+
+    /// `gt_from_recon`, row-major, 16 numbers.
+    #[wasm_bindgen(js_name = gtFromRecon)]
+    pub fn gt_from_recon(&self) -> Vec<f64> {
+        self.inner
+            .report
+            .alignment
+            .gt_from_recon
+            .iter()
+            .flatten()
+            .copied()
+            .collect()
+    }
+}
+
+/// Aligns and measures `recon` against `gt` (with its cameras when attached), as
+/// `sfmeval eval`. `options` holds the core's
+/// `EvalOptions` fields (`tau`, `tau_percent_of_diagonal`, `samples`, `seed`, `signed`,
+/// `histogram_bins`, `crop`) plus `align`, `transform` and `pairs` (as the CLI's flags).
+/// `progress(stage, done, total)` is called during the long steps.
+#[wasm_bindgen]
+pub fn evaluate(
+    gt: &mut GroundTruth,
+    recon: &Reconstruction,
+    options: JsValue,
+    progress: Option<Function>,
+) -> Result<Evaluation, JsError> {
+    let (eval, align) = parse_options(options)?;
+    eval.validate().map_err(|e| js_err("options", e))?;
+    let (request, icp_start) = align_request(&align)?;
+    let _guard = CallbackGuard::set(progress);
+    let bar = JsProgress::new();
+    let fresh = !matches!(&gt.prepared, Some((n, s, _)) if *n == eval.samples && *s == eval.seed);
+    if fresh {
+        gt.prepared = None;
+        let p = PreparedGroundTruth::new(&gt.loaded.ground_truth, eval.samples, eval.seed, &bar)
+            .map_err(|e| js_err(&format!("ground truth '{}'", gt.name), e))?;
+        gt.prepared = Some((eval.samples, eval.seed, p));
+    }
+    let Some((_, _, prepared)) = gt.prepared.as_ref() else {
+        return Err(JsError::new("ground truth not prepared"));
+    };
+    let info = GroundTruthInfo {
+        name: gt.name.clone(),
+        format: gt.loaded.format.name().into(),
+        warnings: gt.loaded.warnings.clone(),
+    };
+    let run_options = RunOptions {
+        eval,
+        align: request,
+        icp_start,
+        ..RunOptions::default()
+    };
+    let inner = pipeline::run(
+        prepared,
+        &info,
+        &recon.input,
+        gt.cameras.as_ref(),
+        align.pairs.as_deref().unwrap_or(&[]),
+        &run_options,
+        &bar,
+    )
+    .map_err(|e| js_err(&format!("evaluating '{}'", recon.input.name), e))?;
+    Ok(Evaluation { inner })
+}
+
+/// Parses and validates a crop file (`sfmeval.crop/1`) and returns it as a plain object.
+#[wasm_bindgen(js_name = parseCrop)]
+pub fn parse_crop(text: &str) -> Result<JsValue, JsError> {
+    let crop = Crop::parse(text.as_bytes()).map_err(|e| js_err("", e))?;
+    crop.serialize(&serde_wasm_bindgen::Serializer::json_compatible())
+        .map_err(|e| js_err("crop", e.to_string()))
+}
+
+/// Validates a crop object and returns the text of its crop file, as the CLI reads it.
+#[wasm_bindgen(js_name = cropFile)]
+pub fn crop_file(crop: JsValue) -> Result<String, JsError> {
+    let crop: Crop = serde_wasm_bindgen::from_value(crop).map_err(|e| js_err("crop", e))?;
+    crop.validate().map_err(|e| js_err("", e))?;
+    Ok(crop.to_file_json() + "\n")
+}
+
+/// Parses a transform (16 numbers as text, or JSON) into a row-major 4×4 similarity.
+#[wasm_bindgen(js_name = parseTransform)]
+pub fn parse_transform_text(text: &str) -> Result<Vec<f64>, JsError> {
+    let t = Similarity::parse(text.as_bytes()).map_err(|e| js_err("transform", e))?;
+    Ok(t.matrix.iter().flatten().copied().collect())
+}
+
+/// Parses a point-pairs file (`{"pairs": [{"recon": [x,y,z], "gt": [x,y,z]}, ...]}`).
+#[wasm_bindgen(js_name = parsePointPairs)]
+pub fn parse_point_pairs_text(text: &str) -> Result<JsValue, JsError> {
+    let pairs = parse_point_pairs(text.as_bytes()).map_err(|e| js_err("", e))?;
+    pairs
+        .serialize(&serde_wasm_bindgen::Serializer::json_compatible())
+        .map_err(|e| js_err("point pairs", e.to_string()))
+}

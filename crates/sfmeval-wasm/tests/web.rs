@@ -1,0 +1,93 @@
+//! Tests of the bindings, run by wasm-bindgen-test-runner in Node and in headless Chromium.
+#![cfg(target_arch = "wasm32")]
+#![allow(clippy::unwrap_used, clippy::expect_used, missing_docs)]
+
+use js_sys::{Object, Reflect, Uint8Array};
+use sfmeval_wasm::{GroundTruth, Reconstruction, evaluate, parse_crop, parse_transform_text};
+use wasm_bindgen::JsValue;
+use wasm_bindgen_test::*;
+
+const GT: &[u8] = include_bytes!("../../../data/demo/ground_truth.glb");
+const RECON: &[u8] = include_bytes!("../../../data/demo/sparse.ply");
+const TRANSFORM: &str = include_str!("../../../data/demo/gt_from_recon.txt");
+
+fn files(name: &str, bytes: &[u8]) -> Object {
+    let o = Object::new();
+    Reflect::set(&o, &name.into(), &Uint8Array::from(bytes)).unwrap();
+    o
+}
+
+fn options(json: &str) -> JsValue {
+    js_sys::JSON::parse(json).unwrap()
+}
+
+#[wasm_bindgen_test]
+fn evaluates_the_demo_with_its_transform() {
+    let mut gt = GroundTruth::new("ground_truth.glb", &Uint8Array::from(GT), None).unwrap();
+    assert!(gt.is_mesh());
+    assert_eq!(gt.vertices().length() % 3, 0);
+    let recon = Reconstruction::new("sparse.ply", &files("sparse.ply", RECON)).unwrap();
+    assert_eq!(recon.format(), "ply");
+    let opts = Object::new();
+    Reflect::set(&opts, &"transform".into(), &TRANSFORM.into()).unwrap();
+    Reflect::set(&opts, &"samples".into(), &20_000.into()).unwrap();
+    let calls = std::rc::Rc::new(std::cell::Cell::new(0u32));
+    let c = calls.clone();
+    let cb = wasm_bindgen::closure::Closure::<dyn FnMut(String, f64, f64)>::new(
+        move |_: String, _: f64, _: f64| c.set(c.get() + 1),
+    );
+    let e = evaluate(
+        &mut gt,
+        &recon,
+        opts.into(),
+        Some(cb.as_ref().unchecked_ref::<js_sys::Function>().clone()),
+    )
+    .unwrap();
+    let report: serde_json::Value = serde_json::from_str(&e.report_json()).unwrap();
+    assert_eq!(report["schema"], "sfmeval.report/1");
+    assert_eq!(report["alignment"]["method"], "given");
+    assert_eq!(report["options"]["samples"], 20_000);
+    let n = recon.point_count() as u32;
+    assert_eq!(e.distances().length(), n);
+    assert_eq!(e.status().length(), n);
+    assert_eq!(e.colors(0.01).length(), 3 * n);
+    assert!(report["accuracy"]["stats"]["mean"].as_f64().unwrap() > 0.0);
+    assert!(calls.get() > 0, "progress was reported");
+    assert!(e.colored_ply(0.01).to_vec().starts_with(b"ply\n"));
+    assert!(e.csv().starts_with("index,x,y,z,distance"));
+}
+
+use wasm_bindgen::JsCast as _;
+
+#[wasm_bindgen_test]
+fn errors_carry_the_core_message() {
+    let err = GroundTruth::new(
+        "broken.glb",
+        &Uint8Array::from(&b"glTF\x02\0\0\0junk"[..]),
+        None,
+    )
+    .err()
+    .expect("a broken GLB is an error");
+    let v: JsValue = err.into();
+    let msg = Reflect::get(&v, &"message".into())
+        .unwrap()
+        .as_string()
+        .unwrap();
+    assert!(msg.starts_with("ground truth 'broken.glb'"), "{msg}");
+    let err = Reconstruction::new(
+        "x.ply",
+        &files("x.ply", b"ply\nformat ascii 1.0\nelement vertex 5\n"),
+    )
+    .err()
+    .expect("a truncated PLY is an error");
+    let v: JsValue = err.into();
+    assert!(v.is_instance_of::<js_sys::Error>());
+    assert!(parse_crop(r#"{"max_distance": -1}"#).is_err());
+    assert!(parse_crop(r#"{"schema":"sfmeval.crop/1","max_distance": 0.1}"#).is_ok());
+    assert_eq!(parse_transform_text(TRANSFORM).unwrap().len(), 16);
+    let mut gt = GroundTruth::new("ground_truth.glb", &Uint8Array::from(GT), None).unwrap();
+    let recon = Reconstruction::new("sparse.ply", &files("sparse.ply", RECON)).unwrap();
+    assert!(evaluate(&mut gt, &recon, options(r#"{"samples": 0}"#), None).is_err());
+    assert!(evaluate(&mut gt, &recon, options(r#"{"bogus": 1}"#), None).is_err());
+    assert!(evaluate(&mut gt, &recon, options(r#"{"align": "given"}"#), None).is_err());
+}

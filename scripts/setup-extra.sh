@@ -1,0 +1,26 @@
+#!/usr/bin/env bash
+# Extra setup for the browser page and the npm package (called by scripts/setup.sh):
+# Debian's chromium + chromedriver (headless tests), and wasm-bindgen-cli pinned to the
+# wasm-bindgen version in Cargo.lock, cargo-installed into .tools/. Idempotent.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+missing=()
+for p in chromium chromium-driver; do dpkg -s "$p" >/dev/null 2>&1 || missing+=("$p"); done
+if [ ${#missing[@]} -gt 0 ]; then
+  echo "setup-extra: apt-get install ${missing[*]}"
+  export DEBIAN_FRONTEND=noninteractive
+  apt-get update -qq
+  apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
+fi
+rustup target list --installed | grep -q wasm32-unknown-unknown || rustup target add wasm32-unknown-unknown
+want=$(awk '/^name = "wasm-bindgen"$/ {getline; gsub(/version = |"/, ""); print; exit}' Cargo.lock)
+have=$(.tools/bin/wasm-bindgen --version 2>/dev/null | awk '{print $2}' || true)
+if [ "$have" != "$want" ]; then
+  echo "setup-extra: cargo install wasm-bindgen-cli $want into .tools (about 6 minutes)"
+  # Not --locked: the CLI's lock file pins a webpki-roots the registry no longer has.
+  cargo install --quiet --root .tools wasm-bindgen-cli --version "$want"
+fi
+for d in www crates/sfmeval-wasm/js tests/browser; do
+  [ -f "$d/package-lock.json" ] && [ ! -d "$d/node_modules" ] && (cd "$d" && npm ci --no-audit --no-fund --silent)
+done
+echo "setup-extra: chromium $(chromium --version 2>/dev/null | awk '{print $2}'), wasm-bindgen $(.tools/bin/wasm-bindgen --version | awk '{print $2}')"

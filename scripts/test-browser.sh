@@ -1,0 +1,77 @@
+#!/usr/bin/env bash
+# Tests of the browser page and the npm package: builds the wasm once (scripts/build-web.sh),
+# then runs the wasm-bindgen tests (Node and headless Chromium), the packed npm tarball in Node
+# (report byte for byte the CLI's), and the page end to end in Chromium via playwright-core.
+# SFMEVAL_BENCH=1 also runs the speed benchmark (bench/data; not a test).
+# Ends with "N passed, N failed".
+set -uo pipefail
+cd "$(dirname "$0")/.."
+ROOT=$PWD
+export PATH="$ROOT/.tools/bin:$PATH" CARGO_TERM_COLOR=never
+passed=0; failed=0
+log=$(mktemp -d)
+out=$ROOT/target/web/test-output
+mkdir -p "$out"
+
+count() { # file with ok / FAILED lines
+  local p f
+  p=$(grep -c '^ok ' "$1"); f=$(grep -c '^FAILED ' "$1")
+  passed=$((passed + p)); failed=$((failed + f))
+  grep -E '^(FAILED|page:|npm:|bench)' "$1"
+}
+fail() { failed=$((failed + 1)); echo "FAILED $1"; tail -30 "$2"; }
+
+t=$SECONDS
+if ! scripts/build-web.sh >"$log/build.log" 2>&1; then
+  fail "build-web" "$log/build.log"; echo "$passed passed, $failed failed"; exit 1
+fi
+tail -1 "$log/build.log"
+cargo build --release --locked -p sfmeval-cli >"$log/cli.log" 2>&1 || fail "cli build" "$log/cli.log"
+echo "build: $((SECONDS - t)) s"
+(cd tests/browser && [ -d node_modules ] || npm ci --no-audit --no-fund --silent)
+
+# wasm-bindgen-test: one build, run in Node and in headless Chromium.
+t=$SECONDS
+export CARGO_TARGET_WASM32_UNKNOWN_UNKNOWN_RUNNER=wasm-bindgen-test-runner
+for where in node chromium; do
+  if [ $where = chromium ]; then env_extra=(WASM_BINDGEN_USE_BROWSER=1 CHROMEDRIVER=/usr/bin/chromedriver); else env_extra=(); fi
+  env "${env_extra[@]}" cargo test --release --locked --target wasm32-unknown-unknown -p sfmeval-wasm --test web \
+    >"$log/wbt-$where.log" 2>&1
+  rc=$?
+  p=$(grep -Eo 'test result: .* ([0-9]+) passed' "$log/wbt-$where.log" | grep -Eo '[0-9]+ passed' | awk '{s+=$1} END {print s+0}')
+  f=$(grep -Eo '[0-9]+ failed' "$log/wbt-$where.log" | awk '{s+=$1} END {print s+0}')
+  passed=$((passed + p)); failed=$((failed + f))
+  if [ $rc -ne 0 ] && [ "$f" -eq 0 ]; then fail "wasm-bindgen-test ($where)" "$log/wbt-$where.log"; fi
+  echo "wasm-bindgen-test ($where): $p passed, $f failed"
+done
+echo "wasm-bindgen-test: $((SECONDS - t)) s"
+
+# npm tarball in Node
+t=$SECONDS
+./target/release/sfmeval eval --gt data/demo/ground_truth.glb --recon data/demo/sparse \
+  --gt-cameras data/demo/cameras.json --quiet --report "$out/cli-demo.json"
+node tests/browser/npm-test.mjs target/web/sfmeval-*.tgz "$out/cli-demo.json" >"$log/npm.log" 2>&1
+rc=$?
+count "$log/npm.log"
+[ $rc -ne 0 ] && ! grep -q '^FAILED' "$log/npm.log" && fail "npm-test" "$log/npm.log"
+echo "npm: $((SECONDS - t)) s"
+
+# the page in Chromium
+t=$SECONDS
+port=$(python3 -c 'import socket; s=socket.socket(); s.bind(("127.0.0.1", 0)); print(s.getsockname()[1])')
+python3 -m http.server "$port" --bind 127.0.0.1 --directory target/web/site >"$log/http.log" 2>&1 &
+server=$!
+trap 'kill $server 2>/dev/null' EXIT
+for _ in $(seq 50); do curl -sf "http://127.0.0.1:$port/" >/dev/null && break; sleep 0.1; done
+node tests/browser/e2e.mjs --url "http://127.0.0.1:$port/" --cli target/release/sfmeval --out "$out" >"$log/e2e.log" 2>&1
+rc=$?
+count "$log/e2e.log"
+[ $rc -ne 0 ] && ! grep -q '^FAILED' "$log/e2e.log" && fail "e2e" "$log/e2e.log"
+echo "e2e: $((SECONDS - t)) s (screenshots in $out)"
+
+if [ "${SFMEVAL_BENCH:-0}" = 1 ]; then
+  node tests/browser/bench.mjs --url "http://127.0.0.1:$port/" --cli target/release/sfmeval 2>&1 | tee "$log/bench.log"
+fi
+kill $server 2>/dev/null
+echo "$passed passed, $failed failed"
+[ "$failed" -eq 0 ]

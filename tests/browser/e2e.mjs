@@ -1,0 +1,209 @@
+// End-to-end test of the page in Debian's Chromium driven by playwright-core.
+// Usage: node e2e.mjs --url http://127.0.0.1:PORT/ --cli target/release/sfmeval --out DIR
+// Prints one "ok NAME" / "FAILED NAME: why" line per check; exits 1 when one failed.
+import { chromium } from 'playwright-core';
+import { execFileSync } from 'node:child_process';
+import { readFileSync, writeFileSync, mkdirSync } from 'node:fs';
+import { join, resolve } from 'node:path';
+
+const args = Object.fromEntries(process.argv.slice(2).reduce((a, v, i, all) => (v.startsWith('--') ? [...a, [v.slice(2), all[i + 1]]] : a), []));
+const url = args.url;
+const cli = resolve(args.cli);
+const out = resolve(args.out);
+mkdirSync(out, { recursive: true });
+const root = resolve(new URL('../..', import.meta.url).pathname);
+const demo = (f) => join(root, 'data/demo', f);
+const origin = new URL(url).origin;
+
+let failed = 0;
+const check = (name, ok, why = '') => {
+  if (ok) console.log(`ok ${name}`);
+  else { failed++; console.log(`FAILED ${name}: ${why}`); }
+};
+const cliReport = (extra, name) => {
+  const file = join(out, name);
+  execFileSync(cli, ['eval', '--gt', demo('ground_truth.glb'), '--quiet', '--report', file, ...extra]);
+  return readFileSync(file, 'utf8');
+};
+/** The first differing line of two texts, for failure messages. */
+function firstDiff(a, b) {
+  const x = a.split('\n'), y = b.split('\n');
+  const i = x.findIndex((l, k) => l !== y[k]);
+  return i < 0 ? (x.length === y.length ? 'equal' : 'lengths differ') : `line ${i + 1}: ${x[i]?.trim()} vs ${y[i]?.trim()} (${x.filter((l, k) => l !== y[k]).length} lines differ)`;
+}
+/** The CLI summary's number format. */
+function g(v) {
+  if (v === 0) return '0';
+  const a = Math.abs(v);
+  if (a >= 1e-3 && a < 1e5) return v.toFixed(6);
+  return v.toExponential(4).replace('e+', 'e');
+}
+
+const browser = await chromium.launch({
+  executablePath: process.env.CHROMIUM || '/usr/bin/chromium',
+  args: ['--use-angle=swiftshader', '--enable-unsafe-swiftshader', '--no-sandbox', '--disable-dev-shm-usage'],
+});
+const context = await browser.newContext({ acceptDownloads: true, viewport: { width: 1400, height: 900 } });
+const page = await context.newPage();
+const requests = [];
+page.on('request', (r) => requests.push(r.url()));
+context.on('request', (r) => requests.push(r.url()));
+const consoleErrors = [];
+page.on('console', (m) => { if (m.type() === 'error') consoleErrors.push(m.text()); });
+page.on('pageerror', (e) => consoleErrors.push(String(e)));
+
+async function downloadText(buttonSel) {
+  const [dl] = await Promise.all([page.waitForEvent('download'), page.click(buttonSel)]);
+  const p = join(out, dl.suggestedFilename());
+  await dl.saveAs(p);
+  return { path: p, text: readFileSync(p, 'utf8') };
+}
+async function evaluateAndWait() {
+  const before = Number(await page.evaluate(() => document.body.dataset.evaluated || 0));
+  const t0 = Date.now();
+  await page.click('#run');
+  await page.waitForFunction((n) => Number(document.body.dataset.evaluated || 0) > n || document.getElementById('error').textContent,
+    before, { timeout: 600000 });
+  const err = await page.textContent('#error');
+  if (err) throw new Error(`page error: ${err}`);
+  return Date.now() - t0;
+}
+
+try {
+  await page.goto(url);
+  await page.waitForFunction(() => document.body.dataset.ready === '1', null, { timeout: 60000 });
+  check('page-loads-wasm', true);
+
+  // 1. drop the demo files (a COLMAP model folder, the GT mesh, the GT cameras), align auto:
+  //    the report equals the CLI's byte for byte, the DOM shows the CLI's numbers
+  await page.setInputFiles('#file-gt', demo('ground_truth.glb'));
+  await page.waitForFunction(() => /triangles/.test(document.getElementById('info-gt').textContent));
+  await page.setInputFiles('#dir-recon', demo('sparse'));
+  await page.waitForFunction(() => /points/.test(document.getElementById('info-recon').textContent));
+  await page.setInputFiles('#file-cams', demo('cameras.json'));
+  await page.waitForFunction(() => /images/.test(document.getElementById('info-cams').textContent));
+  await page.check('input[name=align][value=auto]');
+  const msModel = await evaluateAndWait();
+  const modelArgs = ['--recon', demo('sparse'), '--gt-cameras', demo('cameras.json')];
+  const expectedModel = cliReport(modelArgs, 'cli-model.json');
+  const pageModel = await downloadText('#dl-report');
+  check('report-model-auto-equals-cli', pageModel.text === expectedModel, `page ${pageModel.path} vs cli-model.json: ${firstDiff(pageModel.text, expectedModel)}`);
+  const rep = JSON.parse(expectedModel);
+  const cell = (row, k) => page.textContent(`#stats tr[data-row=${row}] td[data-k=${k}]`);
+  const dom = {
+    mean: await cell('accuracy', 'mean'), median: await cell('accuracy', 'median'), p90: await cell('accuracy', 'p90'),
+    cmean: await cell('completeness', 'mean'), count: await cell('accuracy', 'count'),
+  };
+  const want = {
+    mean: g(rep.accuracy.mean), median: g(rep.accuracy.median), p90: g(rep.accuracy.percentiles.p90),
+    cmean: g(rep.completeness.mean), count: String(rep.accuracy.count),
+  };
+  check('dom-numbers-equal-cli', JSON.stringify(dom) === JSON.stringify(want), `${JSON.stringify(dom)} vs ${JSON.stringify(want)}`);
+  const thr = await page.$$eval('#thresholds tr', (rows) => rows.slice(1).map((r) => Array.from(r.children).map((c) => c.textContent)));
+  const wantThr = rep.thresholds.map((t) => [g(t.tau), (t.tau_relative_to_diagonal * 100).toFixed(3), t.precision.toFixed(4), t.recall.toFixed(4), t.f_score.toFixed(4)]);
+  check('dom-thresholds-equal-cli', JSON.stringify(thr) === JSON.stringify(wantThr), `${JSON.stringify(thr)} vs ${JSON.stringify(wantThr)}`);
+  const stages = await page.$$eval('#stages tr', (r) => r.length);
+  check('alignment-stages-shown', stages >= 3 && (await page.textContent('#r-align')) === rep.alignment.method, `${stages} rows`);
+  check('camera-metrics-shown', !rep.cameras || /cameras:/.test(await page.textContent('#summary')));
+  const ply = await (async () => { const [dl] = await Promise.all([page.waitForEvent('download'), page.click('#dl-ply')]); const p = join(out, 'page.errors.ply'); await dl.saveAs(p); return readFileSync(p); })();
+  execFileSync(cli, ['eval', '--gt', demo('ground_truth.glb'), ...modelArgs, '--quiet', '--colored', join(out, 'cli.errors.ply'), '--csv', join(out, 'cli.csv')]);
+  check('colored-ply-equals-cli', ply.equals(readFileSync(join(out, 'cli.errors.ply'))));
+  const csv = await downloadText('#dl-csv');
+  check('csv-equals-cli', csv.text === readFileSync(join(out, 'cli.csv'), 'utf8'));
+
+  // 1b. the PLY cloud with a pasted 4x4 (the alignment just found)
+  await page.click('#clear-cams');
+  await page.setInputFiles('#file-recon', demo('sparse.ply'));
+  await page.waitForFunction(() => /sparse\.ply/.test(document.getElementById('info-recon').textContent));
+  const matrixText = rep.alignment.gt_from_recon.map((r) => r.join(' ')).join('\n');
+  writeFileSync(join(out, 'transform.txt'), `${matrixText}\n`);
+  await page.check('input[name=align][value=given]');
+  await page.fill('#transform', matrixText);
+  await evaluateAndWait();
+  const expectedGiven = cliReport(['--recon', demo('sparse.ply'), '--transform', join(out, 'transform.txt')], 'cli-given.json');
+  const pageGiven = await downloadText('#dl-report');
+  check('report-ply-given-equals-cli', pageGiven.text === expectedGiven, `page ${pageGiven.path} vs cli-given.json: ${firstDiff(pageGiven.text, expectedGiven)}`);
+
+  // 2. crop (box through the gizmo's object, plus "discard farther than D") and align auto
+  await page.check('input[name=align][value=auto]');
+  await page.selectOption('#crop-kind', 'box');
+  const keptFull = await page.textContent('#kept');
+  await page.evaluate(() => {
+    const v = window.sfmevalViewer;
+    const o = v.cropObject;
+    o.scale.multiplyScalar(0.6);
+    o.rotation.set(0.2, 0.3, 0.1);
+    o.position.x += v.diag * 0.05;
+    v.onCropChange();
+  });
+  const dmax = (rep.accuracy.percentiles.p95).toPrecision(6);
+  await page.fill('#max-distance', dmax);
+  await page.waitForTimeout(200);
+  const keptLive = await page.textContent('#kept');
+  check('crop-live-count-changes', keptLive !== keptFull, `${keptFull} → ${keptLive}`);
+  const msAuto = await evaluateAndWait();
+  const cropFile = await downloadText('#crop-export');
+  check('crop-file-schema', JSON.parse(cropFile.text).schema === 'sfmeval.crop/1' && JSON.parse(cropFile.text).volume.kind === 'oriented_box', cropFile.text);
+  const expectedAuto = cliReport(['--recon', demo('sparse.ply'), '--align', 'auto', '--crop', cropFile.path], 'cli-auto-crop.json');
+  const pageAuto = await downloadText('#dl-report');
+  check('report-auto-crop-equals-cli', pageAuto.text === expectedAuto, `page ${pageAuto.path} vs cli-auto-crop.json: ${firstDiff(pageAuto.text, expectedAuto)}`);
+  const repAuto = JSON.parse(expectedAuto);
+  check('dom-kept-equals-cli', (await page.textContent('#r-kept')) === String(repAuto.crop.kept));
+  check('live-kept-equals-report', (await page.textContent('#kept')) === `${repAuto.crop.kept} / ${repAuto.inputs.reconstruction.points}`, await page.textContent('#kept'));
+  check('dom-align-method', (await page.textContent('#r-align')) === repAuto.alignment.method);
+  // import the crop file back
+  await page.selectOption('#crop-kind', 'none');
+  await page.setInputFiles('#crop-import', cropFile.path);
+  await page.waitForFunction(() => document.getElementById('crop-kind').value === 'box');
+  const reexport = JSON.parse((await page.evaluate(() => window.sfmeval.cropText())));
+  const orig = JSON.parse(cropFile.text);
+  const close = (a, b) => JSON.stringify(a, (k, v) => (typeof v === 'number' ? Number(v.toPrecision(9)) : v)) === JSON.stringify(b, (k, v) => (typeof v === 'number' ? Number(v.toPrecision(9)) : v));
+  check('crop-import-roundtrip', close(reexport, orig), `${JSON.stringify(reexport)} vs ${cropFile.text}`);
+
+  // 3. the viewer draws something: screenshot, and count non-background pixels of the canvas
+  await page.waitForTimeout(300);
+  await page.screenshot({ path: join(out, 'page.png') });
+  const lit = await page.evaluate(() => {
+    const c = document.querySelector('#viewer canvas');
+    const t = document.createElement('canvas');
+    t.width = c.width; t.height = c.height;
+    const ctx = t.getContext('2d');
+    ctx.drawImage(c, 0, 0);
+    const d = ctx.getImageData(0, 0, t.width, t.height).data;
+    let n = 0;
+    for (let i = 0; i < d.length; i += 4) if (Math.abs(d[i] - 0x1d) + Math.abs(d[i + 1] - 0x21) + Math.abs(d[i + 2] - 0x28) > 30) n++;
+    return { n, total: d.length / 4 };
+  });
+  check('viewer-not-blank', lit.n > lit.total * 0.01, `${lit.n} of ${lit.total} pixels differ from the background`);
+  const plots = await page.$$eval('.uplot canvas', (cs) => cs.length);
+  check('plots-drawn', plots >= 2, `${plots} plot canvases`);
+
+  // 4. "Try the demo" loads the shipped demo and gives the CLI's numbers
+  await page.selectOption('#crop-kind', 'none');
+  await page.fill('#max-distance', '');
+  await page.click('#demo');
+  await page.waitForFunction(() => /^sparse \(/.test(document.getElementById('info-recon').textContent));
+  await page.waitForTimeout(300);
+  await evaluateAndWait();
+  const demoReport = await downloadText('#dl-report');
+  check('demo-button-report-equals-cli', demoReport.text === expectedModel, `vs CLI report of data/demo/sparse with cameras.json: ${firstDiff(demoReport.text, expectedModel)}`);
+
+  // 5. a broken file gives a readable error
+  await page.setInputFiles('#file-gt', { name: 'broken.glb', mimeType: 'model/gltf-binary', buffer: Buffer.from('glTF\x02\0\0\0\x40\0\0\0garbage') });
+  await page.waitForFunction(() => document.getElementById('error').textContent.length > 0);
+  const err = await page.textContent('#error');
+  check('broken-file-error', /ground truth 'broken\.glb'/.test(err) && /GLB|glTF/i.test(err), err);
+  await page.screenshot({ path: join(out, 'page-error.png') });
+
+  writeFileSync(join(out, 'timings.json'), JSON.stringify({ msModel, msAuto }));
+  console.log(`page: demo evaluation ${msModel} ms (COLMAP model, auto), ${msAuto} ms (PLY, auto + crop), wall time incl. UI`);
+} catch (e) {
+  check('e2e-run', false, e.stack || String(e));
+} finally {
+  const foreign = requests.filter((u) => !u.startsWith(origin) && !u.startsWith('data:') && !u.startsWith('blob:'));
+  check('no-request-left-127.0.0.1', foreign.length === 0 && requests.length > 0, foreign.join(', '));
+  const bad = consoleErrors.filter((t) => !/broken\.glb|Failed to load resource/.test(t));
+  check('no-console-errors', bad.length === 0, bad.join(' | '));
+  await browser.close();
+}
+process.exit(failed ? 1 : 0);

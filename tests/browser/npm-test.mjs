@@ -1,0 +1,65 @@
+// Installs the packed npm tarball into a fresh project, evaluates the demo with it in Node and
+// checks the report is byte for byte the CLI's. Usage: node npm-test.mjs TARBALL CLI_REPORT.json
+// Prints one "ok NAME" / "FAILED NAME: why" line per check.
+import { execFileSync } from 'node:child_process';
+import { mkdtempSync, readFileSync, readdirSync, writeFileSync } from 'node:fs';
+import { tmpdir } from 'node:os';
+import { join, resolve } from 'node:path';
+import { pathToFileURL } from 'node:url';
+
+const [tarball, cliReport] = process.argv.slice(2).map((p) => resolve(p));
+const root = resolve(new URL('../..', import.meta.url).pathname);
+const demo = (f) => readFileSync(join(root, 'data/demo', f));
+let failed = 0;
+const check = (name, ok, why = '') => {
+  if (ok) console.log(`ok ${name}`);
+  else { failed++; console.log(`FAILED ${name}: ${why}`); }
+};
+
+const dir = mkdtempSync(join(tmpdir(), 'sfmeval-npm-'));
+writeFileSync(join(dir, 'package.json'), JSON.stringify({ name: 'consumer', private: true, type: 'module' }));
+execFileSync('npm', ['install', '--offline', '--no-audit', '--no-fund', '--silent', tarball], { cwd: dir, stdio: 'inherit' });
+const pkgJson = JSON.parse(readFileSync(join(dir, 'node_modules/sfmeval/package.json'), 'utf8'));
+check('npm-package-metadata', pkgJson.name === 'sfmeval' && pkgJson.version && pkgJson.license && pkgJson.types, JSON.stringify(pkgJson));
+
+// import by package name from inside the consumer project
+writeFileSync(join(dir, 'run.mjs'), `
+import { readFileSync } from 'node:fs';
+export const sfmeval = await import('sfmeval');
+`);
+const { sfmeval } = await import(pathToFileURL(join(dir, 'run.mjs')).href);
+await sfmeval.init();
+check('npm-version', typeof sfmeval.version() === 'string' && sfmeval.version().length > 0);
+
+let progressCalls = 0;
+const t0 = performance.now();
+// the demo as the CLI reads `--recon data/demo/sparse --gt-cameras data/demo/cameras.json`
+const model = {};
+for (const f of readdirSync(join(root, 'data/demo/sparse'))) model[f] = demo(`sparse/${f}`);
+const r = sfmeval.evaluate({
+  gt: { 'ground_truth.glb': demo('ground_truth.glb') },
+  recon: sfmeval.loadReconstruction(model, 'sparse'),
+  gtCameras: { 'cameras.json': demo('cameras.json') },
+  onProgress: () => { progressCalls++; },
+});
+const ms = performance.now() - t0;
+const expected = readFileSync(cliReport, 'utf8');
+check('npm-report-equals-cli', r.reportJson === expected,
+  `report differs from the CLI's (${r.reportJson.length} vs ${expected.length} bytes; ${r.reportJson.split('\n').filter((l, i) => l !== expected.split('\n')[i]).length} lines differ, first: ${r.reportJson.split('\n').find((l, i) => l !== expected.split('\n')[i])?.trim()})`);
+check('npm-progress', progressCalls > 0);
+const n = r.report.inputs.reconstruction.points;
+check('npm-arrays', r.distances().length === n && r.status().length === n && r.colors().length === 3 * n && r.pointsInGt().length === 3 * n);
+check('npm-colored-ply', Buffer.from(r.coloredPly().slice(0, 4)).toString() === 'ply\n');
+check('npm-csv', r.csv().startsWith('index,x,y,z,distance,signed_distance,status\n'));
+r.free();
+
+try {
+  sfmeval.evaluate({ gt: { 'broken.glb': new Uint8Array([103, 108, 84, 70, 2, 0, 0, 0, 1, 2]) }, recon: { 'sparse.ply': demo('sparse.ply') } });
+  check('npm-error', false, 'no error thrown');
+} catch (e) {
+  check('npm-error', e instanceof Error && /ground truth 'broken.glb'/.test(e.message), String(e && e.message));
+}
+const crop = sfmeval.parseCrop('{"schema":"sfmeval.crop/1","volume":{"kind":"sphere","center":[0,0,0],"radius":1}}');
+check('npm-crop-roundtrip', crop.volume.kind === 'sphere' && sfmeval.cropFile(crop).includes('"sfmeval.crop/1"'));
+console.log(`npm: demo evaluated in ${ms.toFixed(0)} ms in Node`);
+process.exit(failed ? 1 : 0);

@@ -1,0 +1,80 @@
+// Plots with uPlot: the accuracy histogram and precision/recall/F against τ.
+import uPlot from 'uplot';
+
+/** The core's viridis anchors (crates/sfmeval/src/colormap.rs), for the colour bar. */
+export const VIRIDIS = [
+  [68, 1, 84], [71, 44, 122], [59, 81, 139], [44, 113, 142], [33, 144, 141],
+  [39, 173, 129], [92, 200, 99], [170, 220, 50], [253, 231, 37],
+];
+
+const plots = new Map();
+function replace(el, plot) {
+  const old = plots.get(el);
+  if (old) old.destroy();
+  plots.set(el, plot);
+}
+const width = (el) => Math.max(260, el.clientWidth || 360);
+
+/** Draws `{edges, counts}` as bars. */
+export function histogramPlot(el, hist) {
+  const centers = hist.counts.map((_, i) => (hist.edges[i] + hist.edges[i + 1]) / 2);
+  const opts = {
+    width: width(el), height: 200,
+    legend: { show: false },
+    scales: { x: { time: false } },
+    axes: [{ label: 'distance' }, { label: 'points' }],
+    series: [{}, { label: 'points', stroke: '#4fc3f7', fill: 'rgba(79,195,247,0.35)', paths: uPlot.paths.bars({ size: [1, Infinity], gap: 1 }), points: { show: false } }],
+  };
+  const plot = new uPlot(opts, [centers, hist.counts], el);
+  replace(el, plot);
+  return plot;
+}
+
+/**
+ * Precision, recall and F against τ from the sorted kept distances and completeness distances
+ * of an evaluation (`r.sortedKept`, `r.sortedComp`, `r.compTotal`, `r.tauMax`). Returns an
+ * object with `mark(tau)` that moves the τ cursor.
+ */
+export function curvesPlot(el, r) {
+  const n = 200;
+  const xs = [], ps = [], rs = [], fs = [];
+  const below = (s, tau, total) => {
+    let lo = 0, hi = s.length;
+    while (lo < hi) { const m = (lo + hi) >> 1; if (s[m] < tau) lo = m + 1; else hi = m; }
+    return total ? lo / total : 0;
+  };
+  for (let i = 0; i <= n; i++) {
+    const tau = (r.tauMax * i) / n;
+    const p = below(r.sortedKept, tau, r.sortedKept.length);
+    const rc = below(r.sortedComp, tau, r.compTotal);
+    xs.push(tau); ps.push(p); rs.push(rc); fs.push(p + rc > 0 ? (2 * p * rc) / (p + rc) : 0);
+  }
+  let marked = null;
+  const opts = {
+    width: width(el), height: 200,
+    scales: { x: { time: false }, y: { range: [0, 1] } },
+    axes: [{ label: 'τ' }, {}],
+    series: [{ label: 'τ' },
+      { label: 'precision', stroke: '#ff7043', width: 2 },
+      { label: 'recall', stroke: '#66bb6a', width: 2 },
+      { label: 'F', stroke: '#ffee58', width: 2 }],
+    hooks: {
+      draw: [(u) => {
+        if (marked == null) return;
+        const x = u.valToPos(marked, 'x', true);
+        const ctx = u.ctx;
+        ctx.save();
+        ctx.strokeStyle = '#ffffff';
+        ctx.setLineDash([4, 4]);
+        ctx.beginPath();
+        ctx.moveTo(x, u.bbox.top);
+        ctx.lineTo(x, u.bbox.top + u.bbox.height);
+        ctx.stroke();
+        ctx.restore();
+      }],
+    },
+  };
+  const plot = new uPlot(opts, [xs, ps, rs, fs], el);
+  replace(el, plot);
+  return { plot, mark(tau) { marked = tau; plot.redraw(false); } };
+}

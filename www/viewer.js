@@ -1,0 +1,227 @@
+// The three.js viewer: ground-truth mesh, reconstruction points, crop box / sphere gizmo,
+// point picking. Everything is drawn in the ground-truth frame, shifted by `offset` so that
+// large coordinates keep their float32 precision on the GPU.
+import * as THREE from 'three';
+import { OrbitControls } from 'three/addons/controls/OrbitControls.js';
+import { TransformControls } from 'three/addons/controls/TransformControls.js';
+
+export class Viewer {
+  constructor(container) {
+    this.container = container;
+    this.renderer = new THREE.WebGLRenderer({ antialias: true, preserveDrawingBuffer: true });
+    this.renderer.setPixelRatio(window.devicePixelRatio || 1);
+    this.renderer.setClearColor(0x1d2128);
+    container.appendChild(this.renderer.domElement);
+    this.scene = new THREE.Scene();
+    this.camera = new THREE.PerspectiveCamera(45, 1, 0.001, 1000);
+    this.camera.position.set(2, 1.5, 3);
+    this.world = new THREE.Group();
+    this.scene.add(this.world);
+    this.scene.add(new THREE.HemisphereLight(0xffffff, 0x445566, 1.2));
+    const sun = new THREE.DirectionalLight(0xffffff, 1.5);
+    sun.position.set(3, 5, 4);
+    this.scene.add(sun);
+    this.orbit = new OrbitControls(this.camera, this.renderer.domElement);
+    this.orbit.enableDamping = false;
+    this.gizmo = new TransformControls(this.camera, this.renderer.domElement);
+    this.gizmo.addEventListener('dragging-changed', (e) => { this.orbit.enabled = !e.value; });
+    this.gizmo.addEventListener('objectChange', () => { if (this.onCropChange) this.onCropChange(); });
+    this.scene.add(this.gizmo.getHelper ? this.gizmo.getHelper() : this.gizmo);
+    this.pointSize = 3;
+    this.gtMesh = null;
+    this.points = null;
+    this.cropObject = null;
+    this.pairMarkers = new THREE.Group();
+    this.world.add(this.pairMarkers);
+    this.diag = 1;
+    this.raycaster = new THREE.Raycaster();
+    new ResizeObserver(() => this.resize()).observe(container);
+    this.resize();
+    const loop = () => {
+      this.renderer.render(this.scene, this.camera);
+      requestAnimationFrame(loop);
+    };
+    requestAnimationFrame(loop);
+    this.renderer.domElement.addEventListener('pointerdown', (e) => { this.down = [e.clientX, e.clientY]; });
+    this.renderer.domElement.addEventListener('pointerup', (e) => {
+      if (!this.down || !this.onPick) return;
+      const moved = Math.hypot(e.clientX - this.down[0], e.clientY - this.down[1]);
+      if (moved < 4) this.pick(e);
+    });
+  }
+
+  resize() {
+    const w = this.container.clientWidth || 300;
+    const h = this.container.clientHeight || 300;
+    this.renderer.setSize(w, h, false);
+    this.camera.aspect = w / h;
+    this.camera.updateProjectionMatrix();
+  }
+
+  /** Sets the ground-truth geometry (Float32Array vertices, Uint32Array triangles). */
+  setGroundTruth(vertices, triangles, bounds) {
+    if (this.gtMesh) { this.world.remove(this.gtMesh); this.gtMesh.geometry.dispose(); }
+    const c = [0, 1, 2].map((k) => (bounds[k] + bounds[k + 3]) / 2);
+    this.offset = c;
+    this.world.position.set(-c[0], -c[1], -c[2]);
+    this.diag = Math.hypot(bounds[3] - bounds[0], bounds[4] - bounds[1], bounds[5] - bounds[2]) || 1;
+    const g = new THREE.BufferGeometry();
+    g.setAttribute('position', new THREE.BufferAttribute(vertices, 3));
+    let obj;
+    if (triangles.length) {
+      g.setIndex(new THREE.BufferAttribute(triangles, 1));
+      g.computeVertexNormals();
+      obj = new THREE.Mesh(g, new THREE.MeshStandardMaterial({
+        color: 0xb8c4d0, roughness: 0.8, metalness: 0.0, side: THREE.DoubleSide,
+        transparent: true, opacity: 0.85,
+      }));
+    } else {
+      obj = new THREE.Points(g, new THREE.PointsMaterial({ color: 0xb8c4d0, size: this.pointSize, sizeAttenuation: false }));
+    }
+    obj.name = 'gt';
+    this.gtMesh = obj;
+    this.world.add(obj);
+    this.fit();
+  }
+
+  fit() {
+    const d = this.diag;
+    this.camera.near = d / 1000;
+    this.camera.far = d * 100;
+    this.camera.position.set(0.9 * d, 0.6 * d, 1.2 * d);
+    this.camera.updateProjectionMatrix();
+    this.orbit.target.set(0, 0, 0);
+    this.orbit.update();
+  }
+
+  /** Sets the points to show (Float32Array, GT frame) with RGB colours (Uint8Array or null). */
+  setPoints(positions, colors) {
+    if (this.points) { this.world.remove(this.points); this.points.geometry.dispose(); }
+    const g = new THREE.BufferGeometry();
+    g.setAttribute('position', new THREE.BufferAttribute(positions, 3));
+    if (colors) g.setAttribute('color', new THREE.BufferAttribute(colors, 3, true));
+    const m = new THREE.PointsMaterial({
+      size: this.pointSize, sizeAttenuation: false, vertexColors: !!colors, color: colors ? 0xffffff : 0xff7043,
+    });
+    this.points = new THREE.Points(g, m);
+    this.points.name = 'recon';
+    this.world.add(this.points);
+  }
+
+  setPointSize(s) {
+    this.pointSize = s;
+    if (this.points) this.points.material.size = s;
+    if (this.gtMesh && this.gtMesh.isPoints) this.gtMesh.material.size = s;
+  }
+
+  setVisible(name, v) {
+    const o = name === 'gt' ? this.gtMesh : this.points;
+    if (o) o.visible = v;
+  }
+
+  /** Shows a crop volume: kind 'box' | 'sphere' | 'none'. */
+  setCropKind(kind) {
+    if (this.cropObject) { this.gizmo.detach(); this.world.remove(this.cropObject); this.cropObject = null; }
+    if (kind === 'none') return;
+    const geo = kind === 'box' ? new THREE.BoxGeometry(2, 2, 2) : new THREE.SphereGeometry(1, 32, 16);
+    const mesh = new THREE.Mesh(geo, new THREE.MeshBasicMaterial({ color: 0x4fc3f7, transparent: true, opacity: 0.12, depthWrite: false }));
+    mesh.add(new THREE.LineSegments(new THREE.EdgesGeometry(kind === 'box' ? geo : new THREE.IcosahedronGeometry(1, 1)),
+      new THREE.LineBasicMaterial({ color: 0x4fc3f7 })));
+    mesh.userData.kind = kind;
+    const c = this.offset ?? [0, 0, 0];
+    mesh.position.set(c[0], c[1], c[2]);
+    const r = this.diag * 0.35;
+    mesh.scale.set(r, r, r);
+    this.cropObject = mesh;
+    this.world.add(mesh);
+    this.gizmo.attach(mesh);
+  }
+
+  setGizmoMode(mode) {
+    this.gizmo.setMode(mode);
+  }
+
+  /** The crop volume as a `sfmeval.crop/1` volume, or undefined. */
+  cropVolume() {
+    const o = this.cropObject;
+    if (!o) return undefined;
+    const p = o.position;
+    if (o.userData.kind === 'sphere') {
+      const s = Math.max(o.scale.x, o.scale.y, o.scale.z);
+      o.scale.set(s, s, s);
+      return { kind: 'sphere', center: [p.x, p.y, p.z], radius: s };
+    }
+    const m = new THREE.Matrix4().makeRotationFromQuaternion(o.quaternion.clone().normalize());
+    const e = m.elements; // column-major
+    const rotation = [[e[0], e[4], e[8]], [e[1], e[5], e[9]], [e[2], e[6], e[10]]];
+    return {
+      kind: 'oriented_box', center: [p.x, p.y, p.z],
+      half_extents: [Math.abs(o.scale.x), Math.abs(o.scale.y), Math.abs(o.scale.z)], rotation,
+    };
+  }
+
+  /** Places the gizmo at a crop volume (from an imported crop file). */
+  setCropVolume(v) {
+    if (!v) { this.setCropKind('none'); return 'none'; }
+    const kind = v.kind === 'sphere' ? 'sphere' : 'box';
+    this.setCropKind(kind);
+    const o = this.cropObject;
+    if (v.kind === 'sphere') {
+      o.position.set(...v.center);
+      o.scale.set(v.radius, v.radius, v.radius);
+    } else if (v.kind === 'box') {
+      o.position.set(...[0, 1, 2].map((k) => (v.min[k] + v.max[k]) / 2));
+      o.scale.set(...[0, 1, 2].map((k) => (v.max[k] - v.min[k]) / 2));
+    } else {
+      o.position.set(...v.center);
+      o.scale.set(...v.half_extents);
+      const r = v.rotation;
+      const m = new THREE.Matrix4().set(r[0][0], r[0][1], r[0][2], 0, r[1][0], r[1][1], r[1][2], 0, r[2][0], r[2][1], r[2][2], 0, 0, 0, 0, 1);
+      o.quaternion.setFromRotationMatrix(m);
+    }
+    return kind;
+  }
+
+  /** Sizes the crop volume to the GT bounds. */
+  fitCrop(bounds) {
+    const o = this.cropObject;
+    if (!o) return;
+    o.quaternion.identity();
+    o.position.set(...[0, 1, 2].map((k) => (bounds[k] + bounds[k + 3]) / 2));
+    if (o.userData.kind === 'sphere') {
+      const r = this.diag / 2;
+      o.scale.set(r, r, r);
+    } else {
+      o.scale.set(...[0, 1, 2].map((k) => Math.max((bounds[k + 3] - bounds[k]) / 2 * 1.05, this.diag * 1e-3)));
+    }
+  }
+
+  /** Marks picked pair points (GT frame positions). */
+  setMarkers(list) {
+    this.pairMarkers.clear();
+    const geo = new THREE.SphereGeometry(this.diag * 0.006, 12, 8);
+    for (const { p, color } of list) {
+      const m = new THREE.Mesh(geo, new THREE.MeshBasicMaterial({ color }));
+      m.position.set(p[0], p[1], p[2]);
+      this.pairMarkers.add(m);
+    }
+  }
+
+  pick(e) {
+    const rect = this.renderer.domElement.getBoundingClientRect();
+    const ndc = new THREE.Vector2(((e.clientX - rect.left) / rect.width) * 2 - 1, -((e.clientY - rect.top) / rect.height) * 2 + 1);
+    this.raycaster.setFromCamera(ndc, this.camera);
+    this.raycaster.params.Points.threshold = this.diag * 0.004;
+    const targets = [this.gtMesh, this.points].filter((o) => o && o.visible);
+    const hits = this.raycaster.intersectObjects(targets, false);
+    if (!hits.length) return;
+    const h = hits[0];
+    const c = this.offset ?? [0, 0, 0];
+    if (h.object === this.points) this.onPick({ kind: 'recon', index: h.index });
+    else this.onPick({ kind: 'gt', point: [h.point.x + c[0], h.point.y + c[1], h.point.z + c[2]] });
+  }
+
+  screenshot() {
+    return this.renderer.domElement.toDataURL('image/png');
+  }
+}
