@@ -133,7 +133,7 @@ pub fn colmap_text(rec: &Reconstruction) -> BTreeMap<&'static str, String> {
     );
     for c in &rec.cameras {
         let params: Vec<String> = if c.params.is_empty() {
-            vec![c.fx, c.fy, c.cx, c.cy]
+            [c.fx, c.fy, c.cx, c.cy]
                 .iter()
                 .map(|v| v.to_string())
                 .collect()

@@ -201,33 +201,31 @@ fn bar_chart(
         let gx = left + group * di as f64 + group * 0.1;
         for (pi, p) in pipes.iter().enumerate() {
             let x = gx + bar * pi as f64;
-            match find(rows, d, p) {
-                Some(r) => match f(r).filter(|v| v.is_finite()) {
-                    Some(v) => {
-                        let bh = plot_h * (v / ymax).clamp(0.0, 1.0);
-                        let _ = write!(
-                            s,
-                            "<rect x=\"{x:.1}\" y=\"{:.1}\" width=\"{:.1}\" height=\"{bh:.1}\" fill=\"{}\"><title>{}: {} = {v}</title></rect>",
-                            top + plot_h - bh,
-                            (bar - 1.0).max(0.5),
-                            color(pi),
-                            esc(d),
-                            esc(p)
-                        );
-                    }
-                    None if r.status != "ok" => {
-                        let _ = write!(
-                            s,
-                            "<text x=\"{:.1}\" y=\"{:.1}\" font-size=\"11\" fill=\"#a00\" text-anchor=\"middle\">×<title>{}: {} {}</title></text>",
-                            x + bar / 2.0,
-                            top + plot_h - 3.0,
-                            esc(d),
-                            esc(p),
-                            esc(&r.status)
-                        );
-                    }
-                    None => {}
-                },
+            let Some(r) = find(rows, d, p) else { continue };
+            match f(r).filter(|v| v.is_finite()) {
+                Some(v) => {
+                    let bh = plot_h * (v / ymax).clamp(0.0, 1.0);
+                    let _ = write!(
+                        s,
+                        "<rect x=\"{x:.1}\" y=\"{:.1}\" width=\"{:.1}\" height=\"{bh:.1}\" fill=\"{}\"><title>{}: {} = {v}</title></rect>",
+                        top + plot_h - bh,
+                        (bar - 1.0).max(0.5),
+                        color(pi),
+                        esc(d),
+                        esc(p)
+                    );
+                }
+                None if r.status != "ok" => {
+                    let _ = write!(
+                        s,
+                        "<text x=\"{:.1}\" y=\"{:.1}\" font-size=\"11\" fill=\"#a00\" text-anchor=\"middle\">×<title>{}: {} {}</title></text>",
+                        x + bar / 2.0,
+                        top + plot_h - 3.0,
+                        esc(d),
+                        esc(p),
+                        esc(&r.status)
+                    );
+                }
                 None => {}
             }
         }

@@ -115,18 +115,19 @@ fn parse_one(spec: &str, customs: &BTreeMap<String, String>) -> Result<PipelineS
             );
         }
     }
-    if let Some(t) = spec.options.get("timeout") {
-        if !t.parse::<f64>().is_ok_and(|t| t > 0.0) {
-            bail!(
-                "pipeline '{}': timeout must be seconds > 0, got '{t}'",
-                spec.name
-            );
-        }
+    if let Some(t) = spec.options.get("timeout")
+        && !t.parse::<f64>().is_ok_and(|t| t > 0.0)
+    {
+        bail!(
+            "pipeline '{}': timeout must be seconds > 0, got '{t}'",
+            spec.name
+        );
     }
-    if let Some(i) = spec.options.get("intrinsics") {
-        if i != "exif" && i != "known" {
-            bail!("pipeline '{}': intrinsics must be exif or known", spec.name);
-        }
+    if let Some(i) = spec.options.get("intrinsics")
+        && i != "exif"
+        && i != "known"
+    {
+        bail!("pipeline '{}': intrinsics must be exif or known", spec.name);
     }
     Ok(spec)
 }

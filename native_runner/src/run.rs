@@ -247,15 +247,12 @@ pub fn run_batch(
             .out
             .join(&datasets[c.dataset].name)
             .join(&pipelines[c.pipeline].name);
-        if opts.resume {
-            if let Ok(r) = read_record(&dest) {
-                let retry =
-                    opts.retry_failed && matches!(r.status, Status::Failed | Status::Timeout);
-                if !retry {
-                    summary.skipped += 1;
-                    continue;
-                }
-            }
+        if opts.resume
+            && let Ok(r) = read_record(&dest)
+            && !(opts.retry_failed && matches!(r.status, Status::Failed | Status::Timeout))
+        {
+            summary.skipped += 1;
+            continue;
         }
         todo.push(c);
     }
@@ -434,23 +431,23 @@ pub fn run_one(
         }
     }
     rec.finished_unix = unix_now();
-    if rec.status == Status::Ok {
-        if let Err(e) = collect(&work, &output, &mut rec) {
-            rec.status = Status::Failed;
-            rec.reason = Some(format!("reading the tool's output: {e:#}"));
-        }
+    if rec.status == Status::Ok
+        && let Err(e) = collect(&work, &output, &mut rec)
+    {
+        rec.status = Status::Failed;
+        rec.reason = Some(format!("reading the tool's output: {e:#}"));
     }
     if let Some(r) = &rec.reason {
         append(&log, &format!("# {}: {r}\n", rec.status.label()));
     }
     let tool_json = work.join("tool.json");
-    if let Ok(bytes) = std::fs::read(&tool_json) {
-        if let Ok(v) = serde_json::from_slice::<serde_json::Value>(&bytes) {
-            if let Some(version) = v.get("version").and_then(|x| x.as_str()) {
-                rec.version = Some(version.to_string());
-            }
-            rec.tool_report = v;
+    if let Ok(bytes) = std::fs::read(&tool_json)
+        && let Ok(v) = serde_json::from_slice::<serde_json::Value>(&bytes)
+    {
+        if let Some(version) = v.get("version").and_then(|x| x.as_str()) {
+            rec.version = Some(version.to_string());
         }
+        rec.tool_report = v;
     }
     if !opts.keep_scratch {
         let _ = std::fs::remove_dir_all(&scratch);
