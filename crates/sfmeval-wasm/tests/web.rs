@@ -7,9 +7,11 @@ use sfmeval_wasm::{GroundTruth, Reconstruction, evaluate, parse_crop, parse_tran
 use wasm_bindgen::JsValue;
 use wasm_bindgen_test::*;
 
-const GT: &[u8] = include_bytes!("../../../data/demo/ground_truth.glb");
-const RECON: &[u8] = include_bytes!("../../../data/demo/sparse.ply");
-const TRANSFORM: &str = include_str!("../../../data/demo/gt_from_recon.txt");
+/// A unit tetrahedron as an ASCII PLY mesh.
+const GT: &[u8] = b"ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\nproperty float z\nelement face 4\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n3 0 2 1\n3 0 1 3\n3 0 3 2\n3 1 2 3\n";
+/// Points near its faces, in a frame scaled by 2 (so `TRANSFORM` maps them back).
+const RECON: &[u8] = b"ply\nformat ascii 1.0\nelement vertex 5\nproperty float x\nproperty float y\nproperty float z\nend_header\n0.4 0.4 0.02\n0.6 0 0.6\n0 0.5 0.5\n0.2 0.2 0.2\n0.7 0.6 0.6\n";
+const TRANSFORM: &str = "0.5 0 0 0\n0 0.5 0 0\n0 0 0.5 0\n0 0 0 1\n";
 
 fn files(name: &str, bytes: &[u8]) -> Object {
     let o = Object::new();
@@ -23,14 +25,15 @@ fn options(json: &str) -> JsValue {
 
 #[wasm_bindgen_test]
 fn evaluates_the_demo_with_its_transform() {
-    let mut gt = GroundTruth::new("ground_truth.glb", &Uint8Array::from(GT), None).unwrap();
+    let mut gt = GroundTruth::new("tetra.ply", &Uint8Array::from(GT), None).unwrap();
     assert!(gt.is_mesh());
     assert_eq!(gt.vertices().length() % 3, 0);
-    let recon = Reconstruction::new("sparse.ply", &files("sparse.ply", RECON)).unwrap();
+    let recon = Reconstruction::new("cloud.ply", &files("cloud.ply", RECON)).unwrap();
     assert_eq!(recon.format(), "ply");
     let opts = Object::new();
     Reflect::set(&opts, &"transform".into(), &TRANSFORM.into()).unwrap();
     Reflect::set(&opts, &"samples".into(), &20_000.into()).unwrap();
+    Reflect::set(&opts, &"crop".into(), &options(r#"{"max_distance": 0.2}"#)).unwrap();
     let calls = std::rc::Rc::new(std::cell::Cell::new(0u32));
     let c = calls.clone();
     let cb = wasm_bindgen::closure::Closure::<dyn FnMut(String, f64, f64)>::new(
@@ -51,7 +54,11 @@ fn evaluates_the_demo_with_its_transform() {
     assert_eq!(e.distances().length(), n);
     assert_eq!(e.status().length(), n);
     assert_eq!(e.colors(0.01).length(), 3 * n);
-    assert!(report["accuracy"]["stats"]["mean"].as_f64().unwrap() > 0.0);
+    assert_eq!(report["inputs"]["ground_truth"]["triangles"], 4);
+    assert_eq!(report["crop"]["kind"], "max_distance");
+    // (0.2, 0.2, 0.2) is in the tetrahedron's interior, 0.1 from the face x=0 after scaling.
+    assert!((e.distances().get_index(3) - 0.1).abs() < 1e-6);
+    assert_eq!(e.gt_from_recon()[0], 0.5);
     assert!(calls.get() > 0, "progress was reported");
     assert!(e.colored_ply(0.01).to_vec().starts_with(b"ply\n"));
     assert!(e.csv().starts_with("index,x,y,z,distance"));
@@ -85,8 +92,8 @@ fn errors_carry_the_core_message() {
     assert!(parse_crop(r#"{"max_distance": -1}"#).is_err());
     assert!(parse_crop(r#"{"schema":"sfmeval.crop/1","max_distance": 0.1}"#).is_ok());
     assert_eq!(parse_transform_text(TRANSFORM).unwrap().len(), 16);
-    let mut gt = GroundTruth::new("ground_truth.glb", &Uint8Array::from(GT), None).unwrap();
-    let recon = Reconstruction::new("sparse.ply", &files("sparse.ply", RECON)).unwrap();
+    let mut gt = GroundTruth::new("tetra.ply", &Uint8Array::from(GT), None).unwrap();
+    let recon = Reconstruction::new("cloud.ply", &files("cloud.ply", RECON)).unwrap();
     assert!(evaluate(&mut gt, &recon, options(r#"{"samples": 0}"#), None).is_err());
     assert!(evaluate(&mut gt, &recon, options(r#"{"bogus": 1}"#), None).is_err());
     assert!(evaluate(&mut gt, &recon, options(r#"{"align": "given"}"#), None).is_err());
