@@ -22,7 +22,6 @@
 //! ```
 
 pub mod align;
-pub mod align;
 pub mod colormap;
 pub mod crop;
 pub mod distance;
