@@ -31,7 +31,7 @@ pub struct Cli {
 #[derive(Subcommand, Debug)]
 enum Command {
     /// Evaluate a reconstruction against a ground truth and write the report.
-    Eval(EvalArgs),
+    Eval(Box<EvalArgs>),
     /// Align a reconstruction to the ground truth and print (or save) gt_from_recon.
     Align {
         #[command(flatten)]
@@ -545,12 +545,12 @@ fn gltf_neighbours(path: &Path, bytes: &[u8]) -> BTreeMap<String, Vec<u8>> {
         .into_iter()
         .flatten()
     {
-        if let Some(uri) = b.get("uri").and_then(|u| u.as_str()) {
-            if !uri.starts_with("data:") && !uri.contains("..") {
-                if let Ok(data) = std::fs::read(dir.join(uri)) {
-                    out.insert(uri.to_string(), data);
-                }
-            }
+        let uri = b.get("uri").and_then(|u| u.as_str());
+        let local = uri.filter(|u| !u.starts_with("data:") && !u.contains(".."));
+        if let Some((uri, data)) =
+            local.and_then(|u| std::fs::read(dir.join(u)).ok().map(|d| (u, d)))
+        {
+            out.insert(uri.to_string(), data);
         }
     }
     out

@@ -38,18 +38,14 @@ impl Progress for Bars {
     }
 
     fn advance(&self, n: u64) {
-        if let Ok(c) = self.current.lock() {
-            if let Some(b) = c.as_ref() {
-                b.inc(n);
-            }
+        if let Some(b) = self.current.lock().ok().as_ref().and_then(|c| c.as_ref()) {
+            b.inc(n);
         }
     }
 
     fn finish(&self) {
-        if let Ok(mut c) = self.current.lock() {
-            if let Some(b) = c.take() {
-                b.finish_and_clear();
-            }
+        if let Some(b) = self.current.lock().ok().and_then(|mut c| c.take()) {
+            b.finish_and_clear();
         }
     }
 }
