@@ -254,6 +254,29 @@ def test_auto_global_on_blender_suzanne(align_tool, tmp_path, seed):
     assert abs(decompose(m)[0] / decompose(truth)[0] - 1) < 0.002
 
 
+def test_same_result_for_any_thread_count(align_tool, blob, tmp_path):
+    """cameras+icp and global+icp give bit-identical transforms with 1 and 2 threads."""
+    d, mesh = blob
+    rng = np.random.default_rng(300)
+    truth = similarity(2.0, random_rotation(rng), [1.0, 2.0, 3.0])
+    write_cloud(tmp_path / "recon.ply", make_recon(mesh, truth, 20000, rng))
+    v = np.asarray(mesh.vertices)
+    a = np.linspace(0, 2 * np.pi, 20, endpoint=False)
+    gt_c = np.stack([4 * np.cos(a), np.sin(2 * a), 4 * np.sin(a)], -1)
+    rec_c = apply(np.linalg.inv(truth), gt_c)
+    (tmp_path / "cams.json").write_text(json.dumps({"pairs": [{"recon": list(x), "gt": list(y)} for x, y in zip(rec_c, gt_c)]}))
+    for extra in [("--cameras", tmp_path / "cams.json"), ()]:
+        outs = []
+        for threads in ["1", "2"]:
+            p = subprocess.run([align_tool, "auto", d / "blob.ply", tmp_path / "recon.ply", *extra], capture_output=True,
+                               text=True, env={**os.environ, "RAYON_NUM_THREADS": threads})
+            assert p.returncode == 0, p.stderr
+            outs.append(json.loads(p.stdout))
+        assert outs[0]["matrix"] == outs[1]["matrix"]
+        assert outs[0]["report"] == outs[1]["report"]
+    assert len(v) > 0
+
+
 def test_bad_input_is_a_clear_error(align_tool, tmp_path):
     f = tmp_path / "pairs.json"
     f.write_text(json.dumps({"pairs": [{"recon": [0, 0, 0], "gt": [1, 1, 1]}, {"recon": [1, 0, 0], "gt": [2, 1, 1]}]}))
@@ -307,6 +330,10 @@ def bench():
     m = np.asarray(res.transformation)
     print(f"open3d scaled ICP (100k points → 1M samples, from the same camera start): {secs:.3f} s "
           f"(+ KD-tree inside), rotation error {rot_err_deg(m, truth):.4f}°, "
+          f"scale error {100 * abs(decompose(m)[0] / 0.37 - 1):.4f} %")
+    out = run_tool(tool, "auto", d / "gt.ply", d / "recon.ply")
+    m = np.array(out["matrix"])
+    print(f"sfmeval global+icp (no cameras): {out['seconds']:.3f} s, rotation error {rot_err_deg(m, truth):.4f}°, "
           f"scale error {100 * abs(decompose(m)[0] / 0.37 - 1):.4f} %")
 
 

@@ -53,14 +53,14 @@ impl Default for GlobalOptions {
     fn default() -> Self {
         GlobalOptions {
             seed: 0,
-            search_points: 400,
+            search_points: 300,
             gt_points: 2_000,
             extra_rotations: 96,
-            search_iterations: 10,
+            search_iterations: 8,
             trim: 0.8,
-            finalists: 4,
-            final_points: 3_000,
-            final_iterations: 40,
+            finalists: 3,
+            final_points: 1_500,
+            final_iterations: 25,
         }
     }
 }

@@ -8,6 +8,12 @@
 //! the subsample, the fine phase on all of it; iteration stops when the transform moves the
 //! subsample's bounding box by less than `tolerance` × the ground-truth diagonal.
 //!
+//! Speed without changing the answer: points farther than twice the gate are skipped until
+//! the transform has moved any point by more than the gate (so none of them can have come
+//! back inside it), and two consecutive, nearly parallel steps are extrapolated (Besl & McKay)
+//! — the extrapolated pose is kept only if it lowers the truncated cost, otherwise the plain
+//! step is restored and extrapolation is off for the rest of the phase.
+//!
 //! Scale-collapse guard (CloudCompare #1034: scaled ICP shrinking an SfM cloud onto a patch of
 //! the template): the scale may change by at most `max_scale_step` per iteration and by at most
 //! `max_scale_drift` from the start; the result is rejected — the stage keeps the start

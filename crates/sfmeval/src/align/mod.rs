@@ -1,7 +1,7 @@
 //! Alignment of a reconstruction into the ground-truth frame by a similarity (rotation,
 //! translation, uniform scale), in stages that can run alone or chained:
 //!
-//! - [`umeyama`]: the closed-form least-squares similarity between matched point sets;
+//! - [`mod@umeyama`]: the closed-form least-squares similarity between matched point sets;
 //! - [`ransac`] (`cameras`): matched camera centres (and orientations when the centres are
 //!   nearly collinear) inside a seeded LO-RANSAC loop;
 //! - [`points`] (`points`): user-given point pairs;
