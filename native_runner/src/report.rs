@@ -406,7 +406,7 @@ fn wide_columns(rows: &[Row]) -> Vec<String> {
     .collect();
     if let Some(r) = rows.iter().find(|r| !r.thresholds.is_empty()) {
         for t in &r.thresholds {
-            let pct = t.tau_relative * 100.0;
+            let pct = (t.tau_relative * 100.0 * 1e6).round() / 1e6;
             cols.push(format!("P@{pct}%"));
             cols.push(format!("R@{pct}%"));
             cols.push(format!("F@{pct}%"));

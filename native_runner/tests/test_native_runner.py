@@ -148,7 +148,7 @@ def test_tables_hold_the_reports_numbers(batch):
         rep = report_of(batch, p)
         assert float(by[p]["median (m)"]) == rep["accuracy"]["median"]
         assert float(by[p]["RMS (m)"]) == rep["accuracy"]["rms"]
-        assert float(by[p]["F@1.0%"]) == rep["thresholds"][1]["f_score"]
+        assert float(by[p]["F@1%"]) == rep["thresholds"][1]["f_score"]
         assert by[p]["registered"] == "%d/36" % rep["cameras"]["registered"]
         assert float(by[p]["centre median (m)"]) == rep["cameras"]["center_error"]["median"]
     assert "exit status 127" in by["bad"]["reason"]
