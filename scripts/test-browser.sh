@@ -30,20 +30,28 @@ cargo build --release --locked -p sfmeval-cli >"$log/cli.log" 2>&1 || fail "cli 
 echo "build: $((SECONDS - t)) s"
 (cd tests/browser && [ -d node_modules ] || npm ci --no-audit --no-fund --silent)
 
-# wasm-bindgen-test: one build, run in Node and in headless Chromium.
+# wasm-bindgen-test: one build (cargo runs it in Node), then the same test module in headless
+# Chromium through the runner directly.
 t=$SECONDS
-export CARGO_TARGET_WASM32_UNKNOWN_UNKNOWN_RUNNER=wasm-bindgen-test-runner
-for where in node chromium; do
-  if [ $where = chromium ]; then env_extra=(WASM_BINDGEN_USE_BROWSER=1 CHROMEDRIVER=/usr/bin/chromedriver); else env_extra=(); fi
-  env "${env_extra[@]}" cargo test --release --locked --target wasm32-unknown-unknown -p sfmeval-wasm --test web \
-    >"$log/wbt-$where.log" 2>&1
-  rc=$?
-  p=$(grep -Eo 'test result: .* ([0-9]+) passed' "$log/wbt-$where.log" | grep -Eo '[0-9]+ passed' | awk '{s+=$1} END {print s+0}')
-  f=$(grep -Eo '[0-9]+ failed' "$log/wbt-$where.log" | awk '{s+=$1} END {print s+0}')
+wbt() { # where, log, command...
+  local where=$1 logf=$2; shift 2
+  "$@" >"$logf" 2>&1
+  local rc=$? p f
+  p=$(grep -Eo 'test result: .* ([0-9]+) passed' "$logf" | grep -Eo '[0-9]+ passed' | awk '{s+=$1} END {print s+0}')
+  f=$(grep -Eo '[0-9]+ failed' "$logf" | awk '{s+=$1} END {print s+0}')
   passed=$((passed + p)); failed=$((failed + f))
-  if [ $rc -ne 0 ] && [ "$f" -eq 0 ]; then fail "wasm-bindgen-test ($where)" "$log/wbt-$where.log"; fi
+  if [ $rc -ne 0 ] && [ "$f" -eq 0 ]; then fail "wasm-bindgen-test ($where)" "$logf"; fi
   echo "wasm-bindgen-test ($where): $p passed, $f failed"
-done
+}
+wbt node "$log/wbt-node.log" env CARGO_TARGET_WASM32_UNKNOWN_UNKNOWN_RUNNER=wasm-bindgen-test-runner \
+  cargo test --release --locked --target wasm32-unknown-unknown -p sfmeval-wasm --test web
+test_wasm=$(ls -t "${CARGO_TARGET_DIR:-$ROOT/target}"/wasm32-unknown-unknown/release/deps/web-*.wasm 2>/dev/null | head -1)
+if [ -n "$test_wasm" ]; then
+  wbt chromium "$log/wbt-chromium.log" env WASM_BINDGEN_USE_BROWSER=1 CHROMEDRIVER=/usr/bin/chromedriver \
+    wasm-bindgen-test-runner "$test_wasm"
+else
+  fail "wasm-bindgen-test (chromium): no test module" "$log/wbt-node.log"
+fi
 echo "wasm-bindgen-test: $((SECONDS - t)) s"
 
 # npm tarball in Node

@@ -25,6 +25,7 @@ worker.onmessage = (ev) => {
   if (!p) return;
   pending.delete(m.id);
   if (m.ok) p.resolve(m); else p.reject(new Error(m.error));
+  if (m.fatal) document.body.dataset.fatal = '1';
 };
 worker.onerror = (e) => { showError(`worker failed: ${e.message || 'unknown error'}`); };
 function call(type, payload = {}, transfer = []) {
@@ -77,7 +78,12 @@ viewer.onCropChange = () => scheduleKept();
 
 // ---- inputs -----------------------------------------------------------------------------
 /** Reads dropped/picked files; a picked folder's files are keyed relative to that folder. */
+const MAX_BYTES = 1.5e9; // wasm32 memory is 4 GB at most; inputs are copied into it
 async function readFiles(fileList) {
+  const total = Array.from(fileList).reduce((n, f) => n + f.size, 0);
+  if (total > MAX_BYTES) {
+    throw new Error(`${(total / 1e9).toFixed(2)} GB is too large for this page (limit ${MAX_BYTES / 1e9} GB: WebAssembly memory is at most 4 GB); use the sfmeval CLI`);
+  }
   const files = {};
   const transfer = [];
   let folder = null;
@@ -162,17 +168,47 @@ for (const [kind, input] of [['recon', 'file-recon'], ['gt', 'file-gt'], ['cams'
   const zone = $(`drop-${kind}`);
   zone.addEventListener('dragover', (e) => { e.preventDefault(); zone.classList.add('over'); });
   zone.addEventListener('dragleave', () => zone.classList.remove('over'));
-  zone.addEventListener('drop', (e) => {
+  zone.addEventListener('drop', async (e) => {
     e.preventDefault();
     zone.classList.remove('over');
-    handleFiles(kind, e.dataTransfer.files);
+    const entries = Array.from(e.dataTransfer.items || []).map((i) => i.webkitGetAsEntry && i.webkitGetAsEntry()).filter(Boolean);
+    if (kind === 'recon' && entries.length === 1 && entries[0].isDirectory) {
+      try { handleFiles(kind, await folderFiles(entries[0])); } catch (err) { showError(err.message); }
+    } else {
+      handleFiles(kind, e.dataTransfer.files);
+    }
   });
 }
+/** The files under a dropped folder, with webkitRelativePath-like names. */
+async function folderFiles(dir) {
+  const out = [];
+  const walk = async (entry, path) => {
+    if (entry.isFile) {
+      const f = await new Promise((res, rej) => entry.file(res, rej));
+      out.push(new File([f], f.name));
+      Object.defineProperty(out[out.length - 1], 'webkitRelativePath', { value: `${path}${f.name}` });
+    } else if (entry.isDirectory) {
+      const reader = entry.createReader();
+      for (;;) {
+        const batch = await new Promise((res, rej) => reader.readEntries(res, rej));
+        if (!batch.length) break;
+        for (const c of batch) await walk(c, `${path}${entry.name}/`.replace(/^\//, ''));
+      }
+    }
+  };
+  const reader = dir.createReader();
+  for (;;) {
+    const batch = await new Promise((res, rej) => reader.readEntries(res, rej));
+    if (!batch.length) break;
+    for (const c of batch) await walk(c, `${dir.name}/`);
+  }
+  return out.filter((f) => /\.(bin|txt|nvm|out|json|ply)$/i.test(f.name));
+}
+
 function handleFiles(kind, files) {
   if (!files || !files.length) return;
-  if (kind === 'gt') loadGt(files);
-  else if (kind === 'recon') loadRecon(files);
-  else loadCams(files);
+  const p = kind === 'gt' ? loadGt(files) : kind === 'recon' ? loadRecon(files) : loadCams(files);
+  p.catch((e) => showError(e.message));
 }
 $('clear-cams').onclick = async () => { await call('clearCameras'); state.camerasName = null; $('info-cams').textContent = '—'; };
 

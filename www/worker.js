@@ -128,6 +128,13 @@ onmessage = async (ev) => {
     if (out && out.reply) postMessage({ id: msg.id, ok: true, ...out.reply }, out.transfer ?? []);
     else postMessage({ id: msg.id, ok: true, ...(out ?? {}) });
   } catch (err) {
-    postMessage({ id: msg.id, ok: false, error: err && err.message ? err.message : String(err) });
+    let error = err && err.message ? err.message : String(err);
+    if (err instanceof WebAssembly.RuntimeError || /memory/i.test(error) && !(err instanceof Error && err.name === 'Error')) {
+      // A trap (usually out of memory: wasm32 has at most 4 GB) leaves the module unusable.
+      error = `the WebAssembly core stopped (${error}): the input is probably too large for a browser tab; reload the page, or use the sfmeval CLI for this size`;
+      postMessage({ id: msg.id, ok: false, error, fatal: true });
+      return;
+    }
+    postMessage({ id: msg.id, ok: false, error });
   }
 };

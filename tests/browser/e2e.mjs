@@ -124,6 +124,26 @@ try {
   const pageGiven = await downloadText('#dl-report');
   check('report-ply-given-equals-cli', pageGiven.text === expectedGiven, `page ${pageGiven.path} vs cli-given.json: ${firstDiff(pageGiven.text, expectedGiven)}`);
 
+  // 1c. point pairs (as if clicked): recon points and where the found alignment puts them
+  const pairs = await page.evaluate((m) => {
+    const st = window.sfmeval.state;
+    const p = st.recon.positions;
+    const out = [];
+    for (const i of [0, 400, 900, 1500, 2100]) {
+      const x = [p[3 * i], p[3 * i + 1], p[3 * i + 2]];
+      const y = [0, 1, 2].map((r) => m[r][0] * x[0] + m[r][1] * x[1] + m[r][2] * x[2] + m[r][3]);
+      out.push({ recon: x, gt: y });
+    }
+    st.pairs = out;
+    return out;
+  }, rep.alignment.gt_from_recon);
+  writeFileSync(join(out, 'pairs.json'), JSON.stringify({ pairs }));
+  await page.check('input[name=align][value=points]');
+  await evaluateAndWait();
+  const expectedPoints = cliReport(['--recon', demo('sparse.ply'), '--align', 'points', '--pairs', join(out, 'pairs.json')], 'cli-points.json');
+  const pagePoints = await downloadText('#dl-report');
+  check('report-point-pairs-equals-cli', pagePoints.text === expectedPoints, `page ${pagePoints.path} vs cli-points.json: ${firstDiff(pagePoints.text, expectedPoints)}`);
+
   // 2. crop (box through the gizmo's object, plus "discard farther than D") and align auto
   await page.check('input[name=align][value=auto]');
   await page.selectOption('#crop-kind', 'box');
