@@ -96,7 +96,7 @@ def main():
             n = {"10k": 10_000, "100k": 100_000, "1m": 1_000_000}.get(size, 0)
             rep = Path(tmp) / "r.json"
             ours = median_run([args.sfmeval, "eval", "--gt", str(mesh), "--recon", str(cloud), "--samples", str(args.samples),
-                               "--threads", str(args.threads), "--quiet", "--report", str(rep)], args.rounds)
+                               "--threads", str(args.threads), "--align", "none", "--quiet", "--report", str(rep)], args.rounds)
             report = json.loads(rep.read_text())
             o3d = median_run([py, "-c", OPEN3D, str(mesh), str(cloud), str(args.samples), str(args.threads)], args.rounds)
             anchors = {"Open3D": o3d}
