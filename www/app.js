@@ -109,6 +109,7 @@ async function loadGt(fileList) {
   try {
     const gt = await call('loadGt', { files }, transfer);
     state.gt = gt;
+    state.beside = null;
     state.result = null;
     viewer.setGroundTruth(gt.vertices, gt.triangles, gt.bounds);
     $('info-gt').textContent = `${gt.name} (${gt.format}): ${gt.vertexCount} vertices, ${gt.triangleCount} triangles`;
@@ -132,6 +133,7 @@ async function loadRecon(fileList, name) {
   try {
     const r = await call('loadRecon', { files, name }, transfer);
     state.recon = r;
+    state.beside = null;
     state.result = null;
     state.pairs = [];
     updatePairs();
@@ -248,12 +250,22 @@ $('file-transform').addEventListener('change', async (e) => {
 });
 $('transform').addEventListener('input', () => refreshPoints());
 for (const r of document.querySelectorAll('input[name=align], input[name=view]')) r.addEventListener('change', () => refreshPoints());
+for (const r of document.querySelectorAll('input[name=view]')) r.addEventListener('change', () => viewer.fit(viewMode() === 'before'));
 
 /** A display-only similarity placing the raw reconstruction beside the ground truth. */
 function besideTransform() {
+  if (state.beside) return state.beside;
+  // robust extent (2nd–98th percentile per axis): SfM clouds have far outliers
   const p = state.recon.positions;
-  const lo = [Infinity, Infinity, Infinity], hi = [-Infinity, -Infinity, -Infinity];
-  for (let i = 0; i < p.length; i += 3) for (let k = 0; k < 3; k++) { lo[k] = Math.min(lo[k], p[i + k]); hi[k] = Math.max(hi[k], p[i + k]); }
+  const n = p.length / 3, step = Math.max(1, Math.floor(n / 20000));
+  const lo = [], hi = [];
+  for (let k = 0; k < 3; k++) {
+    const v = [];
+    for (let i = 0; i < n; i += step) v.push(p[3 * i + k]);
+    v.sort((a, b) => a - b);
+    lo.push(v[Math.floor(0.02 * (v.length - 1))] ?? 0);
+    hi.push(v[Math.ceil(0.98 * (v.length - 1))] ?? 1);
+  }
   const d = Math.hypot(hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]) || 1;
   const b = state.gt ? state.gt.bounds : [0, 0, 0, 1, 1, 1];
   const gd = Math.hypot(b[3] - b[0], b[4] - b[1], b[5] - b[2]) || 1;
@@ -261,7 +273,8 @@ function besideTransform() {
   const gc = [0, 1, 2].map((k) => (b[k] + b[k + 3]) / 2);
   gc[0] += gd * 0.9;
   const rc = [0, 1, 2].map((k) => (lo[k] + hi[k]) / 2);
-  return (x, y, z) => [gc[0] + s * (x - rc[0]), gc[1] + s * (y - rc[1]), gc[2] + s * (z - rc[2])];
+  state.beside = (x, y, z) => [gc[0] + s * (x - rc[0]), gc[1] + s * (y - rc[1]), gc[2] + s * (z - rc[2])];
+  return state.beside;
 }
 
 function parseMatrixLoose(text) {
@@ -331,6 +344,7 @@ $('pick').onclick = () => {
   viewer.onPick = state.picking ? onPick : null;
   updatePairs();
   refreshPoints();
+  viewer.fit(state.picking || viewMode() === 'before');
 };
 $('clear-pairs').onclick = () => { state.pairs = []; updatePairs(); drawMarkers(); };
 function onPick(hit) {

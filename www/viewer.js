@@ -11,6 +11,7 @@ export class Viewer {
     this.renderer = new THREE.WebGLRenderer({ antialias: true, preserveDrawingBuffer: true });
     this.renderer.setPixelRatio(window.devicePixelRatio || 1);
     this.renderer.setClearColor(0x1d2128);
+    this.renderer.domElement.id = 'view3d';
     container.appendChild(this.renderer.domElement);
     this.scene = new THREE.Scene();
     this.camera = new THREE.PerspectiveCamera(45, 1, 0.001, 1000);
@@ -84,13 +85,16 @@ export class Viewer {
     this.fit();
   }
 
-  fit() {
+  /** Frames the ground truth; `wide` also frames the space beside it (the "before" view). */
+  fit(wide = false) {
     const d = this.diag;
+    const cx = wide ? 0.45 * d : 0;
+    const k = wide ? 1.6 : 1;
     this.camera.near = d / 1000;
     this.camera.far = d * 100;
-    this.camera.position.set(0.9 * d, 0.6 * d, 1.2 * d);
+    this.camera.position.set(cx + 0.9 * d * k, 0.6 * d * k, 1.2 * d * k);
     this.camera.updateProjectionMatrix();
-    this.orbit.target.set(0, 0, 0);
+    this.orbit.target.set(cx, 0, 0);
     this.orbit.update();
   }
 

@@ -184,7 +184,7 @@ try {
   await page.waitForTimeout(300);
   await page.screenshot({ path: join(out, 'page.png') });
   const lit = await page.evaluate(() => {
-    const c = document.querySelector('#viewer canvas');
+    const c = document.getElementById('view3d');
     const t = document.createElement('canvas');
     t.width = c.width; t.height = c.height;
     const ctx = t.getContext('2d');
