@@ -545,6 +545,15 @@ function updateTau() {
   if (state.curves) state.curves.mark(tau);
 }
 $('tau-slider').addEventListener('input', updateTau);
+$('tau-add').onclick = () => {
+  const r = state.result;
+  if (!r) return;
+  const tau = r.tauMax * Number($('tau-slider').value) / 1000;
+  if (!(tau > 0)) return;
+  $('tau').value = [...numList($('tau').value), Number(tau.toPrecision(6))].join(',');
+  // keep the relative defaults when only absolute thresholds would remain
+  if (!$('tau-rel').value.trim()) $('tau-rel').value = '0.5,1,2';
+};
 
 // colours
 function drawColorbar(clip) {
