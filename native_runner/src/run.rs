@@ -423,6 +423,8 @@ pub fn run_one(
                 work: work.clone(),
                 output: output.clone(),
                 scratch: scratch.clone(),
+                output_rel: "output".into(),
+                scratch_rel: "scratch".into(),
                 intrinsics,
                 options: &spec.options,
                 seed: opts.seed,

@@ -58,7 +58,7 @@ impl Adapter for Colmap {
     }
     fn steps(&self, env: &Env, job: &Job) -> Result<Vec<Step>> {
         let o = job.options;
-        let db = path_str(&job.scratch.join("database.db"));
+        let db = format!("{}/database.db", job.scratch_rel);
         let images = path_str(&job.dataset.images);
         let sparse = job.scratch.join("sparse");
         std::fs::create_dir_all(&sparse)
@@ -119,7 +119,7 @@ impl Adapter for Colmap {
             "--image_path",
             &images,
             "--output_path",
-            &path_str(&sparse),
+            &format!("{}/sparse", job.scratch_rel),
             "--random_seed",
             &job.seed.to_string(),
             "--Mapper.num_threads",
@@ -166,9 +166,15 @@ impl Adapter for Colmap {
                 env.colmap.clone(),
                 "model_converter".into(),
                 "--input_path".into(),
-                path_str(&dir),
+                format!(
+                    "{}/sparse/{}",
+                    job.scratch_rel,
+                    dir.file_name()
+                        .map(|n| n.to_string_lossy().to_string())
+                        .unwrap_or_default()
+                ),
                 "--output_path".into(),
-                path_str(&job.output),
+                job.output_rel.clone(),
                 "--output_type".into(),
                 "TXT".into(),
             ],

@@ -122,6 +122,11 @@ pub struct Job<'a> {
     pub work: PathBuf,
     /// Where the tool must leave its final model (COLMAP text/binary, NVM, Bundler or PLY).
     pub output: PathBuf,
+    /// `output` relative to `work` (the commands run in `work`, so run.json's commands stay
+    /// valid inside the finished run folder).
+    pub output_rel: String,
+    /// `scratch` relative to `work`.
+    pub scratch_rel: String,
     /// Scratch space deleted after the run (databases, features).
     pub scratch: PathBuf,
     /// Intrinsics source.
@@ -153,7 +158,7 @@ impl Job<'_> {
             "--images".into(),
             path_str(&self.dataset.images),
             "--out".into(),
-            path_str(&self.output),
+            self.output_rel.clone(),
             "--mode".into(),
             mode.into(),
             "--seed".into(),

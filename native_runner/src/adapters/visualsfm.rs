@@ -43,7 +43,7 @@ impl Adapter for VisualSfm {
             env.visualsfm.clone(),
             mode,
             path_str(&job.dataset.images),
-            path_str(&job.output.join("result.nvm")),
+            format!("{}/result.nvm", job.output_rel),
         ];
         Ok(vec![Step::new("VisualSFM", argv, &job.work)])
     }
