@@ -243,7 +243,7 @@ fn bar_chart(
 
 fn cdf_chart(dataset: &str, rows: &[Row], pipes: &[String]) -> String {
     let (w, hgt, left, bottom, top) = (460.0, 260.0, 50.0, 40.0, 28.0);
-    let plot_w = w - left - 10.0;
+    let plot_w = w - left - 30.0;
     let plot_h = hgt - bottom - top;
     let series: Vec<(usize, &Row)> = pipes
         .iter()

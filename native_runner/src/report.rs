@@ -166,10 +166,11 @@ pub fn report(args: &ReportArgs) -> Result<Vec<Row>> {
                         ));
                     }
                     Some(g) => match evaluate_run(g, dir, rec, args) {
-                        Ok(report) => {
+                        Ok((report, cdf)) => {
                             let rel = format!("reports/{}/{}.json", rec.dataset, rec.pipeline);
                             write_atomic(&args.out.join(&rel), report.to_json().as_bytes())?;
                             fill_row(&mut row, &report);
+                            row.cdf = cdf;
                             row.report = Some(rel);
                         }
                         Err(e) => {
@@ -228,7 +229,32 @@ fn load_gt(dir: &Path, eval: &EvalOptions) -> Result<Gt> {
     })
 }
 
-fn evaluate_run(gt: &Gt, dir: &Path, rec: &RunRecord, args: &ReportArgs) -> Result<Report> {
+/// Points of the cumulative distribution of `distances`: 201 quantiles `(distance, share)`.
+fn cdf_points(distances: &[f64]) -> Vec<(f64, f64)> {
+    let mut d: Vec<f64> = distances
+        .iter()
+        .copied()
+        .filter(|x| x.is_finite())
+        .collect();
+    if d.is_empty() {
+        return Vec::new();
+    }
+    d.sort_by(f64::total_cmp);
+    let n = d.len();
+    (0..=200)
+        .map(|k| {
+            let i = ((k as f64 / 200.0) * (n - 1) as f64).round() as usize;
+            (d[i.min(n - 1)], (i + 1) as f64 / n as f64)
+        })
+        .collect()
+}
+
+fn evaluate_run(
+    gt: &Gt,
+    dir: &Path,
+    rec: &RunRecord,
+    args: &ReportArgs,
+) -> Result<(Report, Vec<(f64, f64)>)> {
     let model = dir.join("model");
     let mut files = if model.is_dir() {
         read_model_dir(&model)?
@@ -255,7 +281,15 @@ fn evaluate_run(gt: &Gt, dir: &Path, rec: &RunRecord, args: &ReportArgs) -> Resu
         &options,
         &NoProgress,
     )?;
-    Ok(evaluation.report)
+    let kept: Vec<f64> = evaluation
+        .distances
+        .iter()
+        .zip(&evaluation.status)
+        .filter(|(_, s)| matches!(s, sfmeval::evaluate::PointStatus::Kept))
+        .map(|(d, _)| *d)
+        .collect();
+    let cdf = cdf_points(&kept);
+    Ok((evaluation.report, cdf))
 }
 
 fn base_row(rec: &RunRecord) -> Row {
@@ -314,16 +348,6 @@ fn fill_row(row: &mut Row, r: &Report) {
             row.images_registered = n as usize;
         }
     }
-    let h = &a.histogram;
-    let total: u64 = h.counts.iter().sum();
-    if total > 0 && h.edges.len() == h.counts.len() + 1 {
-        let mut acc = 0u64;
-        row.cdf.push((h.edges[0], 0.0));
-        for (i, c) in h.counts.iter().enumerate() {
-            acc += c;
-            row.cdf.push((h.edges[i + 1], acc as f64 / total as f64));
-        }
-    }
 }
 
 /// Pipelines in table order: built-ins first (their fixed order), then others by name.
@@ -359,7 +383,14 @@ pub fn table1_cell(r: Option<&Row>) -> String {
         None => "—".into(),
         Some(r) => match r.mean {
             Some(m) => format!("{m:.6} ({})", r.points),
-            None => format!("{}: {}", r.status, short(r.reason.as_deref().unwrap_or(""))),
+            None => {
+                let reason = short(r.reason.as_deref().unwrap_or(""));
+                if reason.starts_with(&r.status) {
+                    reason
+                } else {
+                    format!("{}: {reason}", r.status)
+                }
+            }
         },
     }
 }
