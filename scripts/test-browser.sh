@@ -17,7 +17,7 @@ count() { # file with ok / FAILED lines
   local p f
   p=$(grep -c '^ok ' "$1"); f=$(grep -c '^FAILED ' "$1")
   passed=$((passed + p)); failed=$((failed + f))
-  grep -E '^(FAILED|page:|npm:|bench)' "$1"
+  grep -E '^(FAILED|page:|npm:|bench|note:)' "$1"
 }
 fail() { failed=$((failed + 1)); echo "FAILED $1"; tail -30 "$2"; }
 
