@@ -46,7 +46,7 @@ struct Cli {
 enum Command {
     /// Create the Python venv with the pinned SfM tools (requirements/runner.txt).
     Setup(SetupArgs),
-    /// Run pipelines on datasets: OUT/<dataset>/<pipeline>/{sparse.ply,cameras.json,run.json,log.txt,model/}.
+    /// Run pipelines on datasets: writes `OUT/<dataset>/<pipeline>/` (sparse.ply, cameras.json, run.json, log.txt, model/).
     Run(RunArgs),
     /// Join the run folders of several shards into one.
     Merge(MergeArgs),
