@@ -100,7 +100,7 @@ struct InputArgs {
     /// `--align given`, as the start of `--align icp`.
     #[arg(long, value_name = "FILE")]
     transform: Option<PathBuf>,
-    /// Point pairs for `--align points`: {"pairs": [{"recon": [x,y,z], "gt": [x,y,z]}, ...]}.
+    /// Point pairs for `--align points`: `{"pairs": [{"recon": [x,y,z], "gt": [x,y,z]}, ...]}`.
     #[arg(long, value_name = "FILE")]
     pairs: Option<PathBuf>,
 }
