@@ -1,6 +1,7 @@
 // The packed npm tarball in a bundler-free browser page: unpacks it next to a tiny index.html,
 // serves that folder on 127.0.0.1, evaluates the demo in headless Chromium and compares the
 // report with the CLI's. Usage: node npm-browser.mjs TARBALL CLI_REPORT.json WORKDIR
+import { sameReport } from './same-report.mjs';
 import { chromium } from 'playwright-core';
 import { execFileSync, spawn } from 'node:child_process';
 import { cpSync, mkdirSync, readFileSync, readdirSync, rmSync, writeFileSync } from 'node:fs';
@@ -18,7 +19,6 @@ writeFileSync(join(work, 'index.html'), `<!doctype html><meta charset="utf-8"><l
 <pre id="out"></pre>
 <script type="module">
 import { init, evaluate, loadReconstruction } from './node_modules/sfmeval/index.js';
-import { sameReport } from './same-report.mjs';
 const bytes = async (u) => new Uint8Array(await (await fetch(u)).arrayBuffer());
 try {
   await init();

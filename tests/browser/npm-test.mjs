@@ -1,6 +1,7 @@
 // Installs the packed npm tarball into a fresh project, evaluates the demo with it in Node and
 // checks the report is byte for byte the CLI's. Usage: node npm-test.mjs TARBALL CLI_REPORT.json
 // Prints one "ok NAME" / "FAILED NAME: why" line per check.
+import { sameReport } from './same-report.mjs';
 import { execFileSync } from 'node:child_process';
 import { mkdtempSync, readFileSync, readdirSync, writeFileSync } from 'node:fs';
 import { tmpdir } from 'node:os';
@@ -25,7 +26,6 @@ check('npm-package-metadata', pkgJson.name === 'sfmeval' && pkgJson.version && p
 // import by package name from inside the consumer project
 writeFileSync(join(dir, 'run.mjs'), `
 import { readFileSync } from 'node:fs';
-import { sameReport } from './same-report.mjs';
 export const sfmeval = await import('sfmeval');
 `);
 const { sfmeval } = await import(pathToFileURL(join(dir, 'run.mjs')).href);
