@@ -321,14 +321,13 @@ struct Loaded {
     run_options: RunOptions,
 }
 
+/// Reads a `gt_from_recon` file (JSON or 16 numbers), naming it in errors.
+fn read_transform(path: &Path) -> Result<Similarity> {
+    Similarity::parse(&read(path)?).with_context(|| format!("transform file '{}'", path.display()))
+}
+
 fn load(input: &InputArgs, eval: EvalOptions, bars: &Bars) -> Result<Loaded> {
-    let transform = match &input.transform {
-        Some(path) => Some(
-            Similarity::parse(&read(path)?)
-                .with_context(|| format!("transform file '{}'", path.display()))?,
-        ),
-        None => None,
-    };
+    let transform = input.transform.as_deref().map(read_transform).transpose()?;
     let method = input.align.clone().unwrap_or_else(|| {
         if transform.is_some() {
             "given".into()
@@ -505,18 +504,10 @@ fn cameras_cmd(
             recon.display()
         )
     })?;
-    let given = match transform {
-        Some(p) => Some(
-            Similarity::parse(&read(p)?)
-                .with_context(|| format!("transform file '{}'", p.display()))?,
-        ),
-        None => None,
-    };
+    let given = transform.map(read_transform).transpose()?;
     let (_, alignment, cams) = pipeline::cameras_only(&gt, &est, given, &RunOptions::default())?;
     let value = serde_json::json!({"alignment": alignment, "cameras": cams});
     let mut s = serde_json::to_string_pretty(&value)?;
-    let mut shown = value.clone();
-    shown["standalone"] = serde_json::Value::Bool(true);
     s.push('\n');
     if let Some(p) = report {
         write_atomic(p, s.as_bytes())?;
@@ -524,7 +515,7 @@ fn cameras_cmd(
     if json {
         print!("{s}");
     } else {
-        print!("{}", summary::render_cameras(&shown));
+        print!("{}", summary::render_cameras(&value));
     }
     Ok(())
 }

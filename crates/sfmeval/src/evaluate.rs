@@ -296,6 +296,16 @@ impl AlignmentInput {
     }
 }
 
+/// The values of the points the crop kept, in input order.
+fn kept<T: Copy>(values: &[T], status: &[PointStatus]) -> Vec<T> {
+    values
+        .iter()
+        .zip(status)
+        .filter(|(_, s)| **s == PointStatus::Kept)
+        .map(|(v, _)| *v)
+        .collect()
+}
+
 /// Runs the evaluation of `recon` against a prepared ground truth.
 pub fn evaluate(
     gt: &PreparedGroundTruth,
@@ -351,18 +361,8 @@ pub fn evaluate(
         count(PointStatus::OutsideVolume),
         count(PointStatus::TooFar),
     );
-    let kept_distances: Vec<f64> = distances
-        .iter()
-        .zip(&status)
-        .filter(|(_, s)| **s == PointStatus::Kept)
-        .map(|(d, _)| *d)
-        .collect();
-    let kept_points: Vec<Point3> = points_in_gt
-        .iter()
-        .zip(&status)
-        .filter(|(_, s)| **s == PointStatus::Kept)
-        .map(|(p, _)| *p)
-        .collect();
+    let kept_distances = kept(&distances, &status);
+    let kept_points = kept(&points_in_gt, &status);
     if kept_points.is_empty() {
         warnings.push("the crop discarded every reconstructed point".into());
     }
@@ -419,15 +419,9 @@ pub fn evaluate(
         .copied()
         .filter(|d| d.is_finite())
         .collect();
-    let signed_stats = signed_distances.as_ref().map(|s| {
-        let kept: Vec<f64> = s
-            .iter()
-            .zip(&status)
-            .filter(|(_, st)| **st == PointStatus::Kept)
-            .map(|(d, _)| *d)
-            .collect();
-        Statistics::of(&kept, bins)
-    });
+    let signed_stats = signed_distances
+        .as_ref()
+        .map(|s| Statistics::of(&kept(s, &status), bins));
     let report = Report {
         schema: REPORT_SCHEMA.into(),
         tool: Tool::default(),
