@@ -1,7 +1,9 @@
 #!/usr/bin/env bash
 # Tests of the browser page and the npm package: builds the wasm once (scripts/build-web.sh),
 # then runs the wasm-bindgen tests (Node and headless Chromium), the packed npm tarball in Node
-# and in a bundler-free page in Chromium (report byte for byte the CLI's), and the page end to end in Chromium via playwright-core.
+# and in a bundler-free page in Chromium (report byte for byte the CLI's), every alignment path
+# through the npm package in Node against the CLI (byte for byte), and the page end to end in
+# Chromium via playwright-core.
 # SFMEVAL_BENCH=1 also runs the speed benchmark (bench/data; not a test).
 # Ends with "N passed, N failed".
 set -uo pipefail
@@ -62,6 +64,10 @@ node tests/browser/npm-test.mjs target/web/sfmeval-*.tgz "$out/cli-demo.json" >"
 rc=$?
 count "$log/npm.log"
 [ $rc -ne 0 ] && ! grep -q '^FAILED' "$log/npm.log" && fail "npm-test" "$log/npm.log"
+node tests/browser/same-everywhere.mjs target/web/npm target/release/sfmeval "$out" >"$log/same.log" 2>&1
+rc=$?
+count "$log/same.log"
+[ $rc -ne 0 ] && ! grep -q '^FAILED' "$log/same.log" && fail "same-everywhere" "$log/same.log"
 node tests/browser/npm-browser.mjs target/web/sfmeval-*.tgz "$out/cli-demo.json" "$out" >"$log/npm-browser.log" 2>&1
 rc=$?
 count "$log/npm-browser.log"

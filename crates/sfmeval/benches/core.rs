@@ -1,6 +1,9 @@
 //! Inner loops of the core: exact closest point on a mesh through the BVH, k-d tree build and
 //! nearest neighbour, PLY parsing, area-uniform sampling, Umeyama. `cargo bench -p sfmeval`.
 
+// Synthetic inputs only: platform maths is fine here.
+#![allow(clippy::disallowed_methods)]
+
 use std::hint::black_box;
 
 use criterion::{Criterion, criterion_group, criterion_main};

@@ -130,7 +130,7 @@ impl Similarity {
         let det = m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1])
             - m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0])
             + m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0]);
-        det.cbrt()
+        libm::cbrt(det)
     }
 
     /// The rotation R (the 3×3 part divided by the scale).

@@ -175,10 +175,10 @@ fn spread_rotations(n: usize) -> Vec<Matrix3<f64>> {
             let alpha = std::f64::consts::TAU * s / phi;
             let beta = std::f64::consts::TAU * s / psi;
             let q = UnitQuaternion::from_quaternion(Quaternion::new(
-                big_r * beta.cos(),
-                r * alpha.sin(),
-                r * alpha.cos(),
-                big_r * beta.sin(),
+                big_r * libm::cos(beta),
+                r * libm::sin(alpha),
+                r * libm::cos(alpha),
+                big_r * libm::sin(beta),
             ));
             *q.to_rotation_matrix().matrix()
         })

@@ -360,7 +360,7 @@ pub fn refine_icp(
             Some(prev) if !hit_drift && extrapolate_ok => {
                 let (a, b) = (norm7(&step), norm7(&prev));
                 let cos = dot7(&step, &prev) / (a * b);
-                if cos > 20f64.to_radians().cos() && a < b {
+                if cos > libm::cos(20f64.to_radians()) && a < b {
                     let rho = a / b;
                     let lambda = (rho / (1.0 - rho)).min(25.0);
                     let ext = extrapolate(&old, &t, &corners, lambda);
@@ -474,7 +474,7 @@ fn step_params(a: &Similarity, b: &Similarity, corners: &[Point3]) -> [f64; 7] {
     let radius = corners.first().map_or(1.0, |k| (to_v(*k) - c).norm()) * b.scale();
     let dr = super::to_m(&b.rotation()) * super::to_m(&a.rotation()).transpose();
     let w = nalgebra::Rotation3::from_matrix_unchecked(dr).scaled_axis() * radius;
-    let ls = (b.scale() / a.scale()).ln() * radius;
+    let ls = libm::log(b.scale() / a.scale()) * radius;
     let d = cb - ca;
     [w.x, w.y, w.z, ls, d.x, d.y, d.z]
 }
@@ -497,7 +497,7 @@ fn extrapolate(a: &Similarity, b: &Similarity, corners: &[Point3], lambda: f64) 
     let dr = rb * super::to_m(&a.rotation()).transpose();
     let w = nalgebra::Rotation3::from_matrix_unchecked(dr).scaled_axis();
     let r = nalgebra::Rotation3::new(w * lambda).matrix() * rb;
-    let s = b.scale() * (b.scale() / a.scale()).powf(lambda);
+    let s = b.scale() * libm::pow(b.scale() / a.scale(), lambda);
     let target = cb + (cb - ca) * lambda;
     let t = target - s * r * c;
     Similarity::from_parts(s, super::from_m(&r), [t.x, t.y, t.z])

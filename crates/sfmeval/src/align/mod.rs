@@ -94,7 +94,7 @@ pub fn rotation_angle_deg(a: &Rotation, b: &Rotation) -> f64 {
             tr += a[i][k] * b[i][k];
         }
     }
-    ((tr - 1.0) / 2.0).clamp(-1.0, 1.0).acos().to_degrees()
+    libm::acos(((tr - 1.0) / 2.0).clamp(-1.0, 1.0)).to_degrees()
 }
 
 /// The proper rotation closest (Frobenius) to `m`, `None` when `m` is degenerate or not finite.

@@ -111,7 +111,8 @@ pub fn align_points(pairs: &[PointPair]) -> Result<(Similarity, AlignmentStage)>
 }
 
 pub(crate) fn sq_dist(a: Point3, b: Point3) -> f64 {
-    (a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2) + (a[2] - b[2]).powi(2)
+    let d = [a[0] - b[0], a[1] - b[1], a[2] - b[2]];
+    d[0] * d[0] + d[1] * d[1] + d[2] * d[2]
 }
 
 #[cfg(test)]

@@ -1,6 +1,9 @@
 //! Property tests of the alignment stages on meshes built here: a non-symmetric bumpy blob
 //! and an asymmetric "L" of boxes.
 
+// Test data only: platform maths is fine here (reports use libm, see clippy.toml).
+#![allow(clippy::disallowed_methods)]
+
 use nalgebra::{Quaternion, UnitQuaternion};
 use proptest::prelude::*;
 use rand::{Rng as _, SeedableRng as _};

@@ -140,7 +140,9 @@ pub fn umeyama_weighted(
     Ok(out)
 }
 
+// Test data only: platform maths is fine here (reports use libm, see clippy.toml).
 #[cfg(test)]
+#[allow(clippy::disallowed_methods)]
 mod tests {
     use super::*;
     use crate::align::rotation_angle_deg;

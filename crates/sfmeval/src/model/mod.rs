@@ -155,7 +155,7 @@ pub fn rotation_angle_deg(r: &Mat3) -> f64 {
     let cos = ((r[0][0] + r[1][1] + r[2][2]) - 1.0) / 2.0;
     let v = [r[2][1] - r[1][2], r[0][2] - r[2][0], r[1][0] - r[0][1]];
     let sin = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt() / 2.0;
-    sin.atan2(cos).to_degrees()
+    libm::atan2(sin, cos).to_degrees()
 }
 
 /// A camera (intrinsics) of a reconstruction.
@@ -497,8 +497,9 @@ pub fn read_model_files(
     Ok(rec)
 }
 
+// Test data only: platform maths is fine here (reports use libm, see clippy.toml).
 #[cfg(test)]
-#[allow(clippy::unwrap_used, clippy::expect_used)]
+#[allow(clippy::unwrap_used, clippy::expect_used, clippy::disallowed_methods)]
 mod tests {
     use super::*;
 

@@ -167,7 +167,7 @@ pub fn vector_angle_deg(a: Point3, b: Point3) -> f64 {
         (false, false) => 0.0,
         (true, true) => {
             let c = crate::geometry::cross(a, b);
-            norm(c).atan2(crate::geometry::dot(a, b)).to_degrees()
+            libm::atan2(norm(c), crate::geometry::dot(a, b)).to_degrees()
         }
         _ => 180.0,
     }

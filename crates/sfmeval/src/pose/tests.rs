@@ -1,4 +1,5 @@
-#![allow(clippy::unwrap_used, clippy::expect_used)]
+// Test data only: platform maths is fine here (reports use libm, see clippy.toml).
+#![allow(clippy::unwrap_used, clippy::expect_used, clippy::disallowed_methods)]
 
 use super::*;
 use crate::model::cameras_json::read_cameras_json;
