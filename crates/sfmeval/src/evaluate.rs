@@ -332,7 +332,7 @@ pub fn evaluate(
     let points_in_gt: Vec<Point3> = recon.points.iter().map(|&p| t.apply(p)).collect();
 
     progress.start(Stage::Accuracy, points_in_gt.len() as u64);
-    let pairs = parallel::map(&points_in_gt, progress, |&p| gt.distance(p, options.signed));
+    let pairs = parallel::map_points(&points_in_gt, progress, |&p| gt.distance(p, options.signed));
     progress.finish();
     let distances: Vec<f64> = pairs.iter().map(|d| d.0).collect();
     let signed_distances: Option<Vec<f64>> = (options.signed && gt.is_mesh())
@@ -380,7 +380,7 @@ pub fn evaluate(
         let recon_index = CloudIndex::new(&kept_points)?;
         progress.finish();
         progress.start(Stage::Completeness, completeness_points.len() as u64);
-        let d = parallel::map(&completeness_points, progress, |&p| {
+        let d = parallel::map_points(&completeness_points, progress, |&p| {
             recon_index.nearest(p).0
         });
         progress.finish();

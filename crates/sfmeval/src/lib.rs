@@ -37,6 +37,7 @@ pub mod pose;
 pub mod progress;
 pub mod report;
 pub mod sampling;
+pub mod spatial_order;
 pub mod stats;
 pub mod transform;
 

@@ -1,7 +1,9 @@
 //! Order-preserving parallel map: rayon with the `parallel` feature, a plain loop without it.
 //! Results come back in input order, so every later reduction is independent of thread count.
 
+use crate::geometry::Point3;
 use crate::progress::Progress;
+use crate::spatial_order::morton_order;
 
 /// Items per progress tick and per parallel work unit.
 const CHUNK: usize = 8192;
@@ -38,5 +40,50 @@ where
             progress.advance(c.len() as u64);
         }
         out
+    }
+}
+
+/// Maps `f` over 3D points visited in Morton order ([`morton_order`]: neighbours in space are
+/// queried one after the other, which keeps a BVH or k-d tree in cache) and returns the results
+/// in input order, like [`map`]. Worth it for closest-point queries on large inputs.
+pub fn map_points<R, F>(points: &[Point3], progress: &dyn Progress, f: F) -> Vec<R>
+where
+    R: Send + Copy,
+    F: Fn(&Point3) -> R + Sync + Send,
+{
+    let order = morton_order(points);
+    let visited = map(&order, progress, |&i| f(&points[i as usize]));
+    let mut position = vec![0u32; points.len()];
+    for (k, &i) in order.iter().enumerate() {
+        position[i as usize] = k as u32;
+    }
+    position.into_iter().map(|k| visited[k as usize]).collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::progress::NoProgress;
+
+    #[test]
+    fn map_points_returns_results_in_input_order() {
+        // Scrambled points across several chunks, with a NaN among them.
+        let pts: Vec<Point3> = (0..3 * CHUNK as u64 + 17)
+            .map(|i| {
+                let h = i.wrapping_mul(0x9e37_79b9_7f4a_7c15);
+                let f = |s: u32| ((h >> s) & 0xffff) as f64 / 65535.0;
+                if i == 1234 {
+                    [f64::NAN, 0.0, 0.0]
+                } else {
+                    [f(0), f(16), f(32)]
+                }
+            })
+            .collect();
+        let got = map_points(&pts, &NoProgress, |p| (p[0], p[1] + p[2]));
+        let want: Vec<(f64, f64)> = pts.iter().map(|p| (p[0], p[1] + p[2])).collect();
+        assert_eq!(got.len(), want.len());
+        for (g, w) in got.iter().zip(&want) {
+            assert!(g.0.to_bits() == w.0.to_bits() && g.1 == w.1);
+        }
     }
 }

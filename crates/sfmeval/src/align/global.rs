@@ -259,7 +259,7 @@ fn lockstep(
             .iter()
             .flat_map(|c| pts.iter().map(|p| c.t.apply(*p)))
             .collect();
-        let corr = crate::parallel::map(&moved, &NoProgress, |p| gt.closest(*p));
+        let corr = crate::parallel::map_points(&moved, &NoProgress, |p| gt.closest(*p));
         for (k, c) in cands.iter_mut().enumerate() {
             let cs = &corr[k * m..(k + 1) * m];
             let d: Vec<f64> = cs.iter().map(|x| x.1).collect();
@@ -283,7 +283,7 @@ fn lockstep(
         .iter()
         .flat_map(|c| pts.iter().map(|p| c.t.apply(*p)))
         .collect();
-    let corr = crate::parallel::map(&moved, &NoProgress, |p| gt.closest(*p).1);
+    let corr = crate::parallel::map_points(&moved, &NoProgress, |p| gt.closest(*p).1);
     for (k, l) in last.iter_mut().enumerate() {
         *l = corr[k * m..(k + 1) * m].to_vec();
     }

@@ -198,7 +198,7 @@ pub(crate) fn correspondences(
     pts: &[Point3],
 ) -> Vec<(Point3, f64)> {
     let moved: Vec<Point3> = pts.iter().map(|p| t.apply(*p)).collect();
-    crate::parallel::map(&moved, &NoProgress, |p| gt.closest_point(*p))
+    crate::parallel::map_points(&moved, &NoProgress, |p| gt.closest_point(*p))
 }
 
 /// RMS distance of points to their centroid.
