@@ -20,22 +20,40 @@ pub fn sample_surface(mesh: &TriangleMesh, n: usize, seed: u64) -> Result<Vec<Po
             "the ground-truth mesh has zero surface area".into(),
         ));
     }
+    // The stream is drawn in the same order as a per-sample loop would (target, u, v), then
+    // the triangle of each target is found by walking the cumulative areas once in target
+    // order instead of a binary search per sample: 1M binary searches over 1M triangles miss
+    // the cache on nearly every step (~1 s); the sort and the walk take a tenth of that.
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
-    let mut out = Vec::with_capacity(n);
-    for _ in 0..n {
-        let target = rng.random::<f64>() * total;
-        let i = cumulative
-            .partition_point(|&c| c <= target)
-            .min(cumulative.len() - 1);
+    let draws: Vec<[f64; 3]> = (0..n)
+        .map(|_| {
+            let target = rng.random::<f64>() * total;
+            [target, rng.random(), rng.random()]
+        })
+        .collect();
+    let mut by_target: Vec<u32> = (0..n as u32).collect();
+    by_target.sort_unstable_by(|&a, &b| {
+        draws[a as usize][0]
+            .total_cmp(&draws[b as usize][0])
+            .then(a.cmp(&b))
+    });
+    let last = cumulative.len() - 1;
+    let mut out = vec![[0.0; 3]; n];
+    let mut i = 0;
+    for &k in &by_target {
+        let [target, u, v] = draws[k as usize];
+        // First triangle whose cumulative area exceeds the target (as `partition_point`).
+        while i < last && cumulative[i] <= target {
+            i += 1;
+        }
         let [a, b, c] = mesh.corners(&mesh.triangles[i]);
-        let (u, v): (f64, f64) = (rng.random(), rng.random());
         let su = u.sqrt();
         let (wa, wb, wc) = (1.0 - su, su * (1.0 - v), su * v);
-        out.push([
+        out[k as usize] = [
             wa * a[0] + wb * b[0] + wc * c[0],
             wa * a[1] + wb * b[1] + wc * c[1],
             wa * a[2] + wb * b[2] + wc * c[2],
-        ]);
+        ];
     }
     Ok(out)
 }
