@@ -21,7 +21,6 @@ pub struct MeshHit {
 /// A triangle mesh indexed for closest-point queries.
 pub struct MeshIndex {
     trimesh: TriMesh,
-    normals: Vec<Point3>,
 }
 
 impl MeshIndex {
@@ -33,23 +32,9 @@ impl MeshIndex {
             .iter()
             .map(|p| Vector::new(p[0], p[1], p[2]))
             .collect();
-        let normals = mesh
-            .triangles
-            .iter()
-            .map(|t| {
-                let c = mesh.corners(t);
-                let n = cross(sub(c[1], c[0]), sub(c[2], c[0]));
-                let l = norm(n);
-                if l > 0.0 {
-                    [n[0] / l, n[1] / l, n[2] / l]
-                } else {
-                    [0.0; 3]
-                }
-            })
-            .collect();
         let trimesh = TriMesh::with_flags(vertices, mesh.triangles.clone(), TriMeshFlags::empty())
             .map_err(|e| Error::Geometry(format!("cannot index the mesh: {e}")))?;
-        Ok(MeshIndex { trimesh, normals })
+        Ok(MeshIndex { trimesh })
     }
 
     /// The closest surface point to `p`.
@@ -67,11 +52,19 @@ impl MeshIndex {
     /// Distance signed by the normal of the closest triangle (positive on the side the
     /// counter-clockwise normal points to), as CloudCompare's C2M does.
     pub fn signed(&self, p: Point3, hit: &MeshHit) -> f64 {
-        let n = self
-            .normals
-            .get(hit.triangle as usize)
-            .copied()
-            .unwrap_or([0.0; 3]);
+        // The triangle's normal, computed when asked (a stored one costs 24 bytes a triangle).
+        let n = match self.trimesh.indices().get(hit.triangle as usize) {
+            Some(t) => {
+                let v = self.trimesh.vertices();
+                let corner = |k: usize| {
+                    let q = v[t[k] as usize];
+                    [q.x, q.y, q.z]
+                };
+                let (a, b, c) = (corner(0), corner(1), corner(2));
+                cross(sub(b, a), sub(c, a))
+            }
+            None => [0.0; 3],
+        };
         if dot(sub(p, hit.closest), n) < 0.0 {
             -hit.distance
         } else {
