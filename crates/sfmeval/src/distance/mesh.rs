@@ -1,10 +1,8 @@
-//! Exact point-to-triangle-mesh distance through parry's BVH (f64).
+//! Exact point-to-triangle-mesh distance through a compact BVH ([`super::bvh`]) whose leaves
+//! run parry's exact f64 point-triangle projection.
 
-use parry3d_f64::math::Vector;
-use parry3d_f64::query::PointQueryWithLocation as _;
-use parry3d_f64::shape::{TriMesh, TriMeshFlags};
-
-use crate::error::{Error, Result};
+use super::bvh::TriangleBvh;
+use crate::error::Result;
 use crate::geometry::{Point3, TriangleMesh, cross, dot, norm, sub};
 
 /// The closest point of the mesh to a query point.
@@ -16,36 +14,39 @@ pub struct MeshHit {
     pub closest: Point3,
     /// Index of the triangle the closest point lies on.
     pub triangle: u32,
+    /// Its corners (for the signed distance).
+    corners: [Point3; 3],
 }
 
 /// A triangle mesh indexed for closest-point queries.
 pub struct MeshIndex {
-    trimesh: TriMesh,
+    bvh: TriangleBvh,
 }
 
 impl MeshIndex {
     /// Builds the BVH. The mesh must be valid ([`TriangleMesh::validate`]).
     pub fn new(mesh: &TriangleMesh) -> Result<Self> {
         mesh.validate("mesh")?;
-        let vertices: Vec<Vector> = mesh
-            .vertices
-            .iter()
-            .map(|p| Vector::new(p[0], p[1], p[2]))
-            .collect();
-        let trimesh = TriMesh::with_flags(vertices, mesh.triangles.clone(), TriMeshFlags::empty())
-            .map_err(|e| Error::Geometry(format!("cannot index the mesh: {e}")))?;
-        Ok(MeshIndex { trimesh })
+        Ok(MeshIndex {
+            bvh: TriangleBvh::new(mesh),
+        })
     }
 
-    /// The closest surface point to `p`.
+    /// The closest surface point to `p` (a non-finite `p` gets a NaN distance).
     pub fn closest(&self, p: Point3) -> MeshHit {
-        let q = Vector::new(p[0], p[1], p[2]);
-        let (proj, (triangle, _)) = self.trimesh.project_local_point_and_get_location(q, false);
-        let closest = [proj.point.x, proj.point.y, proj.point.z];
-        MeshHit {
-            distance: norm(sub(p, closest)),
-            closest,
-            triangle,
+        match self.bvh.closest(p) {
+            Some(c) => MeshHit {
+                distance: norm(sub(p, c.point)),
+                closest: c.point,
+                triangle: c.triangle,
+                corners: c.corners,
+            },
+            None => MeshHit {
+                distance: f64::NAN,
+                closest: p,
+                triangle: 0,
+                corners: [[0.0; 3]; 3],
+            },
         }
     }
 
@@ -53,18 +54,8 @@ impl MeshIndex {
     /// counter-clockwise normal points to), as CloudCompare's C2M does.
     pub fn signed(&self, p: Point3, hit: &MeshHit) -> f64 {
         // The triangle's normal, computed when asked (a stored one costs 24 bytes a triangle).
-        let n = match self.trimesh.indices().get(hit.triangle as usize) {
-            Some(t) => {
-                let v = self.trimesh.vertices();
-                let corner = |k: usize| {
-                    let q = v[t[k] as usize];
-                    [q.x, q.y, q.z]
-                };
-                let (a, b, c) = (corner(0), corner(1), corner(2));
-                cross(sub(b, a), sub(c, a))
-            }
-            None => [0.0; 3],
-        };
+        let [a, b, c] = hit.corners;
+        let n = cross(sub(b, a), sub(c, a));
         if dot(sub(p, hit.closest), n) < 0.0 {
             -hit.distance
         } else {
