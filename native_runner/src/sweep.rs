@@ -897,7 +897,12 @@ pub fn sweep(a: &SweepArgs) -> Result<()> {
             keep_scratch: false,
             verbose: true,
         };
-        crate::run::run_batch(&datasets, &specs, &customs, &env, &opts)?;
+        let sum = crate::run::run_batch(&datasets, &specs, &customs, &env, &opts)?;
+        eprintln!(
+            "sweep: runs: {} executed, {} reused",
+            sum.ran.values().sum::<usize>(),
+            sum.skipped
+        );
     }
     let runs_seconds = t_runs.elapsed().as_secs_f64();
     // report
