@@ -171,10 +171,10 @@ pub fn svg(c: &Chart) -> String {
     let mut c = c.clone();
     for se in &mut c.series {
         for (_, v) in &mut se.points {
-            if let Value::Ok(y) = v {
-                if !y.is_finite() {
-                    *v = Value::Missing(format!("not finite: {y}"));
-                }
+            if let Value::Ok(y) = v
+                && !y.is_finite()
+            {
+                *v = Value::Missing(format!("not finite: {y}"));
             }
         }
     }

@@ -448,11 +448,11 @@ pub fn expand_metric(path: &str, label: &str, docs: &[&Json]) -> Vec<Metric> {
     let mut n = 0;
     let mut first: Option<&Json> = None;
     for d in docs {
-        if let Some(a) = d.pointer(&pointer).and_then(Json::as_array) {
-            if a.len() > n {
-                n = a.len();
-                first = Some(*d);
-            }
+        if let Some(a) = d.pointer(&pointer).and_then(Json::as_array)
+            && a.len() > n
+        {
+            n = a.len();
+            first = Some(*d);
         }
     }
     (0..n)
@@ -785,8 +785,14 @@ pub fn sweep(a: &SweepArgs) -> Result<()> {
     if !(a.timeout > 0.0) {
         bail!("--timeout must be > 0");
     }
-    let python = crate::find_python(a.tools.python.as_deref());
-    let scripts = crate::table1::find_blender_scripts(a.blender_scripts.as_deref())?;
+    // absolute paths: the generator runs in the datasets folder
+    let mut python = crate::find_python(a.tools.python.as_deref());
+    if python.components().count() > 1 {
+        python = std::path::absolute(&python)?;
+    }
+    let scripts = std::path::absolute(crate::table1::find_blender_scripts(
+        a.blender_scripts.as_deref(),
+    )?)?;
     let customs = crate::pipelines::parse_customs(&a.tools.customs)?;
     let specs = crate::pipelines::parse_list(&a.pipelines, &customs)?;
     let eval = crate::eval_options(&a.eval)?;
@@ -818,7 +824,9 @@ pub fn sweep(a: &SweepArgs) -> Result<()> {
         let o = factor_overrides(factor, *x, &base)?;
         planned.push((text.clone(), *x, variant_name(factor, text), o));
     }
-    let ds_root = a.out.join("datasets");
+    let out = std::path::absolute(&a.out)
+        .with_context(|| format!("output folder {}", a.out.display()))?;
+    let ds_root = out.join("datasets");
     std::fs::create_dir_all(&ds_root).with_context(|| format!("creating {}", ds_root.display()))?;
     let mut variants: Vec<Variant> = Vec::new();
     let mut datasets: Vec<Dataset> = Vec::new();
@@ -876,8 +884,8 @@ pub fn sweep(a: &SweepArgs) -> Result<()> {
     }
     let render_seconds = t0.elapsed().as_secs_f64();
     // runs
-    let runs = a.out.join("runs");
-    let table = a.out.join("table");
+    let runs = out.join("runs");
+    let table = out.join("table");
     let t_runs = Instant::now();
     if !datasets.is_empty() {
         let env = crate::make_env(&a.tools, &runs)?;
@@ -959,14 +967,14 @@ pub fn sweep(a: &SweepArgs) -> Result<()> {
     }
     let metrics = metrics(&a.metrics, &cells);
     write_atomic(
-        &a.out.join("sweep.csv"),
+        &out.join("sweep.csv"),
         csv(factor, &cells, &metrics).as_bytes(),
     )?;
     let charts = charts(factor, &values, &pipes, &cells, &metrics);
     let mut files = Vec::new();
     for (c, m) in charts.iter().zip(&metrics) {
         let f = format!("charts/{}.svg", metric_file(&m.path));
-        write_atomic(&a.out.join(&f), chart::svg(c).as_bytes())?;
+        write_atomic(&out.join(&f), chart::svg(c).as_bytes())?;
         files.push(f);
     }
     let command = std::env::args()
@@ -974,7 +982,7 @@ pub fn sweep(a: &SweepArgs) -> Result<()> {
         .collect::<Vec<_>>()
         .join(" ");
     write_atomic(
-        &a.out.join("sweep.html"),
+        &out.join("sweep.html"),
         page(factor, &command, &variants, &pipes, &charts, &files).as_bytes(),
     )?;
     let total = t0.elapsed().as_secs_f64();
@@ -993,7 +1001,7 @@ pub fn sweep(a: &SweepArgs) -> Result<()> {
     });
     let mut json = serde_json::to_string_pretty(&doc)?;
     json.push('\n');
-    write_atomic(&a.out.join("sweep.json"), json.as_bytes())?;
+    write_atomic(&out.join("sweep.json"), json.as_bytes())?;
     let ok = cells.iter().filter(|c| c.status == "ok").count();
     eprintln!(
         "sweep: {} value(s) × {} pipeline(s), {ok} ok; datasets {render_seconds:.0} s, runs {runs_seconds:.0} s, report {report_seconds:.0} s, total {total:.0} s → {}/{{sweep.csv,sweep.html,sweep.json,charts/}}",

@@ -34,7 +34,8 @@ def sweep(runner_bin, tmp_path_factory):
     pytest.importorskip("bpy")
     pytest.importorskip("pycolmap")
     out = tmp_path_factory.mktemp("sweep")
-    proc = subprocess.run(sweep_cmd(runner_bin, out), cwd=REPO, stdout=subprocess.PIPE,
+    # a relative --out (the generator runs in another folder: paths must not break)
+    proc = subprocess.run(sweep_cmd(runner_bin, out.name), cwd=out.parent, stdout=subprocess.PIPE,
                           stderr=subprocess.PIPE, text=True, timeout=900)
     assert proc.returncode == 0, proc.stderr[-4000:]
     return out, proc
@@ -124,7 +125,7 @@ def test_html_is_self_contained(sweep):
 def test_second_call_reuses_everything(sweep, runner_bin):
     out, _ = sweep
     before = rows_of(out)
-    proc = subprocess.run(sweep_cmd(runner_bin, out), cwd=REPO, stdout=subprocess.PIPE,
+    proc = subprocess.run(sweep_cmd(runner_bin, out.name), cwd=out.parent, stdout=subprocess.PIPE,
                           stderr=subprocess.PIPE, text=True, timeout=300)
     assert proc.returncode == 0, proc.stderr[-3000:]
     assert "sweep: rendering" not in proc.stderr
