@@ -20,7 +20,7 @@ EXTRA_METRIC = "report.completeness.percentiles.p90"
 
 
 def sweep_cmd(runner_bin, out, *extra):
-    return [runner_bin, "sweep", "--factor", "noise=" + ",".join(VALUES),
+    return [os.path.abspath(runner_bin), "sweep", "--factor", "noise=" + ",".join(VALUES),
             "--dataset-preset", "small",
             "--set", "render.samples=8", "--set", "camera.resolution=[320, 180]",
             "--set", "views.orbits=[{elevation_deg=25.0, count=24}]",
