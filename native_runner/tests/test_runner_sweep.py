@@ -149,3 +149,28 @@ def test_bad_factors_fail_before_rendering(runner_bin, tmp_path, factor, msg):
                           timeout=120)
     assert proc.returncode != 0 and msg in proc.stderr, proc.stderr
     assert not os.path.exists(tmp_path / "o" / "datasets")
+
+
+def test_a_variant_that_fails_to_render_is_recorded(runner_bin, tmp_path):
+    """--dataset-config; the noise=4 variant is rejected by the generator (post-processing
+    writes 8-bit images, the config asks for 16-bit PNG) while noise=0 renders: the sweep goes
+    on and marks noise=4 as `generation failed` for every pipeline."""
+    pytest.importorskip("bpy")
+    cfg = tmp_path / "tiny.toml"
+    cfg.write_text('preset = "small"\n[render]\nsamples = 2\nformat = "PNG"\npng_color_depth = 16\n'
+                   '[camera]\nresolution = [160, 90]\n[views]\norbits = [{elevation_deg = 30.0, count = 3}]\n')
+    out = tmp_path / "o"
+    proc = subprocess.run([os.path.abspath(runner_bin), "sweep", "--factor", "noise=0,4",
+                           "--dataset-config", str(cfg), "--pipelines", "broken",
+                           "--custom", "broken=false {out}", "--samples", "10000", "--out", str(out)],
+                          cwd=REPO, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                          timeout=600)
+    assert proc.returncode == 0, proc.stderr[-3000:]
+    rows = rows_of(out)
+    assert [(r["value"], r["status"]) for r in rows] == [("0", "failed"), ("4", "generation failed")]
+    assert "png_color_depth" in rows[1]["reason"], rows[1]["reason"]
+    assert os.path.isfile(out / "datasets" / "noise-0" / "images" / "0000.png")
+    assert not os.path.exists(out / "datasets" / "noise-4")
+    svg = open(out / "charts" / "report_accuracy_mean.svg").read()
+    assert svg.count('class="fail" data-series="broken"') == 2
+    assert "generation failed" in svg
