@@ -13,7 +13,11 @@ Python has it only with ``python3-pil``): :func:`check_available` says so before
 
 import math
 
-import numpy as np
+
+def _np():
+    # imported when used: importing steps must not need numpy (Debian's blender may lack it)
+    import numpy
+    return numpy
 
 
 def active(cfg):
@@ -28,6 +32,7 @@ def seed_of(cfg):
 
 def gaussian_kernel(sigma):
     """Normalised 1-D Gaussian, radius ceil(3σ)."""
+    np = _np()
     r = max(1, int(math.ceil(3.0 * sigma)))
     x = np.arange(-r, r + 1, dtype=np.float64)
     k = np.exp(-0.5 * (x / sigma) ** 2)
@@ -36,6 +41,7 @@ def gaussian_kernel(sigma):
 
 def blur(img, sigma):
     """Separable Gaussian blur of an (H, W, C) float array, edges mirrored (reflect)."""
+    np = _np()
     if sigma <= 0:
         return img
     k = gaussian_kernel(sigma)
@@ -43,14 +49,10 @@ def blur(img, sigma):
     out = img.astype(np.float64)
     for axis in (0, 1):
         n = out.shape[axis]
-        if r >= n:  # a tiny image: reflect padding needs r < n; clamp instead
-            pad = [(0, 0)] * out.ndim
-            pad[axis] = (r, r)
-            padded = np.pad(out, pad, mode="edge")
-        else:
-            pad = [(0, 0)] * out.ndim
-            pad[axis] = (r, r)
-            padded = np.pad(out, pad, mode="reflect")
+        pad = [(0, 0)] * out.ndim
+        pad[axis] = (r, r)
+        # mirrored edges; a side shorter than the kernel radius cannot mirror: repeat the edge
+        padded = np.pad(out, pad, mode="edge" if r >= n else "reflect")
         acc = np.zeros_like(out)
         for i, w in enumerate(k):
             sl = [slice(None)] * out.ndim
@@ -62,6 +64,7 @@ def blur(img, sigma):
 
 def add_noise(img, sigma, rng):
     """Adds N(0, σ²) per pixel and channel."""
+    np = _np()
     if sigma <= 0:
         return img
     return img + rng.normal(0.0, sigma, size=img.shape)
@@ -69,6 +72,7 @@ def add_noise(img, sigma, rng):
 
 def apply(img_u8, cfg, view_index):
     """Blur then noise an (H, W, C) uint8 image; returns uint8 (rounded, clipped to 0..255)."""
+    np = _np()
     pp = cfg["postprocess"]
     x = img_u8.astype(np.float64)
     x = blur(x, float(pp["blur_sigma"]))
@@ -89,6 +93,7 @@ def check_available():
 def process_file(src, dest, cfg, view_index):
     """Reads the lossless render `src`, post-processes it and writes `dest` in the configured
     format (JPEG at render.jpeg_quality, or 8-bit PNG), without metadata."""
+    np = _np()
     from PIL import Image
 
     with Image.open(src) as im:
