@@ -1,4 +1,4 @@
-"""`sfmeval-runner sweep` end to end, kept small for CI (~1 min here): two values of the noise
+"""`sfmeval-runner sweep` end to end, kept small for CI (45–125 s here): two values of the noise
 factor on a 24-view 320x180 render of the statue (8 spp), pycolmap and a custom pipeline that
 always fails, 100k completeness samples. Checks the table, the charts and the page."""
 
