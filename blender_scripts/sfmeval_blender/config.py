@@ -29,6 +29,8 @@ ORBIT_DEFAULTS = {
     "count": 18,             # cameras on the ring, evenly spaced in azimuth
     "radius": "auto",        # metres, or "auto" (fit the object with views.fill)
     "azimuth_offset_deg": 0.0,
+    "azimuth_step_deg": 0.0,  # 0 = evenly around the full circle (360/count); > 0 = the angle
+                              # between neighbouring cameras: a partial arc of count x step
 }
 LIGHT_DEFAULTS = {
     "type": "area",          # area | sun | point
@@ -120,6 +122,11 @@ DEFAULTS = {
             "elevation_min_deg": 5.0,
             "elevation_max_deg": 75.0,
         },
+    },
+    "postprocess": {                  # applied to every view before EXIF (postprocess.py)
+        "blur_sigma": 0.0,            # Gaussian blur, pixels (0 = off)
+        "noise_sigma": 0.0,           # additive Gaussian noise, 8-bit grey levels (0 = off)
+        "seed": -1,                   # noise seed; -1 = dataset.seed
     },
     "outputs": {
         "depth": True,                # depth/NNNN.npy, float32 metres along the optical axis
@@ -371,6 +378,13 @@ def validate(cfg):
             raise ConfigError("views.orbits[%d].count must be >= 0" % i)
         if not -90 <= o["elevation_deg"] <= 90:
             raise ConfigError("views.orbits[%d].elevation_deg must be in [-90, 90]" % i)
+        step = o["azimuth_step_deg"]
+        if step < 0:
+            raise ConfigError("views.orbits[%d].azimuth_step_deg must be >= 0" % i)
+        if step > 0 and o["count"] * step > 360.0 + 1e-9:
+            raise ConfigError("views.orbits[%d]: %d cameras %g deg apart span %g deg, more than a "
+                              "full circle: lower count or azimuth_step_deg"
+                              % (i, o["count"], step, o["count"] * step))
     for band in ("sphere", "shell"):
         b = views[band]
         if b["count"] < 0:
@@ -388,6 +402,14 @@ def validate(cfg):
         cfg["outputs"]["name_format"].format(0)
     except (IndexError, KeyError, ValueError):
         raise ConfigError("outputs.name_format must be a Python format string like \"{:04d}\"")
+    pp = cfg["postprocess"]
+    for key in ("blur_sigma", "noise_sigma"):
+        if not pp[key] >= 0:
+            raise ConfigError("postprocess.%s must be >= 0, got %r" % (key, pp[key]))
+    if (pp["blur_sigma"] > 0 or pp["noise_sigma"] > 0) and rnd["format"] == "PNG" \
+            and rnd["png_color_depth"] != 8:
+        raise ConfigError("postprocess (blur/noise) writes 8-bit images: use "
+                          "render.png_color_depth = 8")
     for i, light in enumerate(cfg["lights"]):
         if light["energy"] < 0:
             raise ConfigError("lights[%d].energy must be >= 0" % i)

@@ -111,7 +111,11 @@ def camera_positions(views_cfg, target, auto, seed):
         r = _radius(ring["radius"], auto)
         el = math.radians(ring["elevation_deg"])
         for k in range(n):
-            az = math.radians(ring["azimuth_offset_deg"]) + 2.0 * math.pi * k / n
+            step = ring.get("azimuth_step_deg", 0.0)
+            if step > 0:  # a partial arc: neighbours `step` degrees apart
+                az = math.radians(ring["azimuth_offset_deg"] + step * k)
+            else:
+                az = math.radians(ring["azimuth_offset_deg"]) + 2.0 * math.pi * k / n
             out.append({"group": "orbit%d" % i, "eye": _point(target, r, az, el),
                         "azimuth_deg": math.degrees(az), "elevation_deg": ring["elevation_deg"],
                         "radius": r})

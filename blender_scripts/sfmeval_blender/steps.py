@@ -15,7 +15,7 @@ import time
 import bpy
 from mathutils import Matrix, Vector
 
-from . import __version__, compat, config as cfgmod, exif, geometry, shapes
+from . import __version__, compat, config as cfgmod, exif, geometry, postprocess, shapes
 
 ROLE = "sfmeval_role"
 
@@ -572,7 +572,15 @@ def step_render(cfg, out_dir, progress=None, frames=None):
     img_dir = os.path.join(out_dir, "images")
     os.makedirs(img_dir, exist_ok=True)
     denoise_used = configure_render(scene, cfg)
-    _set_output(scene, cfg["render"]["format"], cfg)
+    pp_on = postprocess.active(cfg)
+    if pp_on:
+        try:
+            postprocess.check_available()
+        except ImportError as exc:
+            raise GenerationError(str(exc)) from None
+    _set_output(scene, "PNG" if pp_on else cfg["render"]["format"], cfg)
+    if pp_on:
+        scene.render.image_settings.color_depth = "8"
     c = cfg["camera"]
     w, h = scene.render.resolution_x, scene.render.resolution_y
     times = []
@@ -580,7 +588,13 @@ def step_render(cfg, out_dir, progress=None, frames=None):
         scene.frame_set(m["frame"])
         path = os.path.join(img_dir, m["name"])
         t0 = time.perf_counter()
-        _render_to(scene, path)
+        if pp_on:  # render losslessly, then blur/noise into the configured format
+            tmp = path + ".render.png"
+            _render_to(scene, tmp)
+            postprocess.process_file(tmp, path, cfg, m["frame"] - 1)
+            os.remove(tmp)
+        else:
+            _render_to(scene, path)
         times.append(time.perf_counter() - t0)
         if c["exif"]:
             exif.write_exif(path, width=w, height=h, focal_mm=cam.data.lens,
@@ -595,7 +609,11 @@ def step_render(cfg, out_dir, progress=None, frames=None):
         t0 = time.perf_counter()
         render_aux(cfg, out_dir, meta, progress)
         aux_time = time.perf_counter() - t0
-    info = {"seconds_per_frame": times, "aux_seconds_total": aux_time, "denoise_used": denoise_used,
+    info = {"postprocess": {"applied": pp_on, "blur_sigma": cfg["postprocess"]["blur_sigma"],
+                            "noise_sigma": cfg["postprocess"]["noise_sigma"],
+                            "seed": postprocess.seed_of(cfg),
+                            "order": "blur, then noise, on the 8-bit render, before EXIF"},
+            "seconds_per_frame": times, "aux_seconds_total": aux_time, "denoise_used": denoise_used,
             "denoise_available": compat.oidn_available(), "frames": len(meta)}
     store(scene, "render_info", info)
     return info
@@ -816,7 +834,8 @@ def step_export(cfg, out_dir):
         "settings": cfg,
         "render": {"engine": "CYCLES", "device": "CPU", "samples": scene.cycles.samples,
                    "denoise_used": info.get("denoise_used"), "denoise_available": compat.oidn_available(),
-                   "threads": scene.render.threads, "view_transform": scene.view_settings.view_transform},
+                   "threads": scene.render.threads, "view_transform": scene.view_settings.view_transform,
+                   "postprocess": info.get("postprocess")},
         "timing": {"render_seconds_per_frame": [round(t, 3) for t in times],
                    "render_seconds_mean": round(sum(times) / len(times), 3) if times else None,
                    "render_seconds_total": round(sum(times), 3),

@@ -7,9 +7,11 @@
 //! sfmeval-runner merge runs-0/ runs-1/ ... --out runs/
 //! sfmeval-runner report runs/ --out table/
 //! sfmeval-runner table1 [--quick] [--out table1/]
+//! sfmeval-runner sweep --factor views=12,24,36 --dataset-preset statue --pipelines LIST --out sweep/
 //! ```
 
 mod adapters;
+mod chart;
 mod dataset;
 mod exec;
 mod files;
@@ -18,6 +20,7 @@ mod pipelines;
 mod report;
 mod run;
 mod setup;
+mod sweep;
 mod table1;
 
 use std::path::{Path, PathBuf};
@@ -54,6 +57,9 @@ enum Command {
     Report(ReportCmd),
     /// The whole seed experiment: render the five built-in datasets, run every pipeline, write the table.
     Table1(Table1Args),
+    /// Vary one dataset condition (views, baseline, focal, texture, lighting, noise, blur):
+    /// render a variant per value, run the pipelines, plot every metric against it.
+    Sweep(sweep::SweepArgs),
     /// List the pipelines and whether each is installed here.
     Pipelines(ToolArgs),
 }
@@ -229,6 +235,7 @@ fn main() -> ExitCode {
         }),
         Command::Report(a) => cmd_report(&a),
         Command::Table1(a) => table1::table1(&a),
+        Command::Sweep(a) => sweep::sweep(&a),
         Command::Pipelines(a) => cmd_pipelines(&a),
     };
     match result {
