@@ -111,16 +111,23 @@ fn generate(
 /// The whole experiment.
 pub fn table1(a: &Table1Args) -> Result<()> {
     let t0 = Instant::now();
-    let python = crate::find_python(a.tools.python.as_deref());
-    let scripts = find_blender_scripts(a.blender_scripts.as_deref())?;
+    let mut python = crate::find_python(a.tools.python.as_deref());
+    if python.components().count() > 1 {
+        python = std::path::absolute(&python)?;
+    }
+    let scripts = std::path::absolute(find_blender_scripts(a.blender_scripts.as_deref())?)?;
     let presets: Vec<String> = if a.presets.is_empty() {
         PRESETS.iter().map(|s| s.to_string()).collect()
     } else {
         a.presets.clone()
     };
-    let ds_root = a.out.join("datasets");
-    let runs = a.out.join("runs");
-    let table = a.out.join("table");
+    // Absolute: the generator runs inside the datasets folder, so a relative --out would
+    // land one level too deep.
+    let out = std::path::absolute(&a.out)
+        .with_context(|| format!("resolving --out {}", a.out.display()))?;
+    let ds_root = out.join("datasets");
+    let runs = out.join("runs");
+    let table = out.join("table");
     std::fs::create_dir_all(&ds_root).with_context(|| format!("creating {}", ds_root.display()))?;
     let mut timing = serde_json::Map::new();
     let mut gen_times = serde_json::Map::new();
@@ -189,7 +196,7 @@ pub fn table1(a: &Table1Args) -> Result<()> {
     });
     let mut json = serde_json::to_string_pretty(&doc)?;
     json.push('\n');
-    write_atomic(&a.out.join("table1.json"), json.as_bytes())?;
+    write_atomic(&out.join("table1.json"), json.as_bytes())?;
     let t1 = std::fs::read_to_string(table.join("table1.md")).unwrap_or_default();
     println!("{t1}");
     eprintln!(
