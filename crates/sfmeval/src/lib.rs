@@ -39,6 +39,7 @@ pub mod progress;
 pub mod report;
 pub mod sampling;
 pub mod stats;
+pub mod track_error;
 pub mod transform;
 pub mod visibility;
 
