@@ -507,3 +507,169 @@ pub fn cameras_only(
     let cams = evaluate_cameras_matched(gt_cameras, recon, &matches, &t, &options.pose)?;
     Ok((t, report, cams))
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::geometry::{GroundTruth, TriangleMesh};
+    use crate::gt_views::test_scenes::{look_at, render, sphere};
+    use crate::model::{Camera, Image, Observation, Point3D, TrackElement};
+    use crate::progress::NoProgress;
+
+    /// A UV sphere of radius 1 (sag below 3e-4, far below the depth tolerance).
+    fn uv_sphere(n_lon: usize, n_lat: usize) -> TriangleMesh {
+        let mut vertices = Vec::new();
+        for i in 0..=n_lat {
+            let lat = std::f64::consts::PI * (i as f64 / n_lat as f64 - 0.5);
+            for j in 0..n_lon {
+                let lon = 2.0 * std::f64::consts::PI * j as f64 / n_lon as f64;
+                vertices.push([lat.cos() * lon.cos(), lat.sin(), lat.cos() * lon.sin()]);
+            }
+        }
+        let mut triangles = Vec::new();
+        for i in 0..n_lat {
+            for j in 0..n_lon {
+                let a = (i * n_lon + j) as u32;
+                let b = (i * n_lon + (j + 1) % n_lon) as u32;
+                let c = a + n_lon as u32;
+                let d = b + n_lon as u32;
+                triangles.push([a, c, b]);
+                triangles.push([b, c, d]);
+            }
+        }
+        TriangleMesh {
+            vertices,
+            triangles,
+        }
+    }
+
+    #[test]
+    fn run_with_views_adds_visible_completeness_and_track_error() {
+        // 36 cameras on the equator at distance 2: the visible band is |latitude| < 60°, area
+        // fraction sin 60° (see the visibility tests). The reconstruction: points on the sphere
+        // with exact observations in every camera that sees them, named like the GT images.
+        let hit = sphere([0.0; 3], 1.0);
+        let mut gt_cams = Reconstruction::new("cameras_json");
+        let mut cam = Camera::simple(1, "PINHOLE", 300.0, 240.0, 240.0);
+        cam.width = 480;
+        cam.height = 480;
+        gt_cams.cameras.push(cam);
+        let mut views = Vec::new();
+        for k in 0..36 {
+            let phi = 2.0 * std::f64::consts::PI * k as f64 / 36.0;
+            let c = [2.0 * phi.cos(), 0.0, 2.0 * phi.sin()];
+            let mut v = render(look_at(c, [0.0; 3]), 300.0, 480, 480, &hit);
+            v.name = format!("{k:04}.png");
+            gt_cams.images.push(Image {
+                id: k + 1,
+                name: v.name.clone(),
+                camera_id: 1,
+                cam_from_world: v.cam_from_world,
+                observations: vec![],
+            });
+            views.push(v);
+        }
+        let mut est = gt_cams.clone();
+        est.format = "colmap";
+        for im in &mut est.images {
+            im.name = format!("images/{}", im.name.replace(".png", ".PNG"));
+        }
+        let mut rng_state = 1u64;
+        let mut next = || {
+            rng_state = rng_state
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (rng_state >> 11) as f64 / (1u64 << 53) as f64
+        };
+        for p in 0..400 {
+            let (lat, lon): (f64, f64) = ((next() - 0.5) * 1.6, next() * 6.283);
+            let x = [lat.cos() * lon.cos(), lat.sin(), lat.cos() * lon.sin()];
+            let mut track = Vec::new();
+            for (i, v) in views.iter().enumerate() {
+                if crate::visibility::sees(v, x) {
+                    let (u, vv, _) = v.project(x).unwrap();
+                    let im = &mut est.images[i];
+                    track.push(TrackElement {
+                        image: i,
+                        keypoint: im.observations.len() as u64,
+                    });
+                    im.observations.push(Observation {
+                        xy: [u, vv],
+                        point: Some(p),
+                    });
+                }
+            }
+            est.points.push(Point3D {
+                xyz: x,
+                color: None,
+                error: None,
+                track,
+            });
+        }
+        let recon = ReconInput {
+            cloud: est.to_point_cloud(),
+            model: Some(est),
+            name: "synthetic".into(),
+            format: "colmap".into(),
+            warnings: vec![],
+        };
+        let gt = GroundTruth::Mesh(uv_sphere(128, 64));
+        let options = RunOptions {
+            eval: EvalOptions {
+                samples: 20_000,
+                tau: vec![0.01, 0.05],
+                ..EvalOptions::default()
+            },
+            align: AlignRequest::None,
+            ..RunOptions::default()
+        };
+        let prepared = PreparedGroundTruth::new(&gt, 20_000, 0, &NoProgress).unwrap();
+        let info = GroundTruthInfo::default();
+        let e = run_with_views(
+            &prepared,
+            &info,
+            &recon,
+            Some(&gt_cams),
+            Some(&views),
+            &[],
+            &options,
+            &NoProgress,
+        )
+        .unwrap();
+        let vis = e.report.completeness_visible.as_ref().unwrap();
+        assert_eq!((vis.views, vis.min_views, vis.samples), (36, 2, 20_000));
+        let expected = 3f64.sqrt() / 2.0;
+        assert!(
+            (vis.visible_fraction - expected).abs() < 0.01,
+            "{}",
+            vis.visible_fraction
+        );
+        assert_eq!(e.report.options.min_views, Some(2));
+        assert_eq!(e.sample_labels.as_ref().unwrap().len(), 20_000);
+        assert_eq!(vis.labels_tau, 0.01);
+        // Recall over the visible part is higher: the points cover |lat| < 46° only.
+        assert!(vis.thresholds[1].recall_visible > vis.thresholds[1].recall);
+        let te = e.report.track_error.as_ref().unwrap();
+        assert_eq!(te.points, 400);
+        assert!(te.measured >= 395, "{}", te.measured);
+        assert_eq!(te.rejected_unmatched_image, 0);
+        assert!(te.stats.max < 2e-3, "{}", te.stats.max);
+        assert_eq!(te.thresholds[0].sliding_fraction, 0.0);
+        assert_eq!(e.track_errors.as_ref().unwrap().len(), 400);
+        let json = e.report.to_json();
+        assert!(json.contains("\"completeness_visible\"") && json.contains("\"track_error\""));
+        // Without views, nothing changes in the report shape.
+        let plain = run(
+            &prepared,
+            &info,
+            &recon,
+            Some(&gt_cams),
+            &[],
+            &options,
+            &NoProgress,
+        )
+        .unwrap();
+        assert!(plain.report.completeness_visible.is_none() && plain.report.track_error.is_none());
+        assert!(!plain.report.to_json().contains("completeness_visible"));
+    }
+}
