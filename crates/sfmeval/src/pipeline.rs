@@ -347,7 +347,7 @@ fn add_visibility(
         samples: samples as u64,
         visible_samples: visible.len() as u64,
         visible_fraction: fraction,
-        visible_area: whole_surface.then(|| fraction * report.inputs.ground_truth.area),
+        visible_area: whole_surface.then_some(fraction * report.inputs.ground_truth.area),
         labels_tau,
         stats: Statistics::of(&finite, report.options.histogram_bins as usize),
         thresholds,
@@ -582,7 +582,7 @@ mod tests {
             (rng_state >> 11) as f64 / (1u64 << 53) as f64
         };
         for p in 0..400 {
-            let (lat, lon): (f64, f64) = ((next() - 0.5) * 1.6, next() * 6.283);
+            let (lat, lon): (f64, f64) = ((next() - 0.5) * 1.6, next() * std::f64::consts::TAU);
             let x = [lat.cos() * lon.cos(), lat.sin(), lat.cos() * lon.sin()];
             let mut track = Vec::new();
             for (i, v) in views.iter().enumerate() {

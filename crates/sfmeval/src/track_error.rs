@@ -161,6 +161,9 @@ pub struct PointOutcome {
     pub rejected: [u32; 4],
 }
 
+/// The observations of one 3D point: (image index, `Observation::xy`).
+type PointObservations = Vec<(usize, [f64; 2])>;
+
 /// Track errors of every 3D point of `recon` (in point order). `view_of_image[i]` is the
 /// ground-truth view of `recon.images[i]` (by name), `gt_from_recon` the alignment.
 pub fn track_errors(
@@ -172,7 +175,7 @@ pub fn track_errors(
 ) -> (ObservationConvention, Vec<PointOutcome>) {
     let convention = ObservationConvention::of(recon);
     // Observations per point, in image order then observation order.
-    let mut per_point: Vec<Vec<(usize, [f64; 2])>> = vec![Vec::new(); recon.points.len()];
+    let mut per_point: Vec<PointObservations> = vec![Vec::new(); recon.points.len()];
     for (i, im) in recon.images.iter().enumerate() {
         for o in &im.observations {
             if let Some(list) = o.point.and_then(|p| per_point.get_mut(p)) {
@@ -180,7 +183,7 @@ pub fn track_errors(
             }
         }
     }
-    let indexed: Vec<(usize, &Vec<(usize, [f64; 2])>)> = per_point.iter().enumerate().collect();
+    let indexed: Vec<(usize, &PointObservations)> = per_point.iter().enumerate().collect();
     let outcomes = parallel::map(&indexed, progress, |&(p, obs)| {
         let mut out = PointOutcome {
             observations: obs.len() as u32,

@@ -71,10 +71,8 @@ pub fn sees(view: &GtView, point_in_gt: Point3) -> bool {
     };
     let footprint = z / view.focal();
     let tol = RELATIVE_TOLERANCE * z + FOOTPRINT_TOLERANCE * footprint;
-    if let Some(d) = n.interpolated() {
-        if (z - d).abs() <= tol {
-            return true;
-        }
+    if n.interpolated().is_some_and(|d| (z - d).abs() <= tol) {
+        return true;
     }
     let slope = if n.depths.iter().any(|&d| d <= 0.0) {
         RIM_SLOPE_FOOTPRINTS * footprint
