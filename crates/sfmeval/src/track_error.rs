@@ -387,3 +387,97 @@ mod tests {
         assert!((m[1] - 0.0002).abs() < 1e-12);
     }
 }
+
+#[cfg(test)]
+mod convention_tests {
+    //! The observation convention of every reader, on files written by the real programs
+    //! (tests/fixtures/models): each observation, brought to COLMAP pixels, must lie where its
+    //! 3D point projects through its image's pose and focal length.
+    use super::*;
+    use crate::io::npy::DepthMap;
+    use crate::model::fuzz_tests::fixture;
+    use std::collections::BTreeMap;
+
+    fn median_reprojection(rec: &Reconstruction) -> (ObservationConvention, f64, usize) {
+        let conv = ObservationConvention::of(rec);
+        let mut errors = Vec::new();
+        for im in &rec.images {
+            let cam = rec.camera_of(im).unwrap();
+            // NVM and Bundler store no principal point: the images' centre (240×180).
+            let (cx, cy) = if cam.cx > 0.0 {
+                (cam.cx, cam.cy)
+            } else {
+                (120.0, 90.0)
+            };
+            let view = GtView {
+                name: im.name.clone(),
+                cam_from_world: im.cam_from_world,
+                fx: cam.fx,
+                fy: cam.fy,
+                cx,
+                cy,
+                depth: DepthMap {
+                    width: 240,
+                    height: 180,
+                    depth: vec![0.0; 240 * 180],
+                },
+            };
+            for o in &im.observations {
+                let Some(pi) = o.point else { continue };
+                let p = rec.points[pi].xyz;
+                let (u, v, _) = view.project(p).unwrap();
+                let (ou, ov) = conv.to_pixels(o.xy, &view);
+                errors.push(((u - ou).powi(2) + (v - ov).powi(2)).sqrt());
+            }
+        }
+        let n = errors.len();
+        (conv, median(&mut errors), n)
+    }
+
+    #[test]
+    fn every_reader_gives_observations_where_their_points_project() {
+        let mut colmap = BTreeMap::new();
+        for f in ["cameras.txt", "images.txt", "points3D.txt"] {
+            colmap.insert(f.to_string(), fixture(&format!("colmap_text/{f}")));
+        }
+        let cases = [
+            (
+                "colmap_text",
+                crate::model::read_model_files(&colmap).unwrap(),
+                ObservationConvention::ColmapPixels,
+            ),
+            (
+                "colmap38.nvm",
+                crate::model::nvm::read_nvm(&fixture("colmap38.nvm")).unwrap(),
+                ObservationConvention::ColmapPixels,
+            ),
+            (
+                "theia.nvm",
+                crate::model::nvm::read_nvm(&fixture("theia.nvm")).unwrap(),
+                ObservationConvention::CenteredYDown,
+            ),
+            (
+                "colmap38.bundle.out",
+                crate::model::bundler::read_bundler(
+                    &fixture("colmap38.bundle.out"),
+                    Some(&fixture("colmap38.list.txt")),
+                )
+                .unwrap(),
+                ObservationConvention::CenteredYUp,
+            ),
+            (
+                "openmvg_sfm_data.json",
+                crate::model::openmvg::read_openmvg_json(&fixture("openmvg_sfm_data.json"))
+                    .unwrap(),
+                ObservationConvention::ColmapPixels,
+            ),
+        ];
+        for (name, rec, want) in cases {
+            let (conv, med, n) = median_reprojection(&rec);
+            assert_eq!(conv, want, "{name}");
+            assert!(n > 20, "{name}: {n} observations");
+            // SfM residuals are well below a pixel; a wrong convention is off by ~W/2.
+            assert!(med < 1.0, "{name}: median reprojection {med} px");
+        }
+    }
+}
