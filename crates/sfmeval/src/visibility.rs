@@ -11,8 +11,10 @@
 //! - when the 2×2 neighbourhood of the projection holds four depths, they are interpolated in
 //!   inverse depth (exact on a plane, even at grazing angles where neighbouring depths differ by
 //!   many footprints) and the sample is seen when `|z − d̂| ≤ tol`;
-//! - otherwise (silhouette edges, where a neighbour is background) or when the interpolation
-//!   fails (creases, where the four pixels see two faces), the sample is seen when it is within
+//!   when it fails and the four depths are continuous (spread at most
+//!   `MAX_SLOPE_FOOTPRINTS · s`: one surface), the sample is hidden;
+//! - otherwise (silhouette edges, where a neighbour is background, or creases and steps, where
+//!   the four pixels see two faces), the sample is seen when it is within
 //!   `tol + dist · slope` of one valid neighbour's depth, `dist` its pixel distance to that pixel
 //!   centre and `slope` the neighbourhood's depth spread capped at `MAX_SLOPE_FOOTPRINTS · s`
 //!   per pixel, so a step between two surfaces (an occluder) never widens the test beyond a steep
@@ -71,8 +73,14 @@ pub fn sees(view: &GtView, point_in_gt: Point3) -> bool {
     };
     let footprint = z / view.focal();
     let tol = RELATIVE_TOLERANCE * z + FOOTPRINT_TOLERANCE * footprint;
-    if n.interpolated().is_some_and(|d| (z - d).abs() <= tol) {
-        return true;
+    if let Some(d) = n.interpolated() {
+        if (z - d).abs() <= tol {
+            return true;
+        }
+        // A continuous neighbourhood (one surface, however steep) has said it all.
+        if n.spread() <= MAX_SLOPE_FOOTPRINTS * footprint {
+            return false;
+        }
     }
     let slope = if n.depths.iter().any(|&d| d <= 0.0) {
         RIM_SLOPE_FOOTPRINTS * footprint
