@@ -202,6 +202,38 @@ struct Gt {
     prepared: PreparedGroundTruth,
     info: GroundTruthInfo,
     cameras: Option<sfmeval::model::Reconstruction>,
+    /// The dataset's cameras with their depth maps (`depth/`), when it has them: visible
+    /// completeness and track error.
+    views: Option<Vec<sfmeval::gt_views::GtView>>,
+}
+
+/// Reads `depth/<image stem>.npy` for every image of `cameras` when the dataset has `depth/`.
+fn load_views(
+    dir: &Path,
+    cameras: Option<&sfmeval::model::Reconstruction>,
+) -> Result<Option<Vec<sfmeval::gt_views::GtView>>> {
+    let depth = dir.join("depth");
+    let (Some(cameras), true) = (cameras, depth.is_dir()) else {
+        return Ok(None);
+    };
+    let mut maps = BTreeMap::new();
+    for im in &cameras.images {
+        let stem = sfmeval::gt_views::depth_stem(&im.name);
+        let path = depth.join(format!("{stem}.npy"));
+        let bytes = std::fs::read(&path).with_context(|| {
+            format!(
+                "reading {} (depth map of image {})",
+                path.display(),
+                im.name
+            )
+        })?;
+        let map = sfmeval::io::npy::DepthMap::from_npy(&bytes)
+            .with_context(|| format!("{}", path.display()))?;
+        maps.insert(stem, map);
+    }
+    let views = sfmeval::gt_views::build_views(cameras, &maps)
+        .with_context(|| format!("{}", depth.display()))?;
+    Ok(Some(views))
 }
 
 fn load_gt(dir: &Path, eval: &EvalOptions) -> Result<Gt> {
@@ -218,7 +250,9 @@ fn load_gt(dir: &Path, eval: &EvalOptions) -> Result<Gt> {
         ),
         Err(_) => None,
     };
+    let views = load_views(dir, cameras.as_ref())?;
     Ok(Gt {
+        views,
         prepared,
         info: GroundTruthInfo {
             name: "ground_truth.glb".into(),
@@ -272,11 +306,12 @@ fn evaluate_run(
         align: pipeline::AlignRequest::Stages(args.align.clone()),
         ..RunOptions::default()
     };
-    let evaluation = pipeline::run(
+    let evaluation = pipeline::run_with_views(
         &gt.prepared,
         &gt.info,
         &recon,
         gt.cameras.as_ref(),
+        gt.views.as_deref(),
         &[],
         &options,
         &NoProgress,

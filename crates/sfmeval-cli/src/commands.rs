@@ -9,7 +9,9 @@ use sfmeval::align::{PointPair, parse_point_pairs};
 use sfmeval::crop::{Crop, Volume};
 use sfmeval::evaluate::{DEFAULT_SAMPLES, EvalOptions, PreparedGroundTruth};
 use sfmeval::geometry::{Aabb, GroundTruth};
+use sfmeval::gt_views::{GtView, build_views, depth_stem};
 use sfmeval::io;
+use sfmeval::io::npy::DepthMap;
 use sfmeval::model::{self, Reconstruction};
 use sfmeval::pipeline::{
     self, AlignRequest, GroundTruthInfo, ReconInput, RunOptions, read_reconstruction,
@@ -81,9 +83,14 @@ enum Command {
 /// The inputs shared by `eval` and `align`.
 #[derive(Args, Debug)]
 struct InputArgs {
+    /// A dataset folder (docs/dataset.md): its ground_truth.glb is the ground truth, its
+    /// cameras.json the ground-truth cameras, and its depth/ (when present) the depth maps
+    /// (`eval` only). --gt, --gt-cameras and --depth override the parts.
+    #[arg(long, value_name = "DIR")]
+    dataset: Option<PathBuf>,
     /// Ground truth: GLB, glTF, OBJ or PLY (mesh, or a dense cloud).
-    #[arg(long, value_name = "FILE")]
-    gt: PathBuf,
+    #[arg(long, value_name = "FILE", required_unless_present = "dataset")]
+    gt: Option<PathBuf>,
     /// Reconstruction: a PLY point cloud, a COLMAP model folder (sparse/ with sub-models is
     /// fine), an .nvm, a Bundler .out, an OpenMVG sfm_data.json, or a cameras.json.
     #[arg(long, value_name = "PATH")]
@@ -176,6 +183,17 @@ struct EvalArgs {
     /// Worker threads (default: all cores).
     #[arg(long, value_name = "N")]
     threads: Option<usize>,
+    /// Ground-truth depth maps (a dataset's depth/ folder: <image stem>.npy for every image of
+    /// the ground-truth cameras; needs --gt-cameras or --dataset): adds completeness over the
+    /// visible surface and, for models with tracks, the track-based error.
+    #[arg(long, value_name = "DIR")]
+    depth: Option<PathBuf>,
+    /// Images a surface sample must be seen in to count as visible (with depth maps).
+    #[arg(long, value_name = "K", default_value_t = sfmeval::visibility::DEFAULT_MIN_VIEWS)]
+    min_views: u32,
+    /// Write the completeness samples here (CSV: position, distance, views, label).
+    #[arg(long, value_name = "OUT.csv")]
+    samples_csv: Option<PathBuf>,
 }
 
 /// Runs a parsed command line.
@@ -312,6 +330,27 @@ fn is_model_file(p: &Path) -> bool {
         .any(|e| n.ends_with(e))
 }
 
+/// Reads `<dir>/<image stem>.npy` for every image of the ground-truth cameras and pairs them
+/// into views; errors name the file.
+fn load_views(dir: &Path, gt_cameras: &Reconstruction) -> Result<Vec<GtView>> {
+    let mut maps = BTreeMap::new();
+    for im in &gt_cameras.images {
+        let stem = depth_stem(&im.name);
+        let path = dir.join(format!("{stem}.npy"));
+        if !path.is_file() {
+            bail!(
+                "missing depth map '{}' for image '{}'",
+                path.display(),
+                im.name
+            );
+        }
+        let map = DepthMap::from_npy(&read(&path)?)
+            .with_context(|| format!("depth map '{}'", path.display()))?;
+        maps.insert(stem, map);
+    }
+    build_views(gt_cameras, &maps).with_context(|| format!("depth maps in '{}'", dir.display()))
+}
+
 struct Loaded {
     prepared: PreparedGroundTruth,
     gt_info: GroundTruthInfo,
@@ -353,24 +392,33 @@ fn load(input: &InputArgs, eval: EvalOptions, bars: &Bars) -> Result<Loaded> {
     if method == "points" && pairs.is_empty() {
         bail!("--align points needs --pairs FILE");
     }
-    let gt_cameras = match &input.gt_cameras {
+    let gt_path: PathBuf = match (&input.gt, &input.dataset) {
+        (Some(p), _) => p.clone(),
+        (None, Some(d)) => d.join("ground_truth.glb"),
+        (None, None) => bail!("--gt FILE or --dataset DIR is required"),
+    };
+    let gt_cameras_path: Option<PathBuf> = input.gt_cameras.clone().or_else(|| {
+        let p = input.dataset.as_ref()?.join("cameras.json");
+        p.is_file().then_some(p)
+    });
+    let gt_cameras = match &gt_cameras_path {
         Some(p) => Some(
             model::read_model_files(&read_path_files(p)?)
                 .with_context(|| format!("ground-truth cameras '{}'", p.display()))?,
         ),
         None => None,
     };
-    let gt_bytes = read(&input.gt)?;
-    let external = gltf_neighbours(&input.gt, &gt_bytes);
-    let gt = io::read_ground_truth(&name_of(&input.gt), &gt_bytes, &external)
-        .with_context(|| format!("ground truth '{}'", input.gt.display()))?;
+    let gt_bytes = read(&gt_path)?;
+    let external = gltf_neighbours(&gt_path, &gt_bytes);
+    let gt = io::read_ground_truth(&name_of(&gt_path), &gt_bytes, &external)
+        .with_context(|| format!("ground truth '{}'", gt_path.display()))?;
     drop(gt_bytes);
     let recon = read_reconstruction(&name_of(&input.recon), &read_path_files(&input.recon)?)
         .with_context(|| format!("reconstruction '{}'", input.recon.display()))?;
     let prepared = PreparedGroundTruth::new(&gt.ground_truth, eval.samples, eval.seed, bars)
-        .with_context(|| format!("ground truth '{}'", input.gt.display()))?;
+        .with_context(|| format!("ground truth '{}'", gt_path.display()))?;
     let gt_info = GroundTruthInfo {
-        name: name_of(&input.gt),
+        name: name_of(&gt_path),
         format: gt.format.name().into(),
         warnings: gt.warnings,
     };
@@ -399,20 +447,40 @@ fn eval(args: &EvalArgs) -> Result<()> {
         signed: args.signed,
         histogram_bins: args.bins,
         crop: crop_from_args(args)?,
+        min_views: args.min_views,
     };
     options.validate()?;
     let bars = Bars::new(args.quiet);
     let l = load(&args.input, options, &bars)?;
-    let evaluation = pipeline::run(
+    let depth_dir = args.depth.clone().or_else(|| {
+        let d = args.input.dataset.as_ref()?.join("depth");
+        d.is_dir().then_some(d)
+    });
+    let views = match &depth_dir {
+        Some(dir) => {
+            let cams = l.gt_cameras.as_ref().ok_or_else(|| {
+                anyhow::anyhow!(
+                    "--depth needs the ground-truth cameras (--gt-cameras or --dataset)"
+                )
+            })?;
+            Some(load_views(dir, cams)?)
+        }
+        None => None,
+    };
+    let evaluation = pipeline::run_with_views(
         &l.prepared,
         &l.gt_info,
         &l.recon,
         l.gt_cameras.as_ref(),
+        views.as_deref(),
         &l.pairs,
         &l.run_options,
         &bars,
     )
     .with_context(|| format!("evaluating '{}'", args.input.recon.display()))?;
+    if let Some(path) = &args.samples_csv {
+        write_atomic(path, io::write::samples_csv(&evaluation).as_bytes())?;
+    }
     let report = &evaluation.report;
     let json = report.to_json();
     if let Some(path) = &args.report {

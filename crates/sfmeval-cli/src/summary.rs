@@ -103,6 +103,89 @@ pub fn render(r: &Report) -> String {
             t.f_score
         );
     }
+    if let Some(v) = &r.completeness_visible {
+        let _ = writeln!(
+            s,
+            "visible surface {:.2} % of the samples seen in ≥ {} of {} images ({} of {}){}",
+            v.visible_fraction * 100.0,
+            v.min_views,
+            v.views,
+            v.visible_samples,
+            v.samples,
+            v.visible_area
+                .map(|a| format!(", area {}", g(a)))
+                .unwrap_or_default()
+        );
+        let st = &v.stats;
+        let _ = writeln!(
+            s,
+            "{:<15} mean {}  median {}  rms {}  p90 {}  max {}  (GT visible → recon)",
+            "compl. visible",
+            g(st.mean),
+            g(st.median),
+            g(st.rms),
+            g(st.percentiles.p90),
+            g(st.max)
+        );
+        let _ = writeln!(
+            s,
+            "{:>14} {:>10} {:>14} {:>14}",
+            "tau", "recall", "recall visible", "F visible"
+        );
+        for t in &v.thresholds {
+            let _ = writeln!(
+                s,
+                "{:>14} {:>10.4} {:>14.4} {:>14.4}",
+                g(t.tau),
+                t.recall,
+                t.recall_visible,
+                t.f_score_visible
+            );
+        }
+    }
+    if let Some(t) = &r.track_error {
+        let st = &t.stats;
+        let _ = writeln!(
+            s,
+            "{:<15} mean {}  median {}  rms {}  p90 {}  max {}  ({} of {} points measured; their surface distance: mean {}, median {})",
+            "track error",
+            g(st.mean),
+            g(st.median),
+            g(st.rms),
+            g(st.percentiles.p90),
+            g(st.max),
+            t.measured,
+            t.points,
+            g(t.surface_distance.mean),
+            g(t.surface_distance.median)
+        );
+        let _ = writeln!(
+            s,
+            "observations    {} used of {} ({} trimmed; rejected: {} unmatched image, {} outside, {} silhouette, {} depth step; {})",
+            t.observations_used,
+            t.observations,
+            t.observations_trimmed,
+            t.rejected_unmatched_image,
+            t.rejected_outside_image,
+            t.rejected_background,
+            t.rejected_discontinuity,
+            t.observation_convention
+        );
+        let _ = writeln!(
+            s,
+            "{:>14} {:>10} {:>16}",
+            "tau", "sliding", "true err < tau"
+        );
+        for th in &t.thresholds {
+            let _ = writeln!(
+                s,
+                "{:>14} {:>10.4} {:>16.4}",
+                g(th.tau),
+                th.sliding_fraction,
+                th.true_error_below
+            );
+        }
+    }
     if let Some(c) = &r.cameras {
         let v = serde_json::json!({"cameras": c, "alignment": r.alignment});
         s.push_str(&render_cameras(&v));

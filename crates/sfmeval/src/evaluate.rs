@@ -42,6 +42,8 @@ pub struct EvalOptions {
     pub histogram_bins: usize,
     /// The crop, applied in the ground-truth frame after the transform.
     pub crop: Crop,
+    /// Images a surface sample must be seen in to count as visible (used with depth maps).
+    pub min_views: u32,
 }
 
 impl Default for EvalOptions {
@@ -54,6 +56,7 @@ impl Default for EvalOptions {
             signed: false,
             histogram_bins: DEFAULT_BINS,
             crop: Crop::default(),
+            min_views: crate::visibility::DEFAULT_MIN_VIEWS,
         }
     }
 }
@@ -77,6 +80,9 @@ impl EvalOptions {
         }
         if self.samples > 100_000_000 {
             return Err(Error::InvalidOption("samples must be ≤ 100000000".into()));
+        }
+        if self.min_views == 0 {
+            return Err(Error::InvalidOption("min views must be ≥ 1".into()));
         }
         if self.histogram_bins == 0 || self.histogram_bins > 100_000 {
             return Err(Error::InvalidOption(
@@ -239,6 +245,14 @@ pub struct Evaluation {
     pub completeness_points: Vec<Point3>,
     /// Their distances to the reconstruction.
     pub completeness_distances: Vec<f64>,
+    /// Per completeness sample, the ground-truth images that see it (with depth maps only).
+    pub sample_views: Option<Vec<u32>>,
+    /// Per completeness sample, covered / missed / unseen at the report's `labels_tau` (with
+    /// depth maps only).
+    pub sample_labels: Option<Vec<crate::visibility::SampleLabel>>,
+    /// Per reconstructed point (input order), its track-based true error; `None` when not
+    /// measured (with depth maps and tracks only).
+    pub track_errors: Option<Vec<Option<f64>>>,
 }
 
 /// The alignment part of an evaluation, decided before measuring.
@@ -453,6 +467,7 @@ pub fn evaluate(
             tau: options.tau.clone(),
             tau_percent_of_diagonal: percents,
             align: alignment.report.method.clone(),
+            min_views: None,
         },
         crop: CropReport {
             kind: crop.kind(),
@@ -490,6 +505,8 @@ pub fn evaluate(
         },
         thresholds,
         cameras: None,
+        completeness_visible: None,
+        track_error: None,
         warnings,
     };
     Ok(Evaluation {
@@ -500,5 +517,8 @@ pub fn evaluate(
         status,
         completeness_points,
         completeness_distances,
+        sample_views: None,
+        sample_labels: None,
+        track_errors: None,
     })
 }

@@ -28,6 +28,7 @@ pub mod distance;
 pub mod error;
 pub mod evaluate;
 pub mod geometry;
+pub mod gt_views;
 pub mod io;
 pub mod metrics;
 pub mod model;
@@ -39,6 +40,8 @@ pub mod report;
 pub mod sampling;
 pub mod spatial_order;
 pub mod stats;
+pub mod track_error;
 pub mod transform;
+pub mod visibility;
 
 pub use error::{Error, Result};

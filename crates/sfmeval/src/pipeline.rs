@@ -8,14 +8,21 @@ use std::collections::BTreeMap;
 use crate::align::{self, AlignInput, AlignMethod, AlignOptions, CameraPair, PointPair};
 use crate::error::{Error, Result};
 use crate::evaluate::{
-    AlignmentInput, EvalOptions, Evaluation, InputInfo, PreparedGroundTruth, evaluate,
+    AlignmentInput, EvalOptions, Evaluation, InputInfo, PointStatus, PreparedGroundTruth, evaluate,
 };
 use crate::geometry::PointCloud;
+use crate::gt_views::GtView;
 use crate::io;
+use crate::metrics::{f_score, share_below};
 use crate::model::{self, Reconstruction};
 use crate::pose::{PoseOptions, evaluate_cameras_matched};
 use crate::progress::{Progress, Stage};
+use crate::report::{
+    SlidingThresholdReport, TrackErrorReport, VisibleCompletenessReport, VisibleThresholdReport,
+};
+use crate::stats::Statistics;
 use crate::transform::Similarity;
+use crate::{track_error, visibility};
 
 /// A reconstruction as read: its cloud, and its cameras when the format has them.
 #[derive(Debug, Clone)]
@@ -160,6 +167,33 @@ pub fn run(
     options: &RunOptions,
     progress: &dyn Progress,
 ) -> Result<Evaluation> {
+    run_with_views(
+        gt,
+        gt_info,
+        recon,
+        gt_cameras,
+        None,
+        point_pairs,
+        options,
+        progress,
+    )
+}
+
+/// [`run`] with the ground-truth views (cameras + depth maps, [`crate::gt_views::build_views`]
+/// over the same `gt_cameras`): adds completeness over the visible surface
+/// ([`crate::visibility`]) and, for reconstructions with tracks, the track-based true error
+/// ([`crate::track_error`]).
+#[allow(clippy::too_many_arguments)]
+pub fn run_with_views(
+    gt: &PreparedGroundTruth,
+    gt_info: &GroundTruthInfo,
+    recon: &ReconInput,
+    gt_cameras: Option<&Reconstruction>,
+    views: Option<&[GtView]>,
+    point_pairs: &[PointPair],
+    options: &RunOptions,
+    progress: &dyn Progress,
+) -> Result<Evaluation> {
     let mut warnings: Vec<String> = gt_info
         .warnings
         .iter()
@@ -244,7 +278,199 @@ pub fn run(
         }
         evaluation.report.cameras = Some(value);
     }
+    if let Some(views) = views {
+        add_visibility(&mut evaluation, views, options, progress)?;
+        match (gt_cameras, &recon.model) {
+            (Some(g), Some(e)) if e.points.iter().any(|p| !p.track.is_empty()) => {
+                add_track_error(&mut evaluation, g, e, views, &alignment, progress)?;
+            }
+            _ => evaluation.report.warnings.push(
+                "depth maps were given but the reconstruction has no tracks (or no ground-truth cameras): no track-based error".into(),
+            ),
+        }
+    }
     Ok(evaluation)
+}
+
+fn add_visibility(
+    evaluation: &mut Evaluation,
+    views: &[GtView],
+    options: &RunOptions,
+    progress: &dyn Progress,
+) -> Result<()> {
+    let min_views = options.eval.min_views;
+    progress.start(
+        Stage::Visibility,
+        evaluation.completeness_points.len() as u64,
+    );
+    let counts = visibility::count_views(views, &evaluation.completeness_points, progress);
+    progress.finish();
+    let report = &mut evaluation.report;
+    let visible: Vec<f64> = counts
+        .iter()
+        .zip(&evaluation.completeness_distances)
+        .filter(|(n, _)| **n >= min_views)
+        .map(|(_, d)| *d)
+        .collect();
+    let finite: Vec<f64> = visible.iter().copied().filter(|d| d.is_finite()).collect();
+    let samples = counts.len();
+    let fraction = if samples > 0 {
+        visible.len() as f64 / samples as f64
+    } else {
+        0.0
+    };
+    let thresholds = report
+        .thresholds
+        .iter()
+        .map(|t| {
+            let recall_visible = share_below(&visible, t.tau);
+            VisibleThresholdReport {
+                tau: t.tau,
+                recall: t.recall,
+                recall_visible,
+                f_score_visible: f_score(t.precision, recall_visible),
+            }
+        })
+        .collect();
+    let labels_tau = report.thresholds.first().map_or(0.0, |t| t.tau);
+    let whole_surface = report.crop.volume.is_none() && report.inputs.ground_truth.area > 0.0;
+    if visible.is_empty() {
+        report.warnings.push(format!(
+            "no ground-truth sample is seen in {min_views} or more images: check that the depth maps belong to these cameras"
+        ));
+    }
+    report.options.min_views = Some(u64::from(min_views));
+    report.completeness_visible = Some(VisibleCompletenessReport {
+        direction: "ground_truth_to_reconstruction".into(),
+        min_views: u64::from(min_views),
+        views: views.len() as u64,
+        samples: samples as u64,
+        visible_samples: visible.len() as u64,
+        visible_fraction: fraction,
+        visible_area: whole_surface.then_some(fraction * report.inputs.ground_truth.area),
+        labels_tau,
+        stats: Statistics::of(&finite, report.options.histogram_bins as usize),
+        thresholds,
+    });
+    evaluation.sample_labels = Some(visibility::labels(
+        &counts,
+        &evaluation.completeness_distances,
+        min_views,
+        labels_tau,
+    ));
+    evaluation.sample_views = Some(counts);
+    Ok(())
+}
+
+fn add_track_error(
+    evaluation: &mut Evaluation,
+    gt_cameras: &Reconstruction,
+    est: &Reconstruction,
+    views: &[GtView],
+    alignment: &AlignmentInput,
+    progress: &dyn Progress,
+) -> Result<()> {
+    if views.len() != gt_cameras.images.len() {
+        return Err(Error::InvalidOption(format!(
+            "{} ground-truth views for {} ground-truth images: build the views from the same cameras",
+            views.len(),
+            gt_cameras.images.len()
+        )));
+    }
+    let matches = model::matching::match_images(gt_cameras, est);
+    let mut view_of_image: Vec<Option<usize>> = vec![None; est.images.len()];
+    for &(g, e) in &matches.pairs {
+        if let Some(slot) = view_of_image.get_mut(e) {
+            *slot = Some(g);
+        }
+    }
+    progress.start(Stage::TrackError, est.points.len() as u64);
+    let (convention, outcomes) = track_error::track_errors(
+        est,
+        views,
+        &view_of_image,
+        &alignment.gt_from_recon,
+        progress,
+    );
+    progress.finish();
+    // The evaluated cloud is the model's points in order (`Reconstruction::to_point_cloud`).
+    let report = &mut evaluation.report;
+    if outcomes.len() != evaluation.distances.len() {
+        report.warnings.push(format!(
+            "track error skipped: the model has {} points but {} were evaluated",
+            outcomes.len(),
+            evaluation.distances.len()
+        ));
+        return Ok(());
+    }
+    let mut errors = Vec::new();
+    let mut surface = Vec::new();
+    let mut sums = [0u64; 7];
+    let mut kept_points = 0u64;
+    for ((o, d), s) in outcomes
+        .iter()
+        .zip(&evaluation.distances)
+        .zip(&evaluation.status)
+    {
+        if *s != PointStatus::Kept {
+            continue;
+        }
+        kept_points += 1;
+        sums[0] += u64::from(o.observations);
+        sums[1] += u64::from(o.used);
+        sums[2] += u64::from(o.trimmed);
+        for k in 0..4 {
+            sums[3 + k] += u64::from(o.rejected[k]);
+        }
+        if let Some(e) = o.true_error {
+            errors.push(e);
+            surface.push(*d);
+        }
+    }
+    let bins = report.options.histogram_bins as usize;
+    let n = errors.len().max(1) as f64;
+    let thresholds = report
+        .thresholds
+        .iter()
+        .map(|t| SlidingThresholdReport {
+            tau: t.tau,
+            sliding_fraction: errors
+                .iter()
+                .zip(&surface)
+                .filter(|(e, s)| **e - **s > t.tau)
+                .count() as f64
+                / n,
+            true_error_below: share_below(&errors, t.tau),
+        })
+        .collect();
+    if errors.is_empty() {
+        report.warnings.push(
+            "no reconstructed point could be measured against its track (no image matched by name, or every observation fell on a silhouette)".into(),
+        );
+    }
+    let convention = serde_json::to_value(convention)
+        .ok()
+        .and_then(|v| v.as_str().map(str::to_string))
+        .unwrap_or_default();
+    report.track_error = Some(TrackErrorReport {
+        direction: "reconstruction_to_track_truth".into(),
+        observation_convention: convention,
+        min_observations: track_error::MIN_OBSERVATIONS as u64,
+        points: kept_points,
+        measured: errors.len() as u64,
+        observations: sums[0],
+        observations_used: sums[1],
+        observations_trimmed: sums[2],
+        rejected_unmatched_image: sums[3],
+        rejected_outside_image: sums[4],
+        rejected_background: sums[5],
+        rejected_discontinuity: sums[6],
+        stats: Statistics::of(&errors, bins),
+        surface_distance: Statistics::of(&surface, bins),
+        thresholds,
+    });
+    evaluation.track_errors = Some(outcomes.iter().map(|o| o.true_error).collect());
+    Ok(())
 }
 
 /// Camera-pose metrics without a ground-truth geometry: aligns by the matched camera centres
@@ -280,4 +506,172 @@ pub fn cameras_only(
     };
     let cams = evaluate_cameras_matched(gt_cameras, recon, &matches, &t, &options.pose)?;
     Ok((t, report, cams))
+}
+
+// Test data only: platform maths is fine here (reports use libm, see clippy.toml).
+#[cfg(test)]
+#[allow(clippy::disallowed_methods)]
+mod tests {
+    use super::*;
+    use crate::geometry::{GroundTruth, TriangleMesh};
+    use crate::gt_views::test_scenes::{look_at, render, sphere};
+    use crate::model::{Camera, Image, Observation, Point3D, TrackElement};
+    use crate::progress::NoProgress;
+
+    /// A UV sphere of radius 1 (sag below 3e-4, far below the depth tolerance).
+    fn uv_sphere(n_lon: usize, n_lat: usize) -> TriangleMesh {
+        let mut vertices = Vec::new();
+        for i in 0..=n_lat {
+            let lat = std::f64::consts::PI * (i as f64 / n_lat as f64 - 0.5);
+            for j in 0..n_lon {
+                let lon = 2.0 * std::f64::consts::PI * j as f64 / n_lon as f64;
+                vertices.push([lat.cos() * lon.cos(), lat.sin(), lat.cos() * lon.sin()]);
+            }
+        }
+        let mut triangles = Vec::new();
+        for i in 0..n_lat {
+            for j in 0..n_lon {
+                let a = (i * n_lon + j) as u32;
+                let b = (i * n_lon + (j + 1) % n_lon) as u32;
+                let c = a + n_lon as u32;
+                let d = b + n_lon as u32;
+                triangles.push([a, c, b]);
+                triangles.push([b, c, d]);
+            }
+        }
+        TriangleMesh {
+            vertices,
+            triangles,
+        }
+    }
+
+    #[test]
+    fn run_with_views_adds_visible_completeness_and_track_error() {
+        // 36 cameras on the equator at distance 2: the visible band is |latitude| < 60°, area
+        // fraction sin 60° (see the visibility tests). The reconstruction: points on the sphere
+        // with exact observations in every camera that sees them, named like the GT images.
+        let hit = sphere([0.0; 3], 1.0);
+        let mut gt_cams = Reconstruction::new("cameras_json");
+        let mut cam = Camera::simple(1, "PINHOLE", 300.0, 240.0, 240.0);
+        cam.width = 480;
+        cam.height = 480;
+        gt_cams.cameras.push(cam);
+        let mut views = Vec::new();
+        for k in 0..36 {
+            let phi = 2.0 * std::f64::consts::PI * k as f64 / 36.0;
+            let c = [2.0 * phi.cos(), 0.0, 2.0 * phi.sin()];
+            let mut v = render(look_at(c, [0.0; 3]), 300.0, 480, 480, &hit);
+            v.name = format!("{k:04}.png");
+            gt_cams.images.push(Image {
+                id: k + 1,
+                name: v.name.clone(),
+                camera_id: 1,
+                cam_from_world: v.cam_from_world,
+                observations: vec![],
+            });
+            views.push(v);
+        }
+        let mut est = gt_cams.clone();
+        est.format = "colmap";
+        for im in &mut est.images {
+            im.name = format!("images/{}", im.name.replace(".png", ".PNG"));
+        }
+        let mut rng_state = 1u64;
+        let mut next = || {
+            rng_state = rng_state
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (rng_state >> 11) as f64 / (1u64 << 53) as f64
+        };
+        for p in 0..400 {
+            let (lat, lon): (f64, f64) = ((next() - 0.5) * 1.6, next() * std::f64::consts::TAU);
+            let x = [lat.cos() * lon.cos(), lat.sin(), lat.cos() * lon.sin()];
+            let mut track = Vec::new();
+            for (i, v) in views.iter().enumerate() {
+                if crate::visibility::sees(v, x) {
+                    let (u, vv, _) = v.project(x).unwrap();
+                    let im = &mut est.images[i];
+                    track.push(TrackElement {
+                        image: i,
+                        keypoint: im.observations.len() as u64,
+                    });
+                    im.observations.push(Observation {
+                        xy: [u, vv],
+                        point: Some(p),
+                    });
+                }
+            }
+            est.points.push(Point3D {
+                xyz: x,
+                color: None,
+                error: None,
+                track,
+            });
+        }
+        let recon = ReconInput {
+            cloud: est.to_point_cloud(),
+            model: Some(est),
+            name: "synthetic".into(),
+            format: "colmap".into(),
+            warnings: vec![],
+        };
+        let gt = GroundTruth::Mesh(uv_sphere(128, 64));
+        let options = RunOptions {
+            eval: EvalOptions {
+                samples: 20_000,
+                tau: vec![0.01, 0.05],
+                ..EvalOptions::default()
+            },
+            align: AlignRequest::None,
+            ..RunOptions::default()
+        };
+        let prepared = PreparedGroundTruth::new(&gt, 20_000, 0, &NoProgress).unwrap();
+        let info = GroundTruthInfo::default();
+        let e = run_with_views(
+            &prepared,
+            &info,
+            &recon,
+            Some(&gt_cams),
+            Some(&views),
+            &[],
+            &options,
+            &NoProgress,
+        )
+        .unwrap();
+        let vis = e.report.completeness_visible.as_ref().unwrap();
+        assert_eq!((vis.views, vis.min_views, vis.samples), (36, 2, 20_000));
+        let expected = 3f64.sqrt() / 2.0;
+        assert!(
+            (vis.visible_fraction - expected).abs() < 0.01,
+            "{}",
+            vis.visible_fraction
+        );
+        assert_eq!(e.report.options.min_views, Some(2));
+        assert_eq!(e.sample_labels.as_ref().unwrap().len(), 20_000);
+        assert_eq!(vis.labels_tau, 0.01);
+        // Recall over the visible part is higher: the points cover |lat| < 46° only.
+        assert!(vis.thresholds[1].recall_visible > vis.thresholds[1].recall);
+        let te = e.report.track_error.as_ref().unwrap();
+        assert_eq!(te.points, 400);
+        assert!(te.measured >= 395, "{}", te.measured);
+        assert_eq!(te.rejected_unmatched_image, 0);
+        assert!(te.stats.max < 2e-3, "{}", te.stats.max);
+        assert_eq!(te.thresholds[0].sliding_fraction, 0.0);
+        assert_eq!(e.track_errors.as_ref().unwrap().len(), 400);
+        let json = e.report.to_json();
+        assert!(json.contains("\"completeness_visible\"") && json.contains("\"track_error\""));
+        // Without views, nothing changes in the report shape.
+        let plain = run(
+            &prepared,
+            &info,
+            &recon,
+            Some(&gt_cams),
+            &[],
+            &options,
+            &NoProgress,
+        )
+        .unwrap();
+        assert!(plain.report.completeness_visible.is_none() && plain.report.track_error.is_none());
+        assert!(!plain.report.to_json().contains("completeness_visible"));
+    }
 }

@@ -16,6 +16,10 @@ pub enum Stage {
     Completeness,
     /// Aligning the reconstruction.
     Alignment,
+    /// Counting the ground-truth images that see each surface sample.
+    Visibility,
+    /// Back-projecting the tracks of the reconstructed points.
+    TrackError,
 }
 
 impl Stage {
@@ -28,6 +32,8 @@ impl Stage {
             Stage::IndexReconstruction => "indexing reconstruction",
             Stage::Completeness => "completeness (GT → recon)",
             Stage::Alignment => "aligning",
+            Stage::Visibility => "visibility (depth maps)",
+            Stage::TrackError => "track error (depth maps)",
         }
     }
 }

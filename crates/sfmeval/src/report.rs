@@ -31,6 +31,14 @@ pub struct Report {
     pub thresholds: Vec<ThresholdReport>,
     /// Camera pose errors (null when no cameras were given).
     pub cameras: Option<serde_json::Value>,
+    /// Completeness over the part of the surface the ground-truth images see (only when depth
+    /// maps were given).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub completeness_visible: Option<VisibleCompletenessReport>,
+    /// Track-based true error of the reconstructed points (only when depth maps were given and
+    /// the reconstruction has tracks).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub track_error: Option<TrackErrorReport>,
     /// Things the user should know.
     pub warnings: Vec<String>,
 }
@@ -109,6 +117,9 @@ pub struct ReportOptions {
     pub tau_percent_of_diagonal: Vec<f64>,
     /// Requested alignment method.
     pub align: String,
+    /// Images a surface sample must be seen in to count as visible (only with depth maps).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub min_views: Option<u64>,
 }
 
 /// What the crop did.
@@ -219,6 +230,96 @@ pub struct ThresholdReport {
     pub recall: f64,
     /// 2PR / (P + R), 0 when both are 0.
     pub f_score: f64,
+}
+
+/// Completeness over the visible part of the surface: the completeness samples seen in at least
+/// `min_views` ground-truth images (`crate::visibility`).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct VisibleCompletenessReport {
+    /// Always `ground_truth_to_reconstruction`.
+    pub direction: String,
+    /// Images a sample must be seen in.
+    pub min_views: u64,
+    /// Ground-truth images with a depth map.
+    pub views: u64,
+    /// Completeness samples considered (inside the crop volume).
+    pub samples: u64,
+    /// Of those, the visible ones.
+    pub visible_samples: u64,
+    /// `visible_samples / samples`: the visible share of the (cropped) surface.
+    pub visible_fraction: f64,
+    /// Visible area in squared ground-truth units (mesh ground truth without crop volume only).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub visible_area: Option<f64>,
+    /// The threshold of the per-sample labels covered / missed / unseen (the first threshold).
+    pub labels_tau: f64,
+    /// Statistics of the visible samples' distances to the reconstruction.
+    #[serde(flatten)]
+    pub stats: Statistics,
+    /// Recall over the whole surface and over the visible part, per threshold.
+    pub thresholds: Vec<VisibleThresholdReport>,
+}
+
+/// Recall at one threshold, over all samples and over the visible ones.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct VisibleThresholdReport {
+    /// Threshold in ground-truth units.
+    pub tau: f64,
+    /// Share of all samples closer than tau to the reconstruction (as in `thresholds`).
+    pub recall: f64,
+    /// Share of visible samples closer than tau to the reconstruction.
+    pub recall_visible: f64,
+    /// F-score of the precision and `recall_visible`.
+    pub f_score_visible: f64,
+}
+
+/// Track-based true error (`crate::track_error`).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct TrackErrorReport {
+    /// Always `reconstruction_to_track_truth`: from each aligned point to the robust mean of its
+    /// observations back-projected on the ground-truth depth maps.
+    pub direction: String,
+    /// How the observations were read: `colmap_pixels`, `centered_y_down`, `centered_y_up`.
+    pub observation_convention: String,
+    /// Kept back-projections a point needs to be measured.
+    pub min_observations: u64,
+    /// Points of the model kept by the crop.
+    pub points: u64,
+    /// Of those, the points measured.
+    pub measured: u64,
+    /// Observations of the kept points.
+    pub observations: u64,
+    /// Observations whose back-projection entered a robust mean.
+    pub observations_used: u64,
+    /// Back-projections trimmed as outliers of their track.
+    pub observations_trimmed: u64,
+    /// Observations in images without a ground-truth image of the same name.
+    pub rejected_unmatched_image: u64,
+    /// Observations outside the ground-truth image.
+    pub rejected_outside_image: u64,
+    /// Observations on a silhouette (a background pixel in the neighbourhood).
+    pub rejected_background: u64,
+    /// Observations on a depth step.
+    pub rejected_discontinuity: u64,
+    /// Statistics of the true errors of the measured points.
+    #[serde(flatten)]
+    pub stats: Statistics,
+    /// Statistics of the nearest-surface distances of the same points, for comparison.
+    pub surface_distance: Statistics,
+    /// Sliding points per threshold.
+    pub thresholds: Vec<SlidingThresholdReport>,
+}
+
+/// Sliding points at one threshold.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct SlidingThresholdReport {
+    /// Threshold in ground-truth units.
+    pub tau: f64,
+    /// Share of measured points whose true error exceeds their surface distance by more than
+    /// tau: on (or near) the surface, but not where their features are.
+    pub sliding_fraction: f64,
+    /// Share of measured points whose true error is below tau (a track-based precision).
+    pub true_error_below: f64,
 }
 
 impl Report {

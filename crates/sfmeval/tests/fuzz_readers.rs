@@ -9,8 +9,14 @@ use rand_chacha::ChaCha8Rng;
 use sfmeval::io;
 
 fn fixture(name: &str) -> Vec<u8> {
+    let folder = if name.ends_with(".npy") {
+        "npy"
+    } else {
+        "core"
+    };
     let p = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-        .join("../../tests/fixtures/core")
+        .join("../../tests/fixtures")
+        .join(folder)
         .join(name);
     std::fs::read(&p).unwrap_or_else(|e| panic!("{}: {e}", p.display()))
 }
@@ -100,6 +106,23 @@ fn gltf_reader_survives_mutations() {
     for name in ["trimesh_mesh.glb", "blender_monkey.glb"] {
         run(name, 6000, |b| {
             let _ = io::gltf::read_gltf(b, &BTreeMap::new());
+        });
+    }
+}
+
+#[test]
+fn npy_reader_survives_mutations() {
+    for name in [
+        "depth_f4_v1.npy",
+        "depth_f8_v2.npy",
+        "depth_f4_v3.npy",
+        "small_f8_be.npy",
+    ] {
+        run(name, 3000, |b| {
+            if let Ok(a) = io::npy::read_npy(b) {
+                assert_eq!(a.values.len(), a.rows * a.cols);
+            }
+            let _ = io::npy::DepthMap::from_npy(b);
         });
     }
 }

@@ -1,6 +1,7 @@
 //! Readers and writers, all on bytes. Format detection by name and content.
 
 pub mod gltf;
+pub mod npy;
 pub mod obj;
 pub mod ply;
 pub mod write;

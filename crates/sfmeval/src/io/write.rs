@@ -39,10 +39,17 @@ pub fn colored_ply(eval: &Evaluation, clip: f64) -> Vec<u8> {
 
 /// CSV with one row per reconstructed point: index, position in the ground-truth frame,
 /// distance, signed distance (empty when not computed) and status (`kept`, `outside_volume`,
-/// `too_far`).
+/// `too_far`); with depth maps and tracks, a last column `track_error` (empty when the point
+/// was not measured).
 pub fn distances_csv(eval: &Evaluation) -> String {
     let mut s = String::with_capacity(eval.points_in_gt.len() * 64);
-    s.push_str("index,x,y,z,distance,signed_distance,status\n");
+    s.push_str("index,x,y,z,distance,signed_distance,status");
+    let track = eval.track_errors.as_ref();
+    s.push_str(if track.is_some() {
+        ",track_error\n"
+    } else {
+        "\n"
+    });
     for (i, p) in eval.points_in_gt.iter().enumerate() {
         let signed = eval
             .signed_distances
@@ -54,11 +61,46 @@ pub fn distances_csv(eval: &Evaluation) -> String {
             PointStatus::OutsideVolume => "outside_volume",
             PointStatus::TooFar => "too_far",
         };
-        let _ = writeln!(
+        let _ = write!(
             s,
             "{i},{},{},{},{},{signed},{status}",
             p[0], p[1], p[2], eval.distances[i]
         );
+        if let Some(t) = track {
+            let v = t.get(i).copied().flatten();
+            let _ = write!(s, ",{}", v.map(|v| v.to_string()).unwrap_or_default());
+        }
+        s.push('\n');
+    }
+    s
+}
+
+/// CSV with one row per completeness sample (inside the crop volume): index, position in the
+/// ground-truth frame, distance to the reconstruction, and with depth maps the number of
+/// ground-truth images that see it and its label (`covered`, `missed`, `unseen`).
+pub fn samples_csv(eval: &Evaluation) -> String {
+    use crate::visibility::SampleLabel;
+    let mut s = String::with_capacity(eval.completeness_points.len() * 64);
+    s.push_str("index,x,y,z,distance,views,label\n");
+    for (i, p) in eval.completeness_points.iter().enumerate() {
+        let views = eval
+            .sample_views
+            .as_ref()
+            .and_then(|v| v.get(i))
+            .map(|v| v.to_string())
+            .unwrap_or_default();
+        let label = match eval.sample_labels.as_ref().and_then(|l| l.get(i)) {
+            Some(SampleLabel::Covered) => "covered",
+            Some(SampleLabel::Missed) => "missed",
+            Some(SampleLabel::Unseen) => "unseen",
+            None => "",
+        };
+        let d = eval
+            .completeness_distances
+            .get(i)
+            .copied()
+            .unwrap_or(f64::NAN);
+        let _ = writeln!(s, "{i},{},{},{},{d},{views},{label}", p[0], p[1], p[2]);
     }
     s
 }
