@@ -95,32 +95,44 @@ def last_json(stdout):
     return json.loads(lines[-1])
 
 
+def measure_cloudcompare(op, ctx, rounds):
+    """CloudCompare's op: (op run − load-only run) of its own "Processed finished" times, then one
+    untimed run that saves the distances. None when CloudCompare has no such op."""
+    if op not in cloudcompare.OPS:
+        return None
+    f, cwd, env = ctx["files"], ctx["work"], cloudcompare.env()
+    base, cmd, save = cloudcompare.commands(op, f, ctx["samples"])
+    for old in list(Path(cwd).glob("*.asc")) + list(Path(cwd).glob("*_REGISTRATION_MATRIX.txt")):
+        old.unlink()
+    secs, walls, peaks = [], [], []
+    for _ in range(rounds):
+        base_s = 0.0
+        if base:
+            _, _, rc, out, err = run_with_peak(base, env, cwd)
+            if rc != 0:
+                raise Failed(f"load-only run exit {rc}: {(err or out)[-500:]}")
+            base_s = cloudcompare.finished_seconds(out)
+        w, peak, rc, out, err = run_with_peak(cmd, env, cwd)
+        if rc != 0:
+            raise Failed(f"exit {rc}: {(err or out)[-500:]}")
+        secs.append(cloudcompare.finished_seconds(out) - base_s)
+        walls.append(w), peaks.append(peak)
+    if op == "load":
+        result = cloudcompare.load_result(out)
+    else:
+        if save:
+            _, _, rc, out, err = run_with_peak(cmd + save, env, cwd)
+            if rc != 0:
+                raise Failed(f"saving run exit {rc}: {(err or out)[-500:]}")
+        result = cloudcompare.result(op, f, Path(cwd))
+    return dict(seconds=statistics.median(secs), wall=statistics.median(walls), peak=max(peaks), result=result)
+
+
 def measure(tool, op, ctx, rounds):
     """Runs one tool's op `rounds` times. Returns a row dict, or None when unsupported."""
-    f = ctx["files"]
     if tool == "CloudCompare":
-        if op not in cloudcompare.OPS:
-            return None
-        base, cmd, save = cloudcompare.commands(op, f, ctx["samples"])
-        env, cwd = cloudcompare.env(), ctx["work"]
-        secs, walls, peaks = [], [], []
-        for _ in range(rounds):
-            b = run_with_peak(base, env, cwd) if base else None
-            w, peak, rc, out, err = run_with_peak(cmd, env, cwd)
-            if rc != 0:
-                raise Failed(f"exit {rc}: {(err or out)[-500:]}")
-            secs.append(cloudcompare.finished_seconds(out) - (cloudcompare.finished_seconds(b[3]) if b else 0.0))
-            walls.append(w), peaks.append(peak)
-        if op == "load":
-            result = cloudcompare.load_result(out)
-        else:
-            if save:
-                w2, _, rc, out2, err2 = run_with_peak(cmd + save, env, cwd)
-                if rc != 0:
-                    raise Failed(f"check run exit {rc}: {(err2 or out2)[-500:]}")
-            result = cloudcompare.result(op, f, Path(cwd))
-        return dict(seconds=statistics.median(secs), wall=statistics.median(walls), peak=max(peaks), result=result)
-
+        return measure_cloudcompare(op, ctx, rounds)
+    f = ctx["files"]
     env = dict(os.environ)
     threads = ctx["threads"]
     if tool.startswith("sfmeval"):
