@@ -1,7 +1,8 @@
 #!/usr/bin/env python3
 """Side-by-side benchmark: sfmeval against every installed anchor (Open3D, trimesh+scipy,
 point-cloud-utils, CloudCompare), operation by operation, on the same files, each run in its own
-process, several rounds, median; prints one markdown table per operation, ready for the README.
+process, several rounds (a run over SLOW_S seconds is not repeated), median; prints one markdown
+table per operation, ready for the README.
 
   scripts/bench.sh [options]            # from a fresh clone: installs the anchors, builds, generates data
   bench/compare.py [--quick] [--data DIR] [--rounds 3] [--sizes 10k,100k,1m] [--mesh 1m]
@@ -51,6 +52,7 @@ ACC_TOL = 1e-4       # relative, exact distances (float32 tools)
 COMP_TOL = 0.03      # relative, completeness means from independent samplers
 ALIGN_OK = 5e-3      # RMS displacement of the GT box corners after alignment / GT diagonal: the clouds' noise
 GNU_TIME = "/usr/bin/time"  # Debian package `time`
+SLOW_S = 60.0        # a run longer than this is not repeated (its row says "1 round")
 OPS = ["load", "bvh", "kdtree", "accuracy", "completeness", "c2c", "align", "eval"]
 SIZES = {"10k": 10_000, "100k": 100_000, "1m": 1_000_000}
 PY_ANCHORS = {"Open3D": "open3d_ops.py", "trimesh+scipy": "trimesh_ops.py", "point-cloud-utils": "pcu_ops.py"}
@@ -117,6 +119,8 @@ def measure_cloudcompare(op, ctx, rounds):
             raise Failed(f"exit {rc}: {(err or out)[-500:]}")
         secs.append(cloudcompare.finished_seconds(out) - base_s)
         walls.append(w), peaks.append(peak)
+        if w > SLOW_S:
+            break
     if op == "load":
         result = cloudcompare.load_result(out)
     else:
@@ -125,7 +129,8 @@ def measure_cloudcompare(op, ctx, rounds):
             if rc != 0:
                 raise Failed(f"saving run exit {rc}: {(err or out)[-500:]}")
         result = cloudcompare.result(op, f, Path(cwd))
-    return dict(seconds=statistics.median(secs), wall=statistics.median(walls), peak=max(peaks), result=result)
+    return dict(seconds=statistics.median(secs), wall=statistics.median(walls), peak=max(peaks), result=result,
+                rounds=len(secs))
 
 
 def measure(tool, op, ctx, rounds):
@@ -166,7 +171,10 @@ def measure(tool, op, ctx, rounds):
             result = j["result"]
             secs.append(w if op == "eval" else j["seconds"])
         walls.append(w), peaks.append(peak)
-    return dict(seconds=statistics.median(secs), wall=statistics.median(walls), peak=max(peaks), result=result)
+        if w > SLOW_S:
+            break
+    return dict(seconds=statistics.median(secs), wall=statistics.median(walls), peak=max(peaks), result=result,
+                rounds=len(secs))
 
 
 # ---- agreement ------------------------------------------------------------------------------
@@ -408,7 +416,8 @@ def table(op, size, n, rows, fastest, ctx, args):
         ratio = f"{r['seconds'] / fastest:.2f}×" if fastest else "—"
         res = r["agreement"] if op == "align" else result_text(op, r["result"])
         agree = ("✓" if r["agrees"] else "✗") if op == "align" else r["agreement"]
-        lines.append(f"| {tool} | {r['seconds']:.3f} | {r['wall']:.2f} | {r['peak']:.0f} | {ratio} | {res} | {agree} |")
+        once = " (1 round)" if r["rounds"] < args.rounds else ""
+        lines.append(f"| {tool} | {r['seconds']:.3f}{once} | {r['wall']:.2f} | {r['peak']:.0f} | {ratio} | {res} | {agree} |")
     return head + "\n".join(lines)
 
 

@@ -10,7 +10,11 @@ Headless quirks handled here: QT_QPA_PLATFORM=offscreen (no X server), -SILENT (
 window), -AUTO_SAVE OFF (every command would otherwise write its result next to the input),
 -NO_TIMESTAMP (predictable output names), output files land next to the *input path*, so the
 driver gives symlinks inside a scratch directory (never the data directory), and C2M distances
-are signed (the absolute value is compared). No separate index build (its octree is internal)
+are signed (the absolute value is compared). Wrong answers seen: on bench/data's 1M-triangle
+mesh, C2M overestimates the distance of points near the two poles, where 1000 sliver triangles
+meet (cloud_10k: 96 points off by more than 1e-4 relative, some 0.0005 → 0.018; the mean is
+0.1 % high), so compare.py flags its accuracy there; on the 50k mesh it agrees to 1e-10. Its
+ICP runs one C2M pass per iteration: minutes on 100k points. No separate index build (its octree is internal)
 and no whole-`eval` equivalent in one command line.
 
   load          -O mesh -O cloud
