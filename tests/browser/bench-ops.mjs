@@ -15,8 +15,9 @@
 //   completeness  sampling + k-d tree + completeness queries    vs `bench_op completeness`
 //   eval          load + evaluate                               vs `sfmeval eval --threads 1` wall time
 import { execFileSync } from 'node:child_process';
-import { readFileSync } from 'node:fs';
-import { basename, resolve } from 'node:path';
+import { mkdtempSync, readFileSync, rmSync } from 'node:fs';
+import { tmpdir } from 'node:os';
+import { basename, join as pjoin, resolve } from 'node:path';
 
 const root = resolve(new URL('../..', import.meta.url).pathname);
 const args = Object.fromEntries(process.argv.slice(2).reduce((a, v, i, all) => (v.startsWith('--') ? [...a, [v.slice(2), all[i + 1]]] : a), []));
@@ -64,9 +65,12 @@ for (const name of ['load', 'bvh', 'accuracy', 'completeness']) {
   native[name] = r.seconds * 1000;
   nativeResult[name] = r.result;
 }
+// The CLI writes its report atomically (temporary file + rename): never point it at /dev/null.
+const scratch = mkdtempSync(pjoin(tmpdir(), 'sfmeval-bench-ops-'));
 t = performance.now();
-execFileSync(cli, ['eval', '--gt', mesh, '--recon', cloud, '--samples', String(samples), '--threads', '1', '--align', 'none', '--quiet', '--report', '/dev/null']);
+execFileSync(cli, ['eval', '--gt', mesh, '--recon', cloud, '--samples', String(samples), '--threads', '1', '--align', 'none', '--quiet', '--report', pjoin(scratch, 'report.json')]);
 native.eval = performance.now() - t;
+rmSync(scratch, { recursive: true, force: true });
 
 // ---- table ---------------------------------------------------------------------------------
 const same = Math.abs(report.accuracy.mean - nativeResult.accuracy.mean) <= 1e-12 * nativeResult.accuracy.mean
