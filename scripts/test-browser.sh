@@ -4,7 +4,8 @@
 # and in a bundler-free page in Chromium (report byte for byte the CLI's), every alignment path
 # through the npm package in Node against the CLI (byte for byte), and the page end to end in
 # Chromium via playwright-core.
-# SFMEVAL_BENCH=1 also runs the speed benchmark (bench/data; not a test).
+# SFMEVAL_BENCH=1 also runs the speed benchmarks (bench/data; not tests): whole eval in the page,
+# and per operation in Node (tests/browser/bench-ops.mjs).
 # Ends with "N passed, N failed".
 set -uo pipefail
 cd "$(dirname "$0")/.."
@@ -89,6 +90,9 @@ echo "e2e: $((SECONDS - t)) s (screenshots in $out)"
 
 if [ "${SFMEVAL_BENCH:-0}" = 1 ]; then
   node tests/browser/bench.mjs --url "http://127.0.0.1:$port/" --cli target/release/sfmeval 2>&1 | tee "$log/bench.log"
+  # per operation, npm package in Node vs native with one thread (needs examples/bench_op)
+  cargo build --release --locked -q -p sfmeval --features parallel --example bench_op &&
+    node tests/browser/bench-ops.mjs 2>&1 | tee "$log/bench-ops.log"
 fi
 kill $server 2>/dev/null
 echo "$passed passed, $failed failed"

@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Runs every test of sfmeval: formatting, lints, docs, the wasm32 build of the core, the Rust unit
 # and integration tests, and the Python tests that compare sfmeval with independent tools (Open3D,
-# trimesh, scipy, pycolmap, Blender). Prints a final "N passed, N failed" line.
+# trimesh, scipy, pycolmap, Blender), and the benchmark in quick mode. Prints a final "N passed, N failed" line.
 # Needs scripts/setup.sh first.
 set -uo pipefail
 cd "$(dirname "$0")/.."
@@ -38,6 +38,10 @@ if [ $rc -ne 0 ]; then
   failures+=("cargo test"); grep -E "^(test .* FAILED|---- |error)" -A 15 "$log/cargo-test.log" | head -80
 fi
 echo "cargo test: $p passed, $f failed ($((SECONDS - t)) s)"
+
+# The side-by-side benchmark in its quick mode (tiny data, one round): every installed anchor
+# must run and agree with sfmeval, so bench/compare.py cannot rot.
+check bench-compare-quick .venv/bin/python bench/compare.py --quick
 
 # Python tests (reference tools, real files).
 export SFMEVAL_BIN="$PWD/target/release/sfmeval"
