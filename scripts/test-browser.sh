@@ -65,7 +65,9 @@ node tests/browser/npm-test.mjs target/web/sfmeval-*.tgz "$out/cli-demo.json" >"
 rc=$?
 count "$log/npm.log"
 [ $rc -ne 0 ] && ! grep -q '^FAILED' "$log/npm.log" && fail "npm-test" "$log/npm.log"
-node tests/browser/same-everywhere.mjs target/web/npm target/release/sfmeval "$out" >"$log/same.log" 2>&1
+rm -rf "$out/demo-depth"
+.venv/bin/python tests/browser/make_demo_depth.py "$out/demo-depth" >"$log/depth.log" 2>&1 || fail "make_demo_depth" "$log/depth.log"
+node tests/browser/same-everywhere.mjs target/web/npm target/release/sfmeval "$out" "$out/demo-depth" >"$log/same.log" 2>&1
 rc=$?
 count "$log/same.log"
 [ $rc -ne 0 ] && ! grep -q '^FAILED' "$log/same.log" && fail "same-everywhere" "$log/same.log"

@@ -111,6 +111,7 @@ async function loadGt(fileList) {
     state.gt = gt;
     state.beside = null;
     state.result = null;
+    viewer.setCoverage(null);
     viewer.setGroundTruth(gt.vertices, gt.triangles, gt.bounds);
     $('info-gt').textContent = `${gt.name} (${gt.format}): ${gt.vertexCount} vertices, ${gt.triangleCount} triangles`;
     showWarnings(gt.warnings);
@@ -135,6 +136,7 @@ async function loadRecon(fileList, name) {
     state.recon = r;
     state.beside = null;
     state.result = null;
+    viewer.setCoverage(null);
     state.pairs = [];
     updatePairs();
     $('info-recon').textContent = `${r.name} (${r.format}): ${r.count} points${r.images ? `, ${r.images} images` : ''}`;
@@ -160,12 +162,31 @@ async function loadCams(fileList) {
   }
 }
 
+async function loadDepth(fileList) {
+  showError('');
+  const npy = Array.from(fileList).filter((f) => /\.npy$/i.test(f.name));
+  if (!npy.length) { showError('depth maps: no .npy file among the dropped files'); return; }
+  const { files, transfer } = await readFiles(npy);
+  $('info-depth').textContent = 'reading…';
+  try {
+    const d = await call('loadDepth', { files }, transfer);
+    state.depthCount = d.count;
+    $('info-depth').textContent = `${d.count} depth maps${d.checked ? '' : ' (checked against cameras.json when evaluating)'}`;
+  } catch (e) {
+    state.depthCount = 0;
+    await call('clearDepth');
+    $('info-depth').textContent = '—';
+    showError(e.message);
+  }
+}
+
 function showWarnings(list) {
   $('warnings').innerHTML = (list || []).map((w) => `<div class="warn">warning: ${esc(w)}</div>`).join('');
 }
 
 $('dir-recon').addEventListener('change', (e) => handleFiles('recon', e.target.files));
-for (const [kind, input] of [['recon', 'file-recon'], ['gt', 'file-gt'], ['cams', 'file-cams']]) {
+$('dir-depth').addEventListener('change', (e) => handleFiles('depth', e.target.files));
+for (const [kind, input] of [['recon', 'file-recon'], ['gt', 'file-gt'], ['cams', 'file-cams'], ['depth', 'file-depth']]) {
   $(input).addEventListener('change', (e) => handleFiles(kind, e.target.files));
   const zone = $(`drop-${kind}`);
   zone.addEventListener('dragover', (e) => { e.preventDefault(); zone.classList.add('over'); });
@@ -174,7 +195,7 @@ for (const [kind, input] of [['recon', 'file-recon'], ['gt', 'file-gt'], ['cams'
     e.preventDefault();
     zone.classList.remove('over');
     const entries = Array.from(e.dataTransfer.items || []).map((i) => i.webkitGetAsEntry && i.webkitGetAsEntry()).filter(Boolean);
-    if (kind === 'recon' && entries.length === 1 && entries[0].isDirectory) {
+    if ((kind === 'recon' || kind === 'depth') && entries.length === 1 && entries[0].isDirectory) {
       try { handleFiles(kind, await folderFiles(entries[0])); } catch (err) { showError(err.message); }
     } else {
       handleFiles(kind, e.dataTransfer.files);
@@ -204,15 +225,16 @@ async function folderFiles(dir) {
     if (!batch.length) break;
     for (const c of batch) await walk(c, `${dir.name}/`);
   }
-  return out.filter((f) => /\.(bin|txt|nvm|out|json|ply)$/i.test(f.name));
+  return out.filter((f) => /\.(bin|txt|nvm|out|json|ply|npy)$/i.test(f.name));
 }
 
 function handleFiles(kind, files) {
   if (!files || !files.length) return;
-  const p = kind === 'gt' ? loadGt(files) : kind === 'recon' ? loadRecon(files) : loadCams(files);
+  const p = kind === 'gt' ? loadGt(files) : kind === 'recon' ? loadRecon(files) : kind === 'depth' ? loadDepth(files) : loadCams(files);
   p.catch((e) => showError(e.message));
 }
 $('clear-cams').onclick = async () => { await call('clearCameras'); state.camerasName = null; $('info-cams').textContent = '—'; };
+$('clear-depth').onclick = async () => { await call('clearDepth'); state.depthCount = 0; $('info-depth').textContent = '—'; };
 
 // ---- demo -------------------------------------------------------------------------------
 async function fetchFile(name) {
@@ -472,6 +494,10 @@ async function runEvaluation() {
     $('clip').value = r.clip;
     showResults(r);
     refreshPoints();
+    viewer.setCoverage(r.samplePoints, r.sampleLabels);
+    $('show-coverage').disabled = !r.sampleLabels;
+    $('show-coverage').checked = !!r.sampleLabels;
+    viewer.setVisible('coverage', $('show-coverage').checked);
     document.body.dataset.evaluated = String(Number(document.body.dataset.evaluated || 0) + 1);
   } catch (e) {
     showError(e.message);
@@ -498,11 +524,21 @@ function showResults(r) {
   h += statRow('accuracy', rep.accuracy, `recon → GT, ${rep.accuracy.metric}`);
   h += statRow('completeness', rep.completeness, `GT → recon, ${rep.completeness.samples} samples`);
   if (rep.accuracy.signed) h += statRow('signed', rep.accuracy.signed, 'signed accuracy');
-  h += '</table><table id="thresholds"><tr><th>tau</th><th>% diag</th><th>precision</th><th>recall</th><th>F-score</th></tr>';
+  const cv = rep.completeness_visible;
+  if (cv) h += statRow('completeness_visible', cv, `GT → recon, ${cv.visible_samples} of ${cv.samples} samples seen by ≥ ${cv.min_views} images`);
+  const te = rep.track_error;
+  if (te && te.count) h += statRow('track_error', te, `true error through ${te.measured} of ${te.points} tracks`);
+  const vis = cv ? new Map(cv.thresholds.map((t) => [t.tau, t])) : null;
+  const sl = te ? new Map(te.thresholds.map((t) => [t.tau, t])) : null;
+  h += `</table><table id="thresholds"><tr><th>tau</th><th>% diag</th><th>precision</th><th>recall</th><th>F-score</th>${vis ? '<th>recall (visible)</th><th>F (visible)</th>' : ''}${sl ? '<th>sliding</th>' : ''}</tr>`;
   for (const t of rep.thresholds) {
-    h += `<tr><td>${g(t.tau)}</td><td>${(t.tau_relative_to_diagonal * 100).toFixed(3)}</td><td>${t.precision.toFixed(4)}</td><td>${t.recall.toFixed(4)}</td><td>${t.f_score.toFixed(4)}</td></tr>`;
+    const v = vis && vis.get(t.tau);
+    const s = sl && sl.get(t.tau);
+    h += `<tr><td>${g(t.tau)}</td><td>${(t.tau_relative_to_diagonal * 100).toFixed(3)}</td><td>${t.precision.toFixed(4)}</td><td>${t.recall.toFixed(4)}</td><td>${t.f_score.toFixed(4)}</td>`
+      + `${vis ? `<td data-k="recall_visible">${v ? v.recall_visible.toFixed(4) : '—'}</td><td>${v ? v.f_score_visible.toFixed(4) : '—'}</td>` : ''}${sl ? `<td data-k="sliding">${s ? s.sliding_fraction.toFixed(4) : '—'}</td>` : ''}</tr>`;
   }
   h += '</table>';
+  if (cv) h += `<div class="line" id="r-visible">visible surface: <b id="r-visible-fraction">${(100 * cv.visible_fraction).toFixed(2)} %</b> of the ground truth (seen by ≥ ${cv.min_views} of ${cv.views} images); coverage colours at τ = ${g(cv.labels_tau)}</div>`;
   if (rep.cameras) {
     const cams = Object.entries(rep.cameras).filter(([, v]) => typeof v === 'number').map(([k, v]) => `${esc(k)} ${Number.isInteger(v) ? v : g(v)}`);
     h += `<div class="line" id="r-cameras">cameras: ${cams.join(', ')}</div>`;
@@ -580,6 +616,7 @@ $('clip').addEventListener('change', async () => {
 $('point-size').addEventListener('input', (e) => viewer.setPointSize(Number(e.target.value)));
 $('show-gt').addEventListener('change', (e) => viewer.setVisible('gt', e.target.checked));
 $('show-recon').addEventListener('change', (e) => viewer.setVisible('recon', e.target.checked));
+$('show-coverage').addEventListener('change', (e) => viewer.setVisible('coverage', e.target.checked));
 $('heat').addEventListener('change', refreshPoints);
 
 // downloads

@@ -112,14 +112,39 @@ export class Viewer {
     this.world.add(this.points);
   }
 
+  /**
+   * Shows the completeness samples coloured by label (0 covered: green, 1 missed: red,
+   * 2 unseen: grey); at most `max` of them, evenly strided. `null` removes them.
+   */
+  setCoverage(points, labels, max = 400000) {
+    if (this.coverage) { this.world.remove(this.coverage); this.coverage.geometry.dispose(); this.coverage = null; }
+    if (!points || !labels || !labels.length) return;
+    const step = Math.max(1, Math.ceil(labels.length / max));
+    const n = Math.ceil(labels.length / step);
+    const pos = new Float32Array(3 * n);
+    const col = new Uint8Array(3 * n);
+    const palette = [[67, 160, 71], [229, 57, 53], [120, 126, 134]];
+    for (let i = 0, k = 0; i < labels.length; i += step, k++) {
+      pos.set(points.subarray(3 * i, 3 * i + 3), 3 * k);
+      col.set(palette[labels[i]] ?? palette[2], 3 * k);
+    }
+    const g = new THREE.BufferGeometry();
+    g.setAttribute('position', new THREE.BufferAttribute(pos, 3));
+    g.setAttribute('color', new THREE.BufferAttribute(col, 3, true));
+    this.coverage = new THREE.Points(g, new THREE.PointsMaterial({ size: Math.max(1, this.pointSize - 1), sizeAttenuation: false, vertexColors: true }));
+    this.coverage.name = 'coverage';
+    this.world.add(this.coverage);
+  }
+
   setPointSize(s) {
     this.pointSize = s;
     if (this.points) this.points.material.size = s;
+    if (this.coverage) this.coverage.material.size = Math.max(1, s - 1);
     if (this.gtMesh && this.gtMesh.isPoints) this.gtMesh.material.size = s;
   }
 
   setVisible(name, v) {
-    const o = name === 'gt' ? this.gtMesh : this.points;
+    const o = name === 'gt' ? this.gtMesh : name === 'coverage' ? this.coverage : this.points;
     if (o) o.visible = v;
   }
 

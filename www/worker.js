@@ -8,6 +8,7 @@ import {
 let gt = null;
 let recon = null;
 let cameraFiles = null; // attached to each new ground truth
+let depthFiles = null; // attached after the cameras
 let last = null; // the last raw Evaluation
 
 const handlers = {
@@ -55,11 +56,25 @@ const handlers = {
     const images = c.images;
     cameraFiles = bytes;
     if (gt) gt.setCameras(c); else c.free();
+    if (gt && depthFiles) gt.setDepthMaps(depthFiles);
     return { images };
   },
   clearCameras() {
     cameraFiles = null;
     if (gt) gt.clearCameras();
+    return {};
+  },
+  loadDepth({ files }) {
+    const bytes = {};
+    for (const [n, b] of Object.entries(files)) bytes[n] = new Uint8Array(b);
+    // checked now (sizes against the cameras) when the cameras are there
+    if (gt && gt.hasCameras) gt.setDepthMaps(bytes);
+    depthFiles = bytes;
+    return { count: Object.keys(bytes).length, checked: !!(gt && gt.hasCameras) };
+  },
+  clearDepth() {
+    depthFiles = null;
+    if (gt) gt.clearDepthMaps();
     return {};
   },
   evaluate({ options, id }) {
@@ -75,6 +90,10 @@ const handlers = {
     };
     const t0 = performance.now();
     if (cameraFiles && !gt.hasCameras) gt.setCameras(loadCameras(cameraFiles));
+    if (depthFiles && !gt.hasDepthMaps) {
+      if (!gt.hasCameras) throw new Error('depth maps need the ground-truth cameras (cameras.json)');
+      gt.setDepthMaps(depthFiles);
+    }
     const e = raw.evaluate(gt, recon, options, progress);
     const ms = performance.now() - t0;
     if (last) last.free();
@@ -85,12 +104,15 @@ const handlers = {
     const completeness = e.completenessDistances();
     const clip = e.defaultClip();
     const colors = e.colors(clip);
+    const sampleLabels = e.sampleLabels() ?? null;
+    const samplePoints = sampleLabels ? e.completenessPointsF32() : null;
+    const extra = sampleLabels ? [sampleLabels.buffer, samplePoints.buffer] : [];
     return {
       reply: {
         reportJson: e.reportJson(), pointsInGt, distances, status, completeness, colors, clip,
-        gtFromRecon: Array.from(e.gtFromRecon()), ms,
+        gtFromRecon: Array.from(e.gtFromRecon()), ms, sampleLabels, samplePoints,
       },
-      transfer: [pointsInGt.buffer, distances.buffer, status.buffer, completeness.buffer, colors.buffer],
+      transfer: [pointsInGt.buffer, distances.buffer, status.buffer, completeness.buffer, colors.buffer, ...extra],
     };
   },
   colors({ clip }) {

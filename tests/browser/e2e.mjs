@@ -3,7 +3,7 @@
 // Prints one "ok NAME" / "FAILED NAME: why" line per check; exits 1 when one failed.
 import { chromium } from 'playwright-core';
 import { execFileSync } from 'node:child_process';
-import { readFileSync, writeFileSync, mkdirSync } from 'node:fs';
+import { readFileSync, readdirSync, writeFileSync, mkdirSync } from 'node:fs';
 import { join, resolve } from 'node:path';
 import { sameReport } from './same-report.mjs';
 
@@ -213,6 +213,30 @@ try {
   await evaluateAndWait();
   const demoReport = await downloadText('#dl-report');
   check('demo-button-report-equals-cli', noteSame('demo-button-report-equals-cli', demoReport.text, expectedModel), `vs CLI report of data/demo/sparse with cameras.json: ${firstDiff(demoReport.text, expectedModel)}`);
+
+  // 4b. the demo's depth maps (tests/browser/make_demo_depth.py wrote them into OUT/demo-depth):
+  // visible-surface completeness as the CLI computes it, and the GT coloured by coverage
+  const depthDir = join(out, 'demo-depth');
+  const depthFiles = readdirSync(depthDir).filter((f) => f.endsWith('.npy')).map((f) => join(depthDir, f));
+  await page.setInputFiles('#file-depth', depthFiles);
+  await page.waitForFunction(() => /depth maps/.test(document.getElementById('info-depth').textContent));
+  check('depth-maps-loaded', (await page.textContent('#info-depth')).startsWith(`${depthFiles.length} depth maps`), await page.textContent('#info-depth'));
+  await evaluateAndWait();
+  const depthReport = await downloadText('#dl-report');
+  const expectedDepth = cliReport(['--recon', demo('sparse'), '--gt-cameras', demo('cameras.json'), '--depth', depthDir], 'cli-depth.json');
+  check('depth-report-equals-cli', noteSame('depth-report-equals-cli', depthReport.text, expectedDepth), `page ${depthReport.path} vs cli-depth.json: ${firstDiff(depthReport.text, expectedDepth)}`);
+  const cvCli = JSON.parse(expectedDepth).completeness_visible;
+  const shown = await page.textContent('#r-visible-fraction');
+  check('dom-visible-fraction-equals-cli', shown === `${(100 * cvCli.visible_fraction).toFixed(2)} %`, `${shown} vs ${cvCli.visible_fraction}`);
+  check('coverage-layer-shown', await page.evaluate(() => {
+    const v = window.sfmevalViewer;
+    return document.getElementById('show-coverage').checked && !!v.coverage && v.coverage.visible && v.coverage.geometry.attributes.position.count > 1000;
+  }));
+  await page.uncheck('#show-recon');
+  await page.waitForTimeout(300);
+  await page.screenshot({ path: join(out, 'page-coverage.png') });
+  await page.check('#show-recon');
+  await page.click('#clear-depth');
 
   // 5. a broken file gives a readable error
   await page.setInputFiles('#file-gt', { name: 'broken.glb', mimeType: 'model/gltf-binary', buffer: Buffer.from('glTF\x02\0\0\0\x40\0\0\0garbage') });

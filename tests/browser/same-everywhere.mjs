@@ -1,14 +1,15 @@
 // Every alignment path, evaluated by the CLI and by the npm package's wasm in Node: the two
 // reports must be byte for byte the same (the core does all its transcendental maths through the
 // `libm` crate and in a fixed order, so native and wasm round identically).
-// Usage: node same-everywhere.mjs NPM_PACKAGE_DIR CLI_BINARY OUT_DIR
+// Usage: node same-everywhere.mjs NPM_PACKAGE_DIR CLI_BINARY OUT_DIR [DEPTH_DIR]
+// (DEPTH_DIR: depth maps of the demo, tests/browser/make_demo_depth.py, for the visibility case)
 // Prints one "ok NAME" / "FAILED NAME: why" line per case.
 import { execFileSync } from 'node:child_process';
 import { readFileSync, readdirSync, writeFileSync } from 'node:fs';
 import { join, resolve } from 'node:path';
 import { pathToFileURL } from 'node:url';
 
-const [pkgDir, cli, out] = process.argv.slice(2).map((p) => resolve(p));
+const [pkgDir, cli, out, depthDir] = process.argv.slice(2).map((p) => resolve(p));
 const root = resolve(new URL('../..', import.meta.url).pathname);
 const demo = (f) => join(root, 'data/demo', f);
 const sfmeval = await import(pathToFileURL(join(pkgDir, 'index.js')).href);
@@ -51,6 +52,11 @@ const cases = [
   ['points+icp-ply', 'ply', false, ['--align', 'points+icp', '--pairs', join(out, 'same-pairs.json')], { align: 'points+icp', pairs }],
   ['none-ply-signed', 'ply', false, ['--align', 'none', '--signed'], { align: 'none', signed: true }],
 ];
+if (depthDir) {
+  cases.push(['depth-model-min-views-3', 'model', true, ['--depth', depthDir, '--min-views', '3'], { min_views: 3 }]);
+}
+const depthFiles = {};
+if (depthDir) for (const f of readdirSync(depthDir)) depthFiles[`depth/${f}`] = readFileSync(join(depthDir, f));
 let failed = 0;
 for (const [name, kind, withCams, flags, options] of cases) {
   const recon = kind === 'model' ? demo('sparse') : demo('sparse.ply');
@@ -66,8 +72,17 @@ for (const [name, kind, withCams, flags, options] of cases) {
   try {
     const args = { gt: gtFiles, recon: recons[kind](), options: { ...options, samples: 200000, seed: 3 } };
     if (withCams) args.gtCameras = camFiles;
+    if (flags.includes('--depth')) args.depth = depthFiles;
     const r = sfmeval.evaluate(args);
     got = r.reportJson;
+    if (flags.includes('--depth')) {
+      const labels = r.sampleLabels();
+      const rep = JSON.parse(got).completeness_visible;
+      const unseen = labels ? labels.filter((l) => l === 2).length : -1;
+      if (!labels || labels.length !== rep.samples || rep.samples - unseen !== rep.visible_samples) {
+        failed++; console.log(`FAILED same-${name}-labels: ${labels?.length} labels, ${unseen} unseen vs ${JSON.stringify({ samples: rep.samples, visible: rep.visible_samples })}`);
+      } else console.log(`ok same-${name}-labels`);
+    }
     r.free();
   } catch (e) {
     failed++; console.log(`FAILED same-${name}: wasm failed: ${e.message}`); continue;

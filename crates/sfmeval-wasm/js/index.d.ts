@@ -45,6 +45,8 @@ export interface EvalOptions {
   signed?: boolean;
   /** Histogram bins (default 50). */
   histogram_bins?: number;
+  /** With depth maps: images a surface sample must be seen in to count as visible (default 2). */
+  min_views?: number;
   /** The crop, applied in the ground-truth frame after the transform. */
   crop?: Crop;
   /** Alignment: default `given` with a transform, else `auto`. */
@@ -76,6 +78,12 @@ export interface EvaluationResult {
   status(): Uint8Array;
   /** Distances of the completeness samples to the kept points. */
   completenessDistances(): Float64Array;
+  /** The completeness samples themselves, `x0, y0, z0, ...` as 32-bit floats (WebGL). */
+  completenessPointsF32(): Float32Array;
+  /** Per completeness sample: 0 covered, 1 missed, 2 unseen (with depth maps only). */
+  sampleLabels(): Uint8Array | undefined;
+  /** Per point, the track-based true error, NaN where not measured (depth maps + tracks only). */
+  trackErrors(): Float64Array | undefined;
   /** Viridis heat-map colours `r, g, b` per point, saturating at `clip` (default: accuracy p95). */
   colors(clip?: number): Uint8Array;
   /** Binary PLY of the kept points coloured by error, as `sfmeval eval --colored`. */
@@ -107,6 +115,8 @@ export function evaluate(args: {
   gt: Files | RawGroundTruth;
   recon: Files | RawReconstruction;
   gtCameras?: Files | RawCameras;
+  /** The dataset's depth maps, `depth/<image stem>.npy` by name (needs `gtCameras`). */
+  depth?: Files;
   options?: EvalOptions;
   onProgress?: ProgressCallback;
 }): EvaluationResult;

@@ -99,6 +99,9 @@ function wrap(e) {
     signedDistances: () => e.signedDistances(),
     status: () => e.status(),
     completenessDistances: () => e.completenessDistances(),
+    completenessPointsF32: () => e.completenessPointsF32(),
+    sampleLabels: () => e.sampleLabels(),
+    trackErrors: () => e.trackErrors(),
     colors: (clip = e.defaultClip()) => e.colors(clip),
     coloredPly: (clip = e.defaultClip()) => e.coloredPly(clip),
     csv: () => e.csv(),
@@ -112,19 +115,22 @@ function wrap(e) {
 /**
  * Aligns and measures a reconstruction against a ground truth, as `sfmeval eval`.
  * `gt` and `recon` are loaded objects or file maps `{name: bytes}`; `gtCameras` (optional, files
- * or a loaded `Cameras`, which is consumed) are attached to the ground truth.
+ * or a loaded `Cameras`, which is consumed) are attached to the ground truth; `depth` (optional,
+ * needs `gtCameras`) maps the dataset's `depth/<image stem>.npy` file names to bytes and adds
+ * visibility-aware completeness and the track-based error, as `sfmeval eval --depth`.
  * `options` uses the report's option names: `tau`, `tau_percent_of_diagonal`, `samples`, `seed`,
  * `signed`, `histogram_bins`, `crop` (a crop-file object), plus `align` (`auto`, `cameras`,
  * `points`, `global`, `icp`, `given`, `none`), `transform` (4×4 or transform-file text) and
  * `pairs` (`[{recon: [x,y,z], gt: [x,y,z]}, ...]`).
  * `onProgress(stage, done, total)` is called during the long steps.
  */
-export function evaluate({ gt, recon, gtCameras, options, onProgress } = {}) {
+export function evaluate({ gt, recon, gtCameras, depth, options, onProgress } = {}) {
   if (!gt) throw new TypeError('evaluate: gt is required');
   if (!recon) throw new TypeError('evaluate: recon is required');
   const g = loadGroundTruth(gt);
   const r = loadReconstruction(recon);
   if (gtCameras) g.setCameras(loadCameras(gtCameras));
+  if (depth) g.setDepthMaps(fileMap(depth));
   try {
     return wrap(wasm.evaluate(g, r, options ?? {}, onProgress));
   } finally {

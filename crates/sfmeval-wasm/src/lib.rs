@@ -16,6 +16,8 @@ use sfmeval::colormap::distance_color;
 use sfmeval::crop::Crop;
 use sfmeval::evaluate::{EvalOptions, PreparedGroundTruth};
 use sfmeval::geometry::{Aabb, GroundTruth as CoreGroundTruth};
+use sfmeval::gt_views::{GtView, build_views, depth_stem};
+use sfmeval::io::npy::DepthMap;
 use sfmeval::io::{self, LoadedGroundTruth};
 use sfmeval::pipeline::{self, AlignRequest, GroundTruthInfo, ReconInput, RunOptions};
 use sfmeval::progress::{Progress, Stage};
@@ -74,6 +76,7 @@ pub struct GroundTruth {
     name: String,
     prepared: Option<(usize, u64, PreparedGroundTruth)>,
     cameras: Option<sfmeval::model::Reconstruction>,
+    views: Option<Vec<GtView>>,
 }
 
 #[wasm_bindgen]
@@ -97,6 +100,7 @@ impl GroundTruth {
             name: name.to_string(),
             prepared: None,
             cameras: None,
+            views: None,
         })
     }
 
@@ -152,12 +156,46 @@ impl GroundTruth {
     #[wasm_bindgen(js_name = setCameras)]
     pub fn set_cameras(&mut self, cameras: Cameras) {
         self.cameras = Some(cameras.model);
+        self.views = None;
     }
 
-    /// Removes the attached ground-truth cameras.
+    /// Removes the attached ground-truth cameras (and the depth maps, which need them).
     #[wasm_bindgen(js_name = clearCameras)]
     pub fn clear_cameras(&mut self) {
         self.cameras = None;
+        self.views = None;
+    }
+
+    /// Attaches the dataset's depth maps (`depth/<image stem>.npy`, one per ground-truth image,
+    /// given as `{name: Uint8Array}`; folders in the names are ignored) for visibility-aware
+    /// completeness and the track-based error, as `sfmeval eval --depth`. Needs the cameras.
+    #[wasm_bindgen(js_name = setDepthMaps)]
+    pub fn set_depth_maps(&mut self, files: Object) -> Result<(), JsError> {
+        let Some(cameras) = self.cameras.as_ref() else {
+            return Err(JsError::new(
+                "depth maps need the ground-truth cameras (cameras.json) first",
+            ));
+        };
+        let mut maps = BTreeMap::new();
+        for (name, bytes) in files_of(&files)? {
+            let map = DepthMap::from_npy(&bytes)
+                .map_err(|e| js_err(&format!("depth map '{name}'"), e))?;
+            maps.insert(depth_stem(&name), map);
+        }
+        self.views = Some(build_views(cameras, &maps).map_err(|e| js_err("depth maps", e))?);
+        Ok(())
+    }
+
+    /// Removes the attached depth maps.
+    #[wasm_bindgen(js_name = clearDepthMaps)]
+    pub fn clear_depth_maps(&mut self) {
+        self.views = None;
+    }
+
+    /// Whether depth maps are attached.
+    #[wasm_bindgen(getter, js_name = hasDepthMaps)]
+    pub fn has_depth_maps(&self) -> bool {
+        self.views.is_some()
     }
 
     /// Whether ground-truth cameras are attached.
@@ -262,13 +300,15 @@ struct JsProgress {
     total: AtomicU64,
 }
 
-const STAGES: [Stage; 6] = [
+const STAGES: [Stage; 8] = [
     Stage::IndexGroundTruth,
     Stage::Accuracy,
     Stage::Sampling,
     Stage::IndexReconstruction,
     Stage::Completeness,
     Stage::Alignment,
+    Stage::Visibility,
+    Stage::TrackError,
 ];
 
 thread_local! {
@@ -493,6 +533,40 @@ impl Evaluation {
         io::write::distances_csv(&self.inner)
     }
 
+    /// The completeness samples used (inside the crop volume), `x0, y0, z0, ...`, as 32-bit
+    /// floats (WebGL), in the order of `completenessDistances()`.
+    #[wasm_bindgen(js_name = completenessPointsF32)]
+    pub fn completeness_points_f32(&self) -> Float32Array {
+        let flat: Vec<f32> = self
+            .inner
+            .completeness_points
+            .iter()
+            .flatten()
+            .map(|&v| v as f32)
+            .collect();
+        Float32Array::from(flat.as_slice())
+    }
+
+    /// Per completeness sample: 0 covered, 1 missed (visible, not reconstructed within the
+    /// report's `completeness_visible.labels_tau`), 2 unseen; `undefined` without depth maps.
+    #[wasm_bindgen(js_name = sampleLabels)]
+    pub fn sample_labels(&self) -> Option<Uint8Array> {
+        self.inner.sample_labels.as_ref().map(|l| {
+            let flat: Vec<u8> = l.iter().map(|&x| x as u8).collect();
+            Uint8Array::from(flat.as_slice())
+        })
+    }
+
+    /// Per reconstructed point, its track-based true error (NaN where not measured);
+    /// `undefined` without depth maps or tracks.
+    #[wasm_bindgen(js_name = trackErrors)]
+    pub fn track_errors(&self) -> Option<Float64Array> {
+        self.inner.track_errors.as_ref().map(|t| {
+            let flat: Vec<f64> = t.iter().map(|e| e.unwrap_or(f64::NAN)).collect();
+            Float64Array::from(flat.as_slice())
+        })
+    }
+
     /// The accuracy 95th percentile: the default colour clip of the CLI.
     #[wasm_bindgen(js_name = defaultClip)]
     pub fn default_clip(&self) -> f64 {
@@ -551,11 +625,12 @@ pub fn evaluate(
         icp_start,
         ..RunOptions::default()
     };
-    let inner = pipeline::run(
+    let inner = pipeline::run_with_views(
         prepared,
         &info,
         &recon.input,
         gt.cameras.as_ref(),
+        gt.views.as_deref(),
         align.pairs.as_deref().unwrap_or(&[]),
         &run_options,
         &bar,
