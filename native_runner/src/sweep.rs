@@ -46,6 +46,27 @@ pub const DEFAULT_METRICS: &[(&str, &str)] = &[
     ("run.wall_seconds", "run time (s, wall)"),
 ];
 
+/// Metrics plotted when some run's report has them: with `--visibility` (depth maps rendered)
+/// the core adds completeness over the visible surface and the track-based error.
+pub const VISIBILITY_METRICS: &[(&str, &str)] = &[
+    (
+        "report.completeness_visible.thresholds[*].recall_visible",
+        "completeness of the visible surface (recall)",
+    ),
+    (
+        "report.completeness_visible.visible_fraction",
+        "visible share of the surface (≥ k images)",
+    ),
+    (
+        "report.track_error.median",
+        "track-based true error: median (m)",
+    ),
+    (
+        "report.track_error.thresholds[*].sliding_fraction",
+        "sliding points (true error − surface distance > τ)",
+    ),
+];
+
 /// Arguments of `sweep`.
 #[derive(Args)]
 pub struct SweepArgs {
@@ -68,6 +89,10 @@ pub struct SweepArgs {
     /// Output folder (datasets/, runs/, table/, charts/, sweep.csv, sweep.html, sweep.json).
     #[arg(long, default_value = "sweep")]
     out: PathBuf,
+    /// Also render depth maps, so every report gains completeness over the visible surface and
+    /// the track-based error, and plot them (rendering takes longer).
+    #[arg(long)]
+    visibility: bool,
     /// Extra metric to plot: a JSON path such as `report.completeness.p90` or
     /// `report.thresholds[*].recall`, optionally `=LABEL` (repeatable).
     #[arg(long = "metric", value_name = "PATH[=LABEL]")]
@@ -508,6 +533,12 @@ pub fn metrics(extra: &[String], cells: &[Cell]) -> Vec<Metric> {
     let docs: Vec<&Json> = cells.iter().map(|c| &c.doc).collect();
     let mut specs: Vec<(String, String)> = DEFAULT_METRICS
         .iter()
+        .chain(VISIBILITY_METRICS.iter().filter(|(p, _)| {
+            // only when a report has the section (runs with depth maps)
+            let section = p.split('.').take(2).collect::<Vec<_>>().join("/");
+            docs.iter()
+                .any(|d| d.pointer(&format!("/{section}")).is_some())
+        }))
         .map(|(p, l)| (p.to_string(), l.to_string()))
         .collect();
     for e in extra {
@@ -796,7 +827,7 @@ pub fn sweep(a: &SweepArgs) -> Result<()> {
     let customs = crate::pipelines::parse_customs(&a.tools.customs)?;
     let specs = crate::pipelines::parse_list(&a.pipelines, &customs)?;
     let eval = crate::eval_options(&a.eval)?;
-    // base: preset/config, no depth or masks (not needed by the report), the user's --set
+    // base: preset/config, no masks, depth maps only with --visibility, the user's --set
     let mut base_args: Vec<String> = Vec::new();
     match (&a.dataset_preset, &a.dataset_config) {
         (None, None) => base_args.extend(["--preset".into(), "small".into()]),
@@ -810,7 +841,12 @@ pub fn sweep(a: &SweepArgs) -> Result<()> {
             }
         }
     }
-    for s in ["outputs.depth=false", "outputs.masks=false"]
+    let depth = if a.visibility {
+        "outputs.depth=true"
+    } else {
+        "outputs.depth=false"
+    };
+    for s in [depth, "outputs.masks=false"]
         .iter()
         .map(|s| s.to_string())
         .chain(a.sets.iter().cloned())
@@ -1151,6 +1187,41 @@ mod tests {
             metric_file("report.thresholds[1].f_score"),
             "report_thresholds_1_f_score"
         );
+    }
+
+    #[test]
+    fn visibility_metrics_only_when_a_report_has_them() {
+        let cell = |doc: Json| Cell {
+            value: ("1".into(), 1.0),
+            dataset: "d".into(),
+            pipeline: "p".into(),
+            status: "ok".into(),
+            reason: None,
+            doc,
+        };
+        let plain = json!({"report": {"thresholds": [{"tau": 0.01, "recall": 0.3}]}});
+        let without = metrics(&[], &[cell(plain.clone())]);
+        assert!(
+            !without
+                .iter()
+                .any(|m| m.path.contains("visible") || m.path.contains("track"))
+        );
+        let with = json!({"report": {
+            "thresholds": [{"tau": 0.01, "recall": 0.3}],
+            "completeness_visible": {"visible_fraction": 0.8,
+                "thresholds": [{"tau": 0.01, "recall_visible": 0.4}]},
+            "track_error": {"median": 0.001, "thresholds": [{"tau": 0.01, "sliding_fraction": 0.02}]}}});
+        let m = metrics(&[], &[cell(plain), cell(with.clone())]);
+        let paths: Vec<&str> = m.iter().map(|m| m.path.as_str()).collect();
+        for p in [
+            "report.completeness_visible.thresholds[0].recall_visible",
+            "report.completeness_visible.visible_fraction",
+            "report.track_error.median",
+            "report.track_error.thresholds[0].sliding_fraction",
+        ] {
+            assert!(paths.contains(&p), "{p} missing from {paths:?}");
+            assert!(lookup(&with, p).is_some(), "{p}");
+        }
     }
 
     #[test]

@@ -1,6 +1,7 @@
 """`sfmeval-runner sweep` end to end, kept small for CI (45–125 s here): two values of the noise
-factor on a 24-view 320x180 render of the statue (8 spp), pycolmap and a custom pipeline that
-always fails, 100k completeness samples. Checks the table, the charts and the page."""
+factor on a 24-view 320x180 render of the statue (8 spp) with depth maps (--visibility),
+pycolmap and a custom pipeline that always fails, 100k completeness samples. Checks the table
+(including the visible-surface completeness and the track error), the charts and the page."""
 
 import csv
 import json
@@ -26,7 +27,7 @@ def sweep_cmd(runner_bin, out, *extra):
             "--set", "views.orbits=[{elevation_deg=25.0, count=24}]",
             "--pipelines", "pycolmap;broken", "--custom", "broken=false {out}",
             "--metric", EXTRA_METRIC + "=completeness p90 (m)",
-            "--samples", "100000", "--timeout", "600", "--out", str(out)] + list(extra)
+            "--samples", "100000", "--timeout", "600", "--visibility", "--out", str(out)] + list(extra)
 
 
 @pytest.fixture(scope="module")
@@ -55,7 +56,11 @@ def test_csv_has_a_row_per_value_and_pipeline(sweep):
     for needed in ("report.accuracy.mean", "report.accuracy.median", "report.thresholds[0].recall",
                    "report.thresholds[2].f_score", "run.registered_fraction",
                    "report.cameras.rotation_error_deg.median", "report.cameras.ate_rmse",
-                   "run.wall_seconds", EXTRA_METRIC):
+                   "run.wall_seconds", EXTRA_METRIC,
+                   # --visibility: depth maps rendered, the visible-surface metrics plotted
+                   "report.completeness_visible.visible_fraction",
+                   "report.completeness_visible.thresholds[0].recall_visible",
+                   "report.track_error.median"):
         assert needed in cols, cols
     metric_cols = cols[6:]
     for r in rows:
@@ -70,6 +75,10 @@ def test_csv_has_a_row_per_value_and_pipeline(sweep):
         assert 0 < float(r["run.registered_fraction"]) <= 1
         assert 0 <= float(r["report.thresholds[0].recall"]) <= float(r["report.thresholds[2].recall"]) <= 1
         assert float(r["report.accuracy.mean"]) < 0.1  # metres, on a 1 m object
+        # the statue's underside and hidden folds: most but not all of the surface is seen
+        assert 0.5 < float(r["report.completeness_visible.visible_fraction"]) < 1
+        assert float(r["report.completeness_visible.thresholds[0].recall_visible"]) >= \
+            float(r["report.thresholds[0].recall"])
 
 
 def test_variants_are_the_factor_values(sweep):
