@@ -139,7 +139,7 @@ fn main() -> Res<()> {
             let c = read_cloud(cloud_path()?)?;
             let t = Instant::now();
             let idx = MeshIndex::new(&m)?;
-            let d = sfmeval::parallel::map(&c, &NoProgress, |p| idx.closest(*p).distance);
+            let d = sfmeval::parallel::map_points(&c, &NoProgress, |p| idx.closest(*p).distance);
             (t.elapsed().as_secs_f64(), summary(&d))
         }
         "completeness" => {
@@ -148,7 +148,7 @@ fn main() -> Res<()> {
             let t = Instant::now();
             let samples = sfmeval::sampling::sample_surface(&m, a.samples, a.seed)?;
             let idx = CloudIndex::new(&c)?;
-            let d = sfmeval::parallel::map(&samples, &NoProgress, |p| idx.nearest(*p).0);
+            let d = sfmeval::parallel::map_points(&samples, &NoProgress, |p| idx.nearest(*p).0);
             (t.elapsed().as_secs_f64(), summary(&d))
         }
         "c2c" => {
@@ -156,7 +156,7 @@ fn main() -> Res<()> {
             let q = read_cloud(a.queries.as_deref().ok_or("--queries is required")?)?;
             let t = Instant::now();
             let idx = CloudIndex::new(&c)?;
-            let d = sfmeval::parallel::map(&q, &NoProgress, |p| idx.nearest(*p).0);
+            let d = sfmeval::parallel::map_points(&q, &NoProgress, |p| idx.nearest(*p).0);
             (t.elapsed().as_secs_f64(), summary(&d))
         }
         "align" => {
