@@ -1,5 +1,6 @@
-// Per-operation speed of the npm package (wasm, one thread) in Node against native sfmeval with
-// one thread, in the same run and on the same files. Not a test: prints a markdown table.
+// Per-operation speed of the npm package (wasm, one thread) in Node and in headless Chromium
+// against native sfmeval with one thread, in the same run and on the same files. Not a test:
+// prints a markdown table. (`--no-chromium` skips the browser column.)
 //
 //   node tests/browser/bench-ops.mjs [--mesh bench/data/mesh_1m.ply] [--cloud bench/data/cloud_1m.ply]
 //        [--samples 1000000] [--npm target/web/npm] [--bench-op target/release/examples/bench_op]
@@ -14,8 +15,8 @@
 //   accuracy      bvh + "accuracy"                              vs `bench_op accuracy` (BVH build included)
 //   completeness  sampling + k-d tree + completeness queries    vs `bench_op completeness`
 //   eval          load + evaluate                               vs `sfmeval eval --threads 1` wall time
-import { execFileSync } from 'node:child_process';
-import { mkdtempSync, readFileSync, rmSync } from 'node:fs';
+import { execFileSync, spawn } from 'node:child_process';
+import { mkdtempSync, readFileSync, rmSync, symlinkSync, writeFileSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import { basename, join as pjoin, resolve } from 'node:path';
 
@@ -56,6 +57,58 @@ const wasm = {
   eval: loadMs + evalMs,
 };
 
+// ---- the same stages through the same package in headless Chromium --------------------------
+// The measuring code runs in the page; the files are served from 127.0.0.1 with the package.
+async function inChromium() {
+  const { chromium } = await import('playwright-core');
+  const dir = mkdtempSync(pjoin(tmpdir(), 'sfmeval-bench-ops-web-'));
+  symlinkSync(npm, pjoin(dir, 'sfmeval'));
+  symlinkSync(mesh, pjoin(dir, 'gt.' + mesh.split('.').pop()));
+  symlinkSync(cloud, pjoin(dir, 'recon.' + cloud.split('.').pop()));
+  writeFileSync(pjoin(dir, 'index.html'), `<!doctype html><meta charset="utf-8"><link rel="icon" href="data:,">
+<script type="module">
+import { init, loadGroundTruth, loadReconstruction, evaluate } from './sfmeval/index.js';
+const bytes = async (u) => new Uint8Array(await (await fetch(u)).arrayBuffer());
+try {
+  await init();
+  const g = await bytes('gt.${mesh.split('.').pop()}'), c = await bytes('recon.${cloud.split('.').pop()}');
+  let t = performance.now();
+  const gt = loadGroundTruth({ '${basename(mesh)}': g });
+  const recon = loadReconstruction({ '${basename(cloud)}': c });
+  const loadMs = performance.now() - t;
+  const span = {};
+  t = performance.now();
+  const ev = evaluate({ gt, recon, options: { align: 'none', samples: ${samples} },
+    onProgress: (stage) => { const now = performance.now(); span[stage] = [span[stage]?.[0] ?? now, now]; } });
+  window.result = { loadMs, evalMs: performance.now() - t, span, acc: ev.report.accuracy.mean, comp: ev.report.completeness.mean };
+} catch (e) { window.result = { error: String(e && e.message || e) }; }
+</script>`);
+  const port = 20000 + Math.floor(Math.random() * 20000);
+  const server = spawn('python3', ['-m', 'http.server', String(port), '--bind', '127.0.0.1', '--directory', dir], { stdio: 'ignore' });
+  const browser = await chromium.launch({ executablePath: process.env.CHROMIUM || '/usr/bin/chromium', args: ['--no-sandbox', '--disable-gpu', '--disable-dev-shm-usage'] });
+  try {
+    const page = await browser.newPage();
+    for (let i = 0; i < 50; i++) {
+      try { await page.goto(`http://127.0.0.1:${port}/`); break; } catch { await new Promise((r) => setTimeout(r, 100)); }
+    }
+    await page.waitForFunction(() => window.result, null, { timeout: 600000 });
+    const r = await page.evaluate(() => window.result);
+    if (r.error) throw new Error(`in Chromium: ${r.error}`);
+    const ms = Object.fromEntries(Object.entries(r.span).map(([k, [a, b]]) => [k, b - a]));
+    const sum = (re) => Object.entries(ms).filter(([k]) => re.test(k)).reduce((s, [, v]) => s + v, 0);
+    return {
+      ms: { load: r.loadMs, bvh: sum(/indexing ground/), accuracy: sum(/indexing ground|accuracy/),
+        completeness: sum(/sampling|indexing reconstruction|completeness/), eval: r.loadMs + r.evalMs },
+      same: r.acc === report.accuracy.mean && r.comp === report.completeness.mean,
+    };
+  } finally {
+    await browser.close();
+    server.kill();
+    rmSync(dir, { recursive: true, force: true });
+  }
+}
+const chrome = process.argv.includes('--no-chromium') ? null : await inChromium();
+
 // ---- native, one thread --------------------------------------------------------------------
 const op = (name) => JSON.parse(execFileSync(benchOp, [name, '--mesh', mesh, '--cloud', cloud, '--samples', String(samples), '--threads', '1']).toString().trim().split('\n').pop());
 const native = {};
@@ -75,11 +128,13 @@ rmSync(scratch, { recursive: true, force: true });
 // ---- table ---------------------------------------------------------------------------------
 const same = Math.abs(report.accuracy.mean - nativeResult.accuracy.mean) <= 1e-12 * nativeResult.accuracy.mean
   && Math.abs(report.completeness.mean - nativeResult.completeness.mean) <= 1e-12 * nativeResult.completeness.mean;
-console.log(`\nwasm (Node ${process.version}, one thread) vs native sfmeval --threads 1: \`${basename(cloud)}\` vs \`${basename(mesh)}\`, ${samples} samples; `
-  + `accuracy/completeness means ${same ? 'identical' : 'DIFFER'} (${report.accuracy.mean} / ${report.completeness.mean})\n`);
-console.log('| operation | wasm in Node ms | native 1 thread ms | wasm ÷ native |');
-console.log('|---|---|---|---|');
+console.log(`\nwasm (Node ${process.version}${chrome ? ' and headless Chromium' : ''}, one thread) vs native sfmeval --threads 1: \`${basename(cloud)}\` vs \`${basename(mesh)}\`, ${samples} samples; `
+  + `accuracy/completeness means ${same && (!chrome || chrome.same) ? 'identical' : 'DIFFER'} (${report.accuracy.mean} / ${report.completeness.mean})\n`);
+console.log(`| operation | wasm in Node ms | ${chrome ? 'wasm in Chromium ms | ' : ''}native 1 thread ms | Node ÷ native |${chrome ? ' Chromium ÷ native |' : ''}`);
+console.log(`|---|---|${chrome ? '---|' : ''}---|---|${chrome ? '---|' : ''}`);
 for (const k of Object.keys(wasm)) {
-  console.log(`| ${k} | ${wasm[k].toFixed(0)} | ${native[k].toFixed(0)} | ${(wasm[k] / native[k]).toFixed(2)}× |`);
+  const c = chrome ? ` ${chrome.ms[k].toFixed(0)} |` : '';
+  const cr = chrome ? ` ${(chrome.ms[k] / native[k]).toFixed(2)}× |` : '';
+  console.log(`| ${k} | ${wasm[k].toFixed(0)} |${c} ${native[k].toFixed(0)} | ${(wasm[k] / native[k]).toFixed(2)}× |${cr}`);
 }
-if (!same) process.exit(1);
+if (!same || (chrome && !chrome.same)) process.exit(1);
