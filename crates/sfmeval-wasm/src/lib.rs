@@ -67,6 +67,12 @@ fn points_f64(points: &[[f64; 3]]) -> Float64Array {
     Float64Array::from(flat.as_slice())
 }
 
+/// The same as 32-bit floats (WebGL buffers).
+fn points_f32(points: &[[f64; 3]]) -> Float32Array {
+    let flat: Vec<f32> = points.iter().flatten().map(|&v| v as f32).collect();
+    Float32Array::from(flat.as_slice())
+}
+
 /// A ground truth read from bytes (GLB, glTF with its external buffers, OBJ, PLY mesh or cloud).
 /// Its BVH and completeness samples are prepared on the first evaluation and reused while the
 /// sample count and seed stay the same.
@@ -474,14 +480,7 @@ impl Evaluation {
     /// The same points as 32-bit floats (for WebGL buffers).
     #[wasm_bindgen(js_name = pointsInGtF32)]
     pub fn points_in_gt_f32(&self) -> Float32Array {
-        let flat: Vec<f32> = self
-            .inner
-            .points_in_gt
-            .iter()
-            .flatten()
-            .map(|&v| v as f32)
-            .collect();
-        Float32Array::from(flat.as_slice())
+        points_f32(&self.inner.points_in_gt)
     }
 
     /// Unsigned distance of every point to the ground truth.
@@ -537,14 +536,7 @@ impl Evaluation {
     /// floats (WebGL), in the order of `completenessDistances()`.
     #[wasm_bindgen(js_name = completenessPointsF32)]
     pub fn completeness_points_f32(&self) -> Float32Array {
-        let flat: Vec<f32> = self
-            .inner
-            .completeness_points
-            .iter()
-            .flatten()
-            .map(|&v| v as f32)
-            .collect();
-        Float32Array::from(flat.as_slice())
+        points_f32(&self.inner.completeness_points)
     }
 
     /// Per completeness sample: 0 covered, 1 missed (visible, not reconstructed within the
