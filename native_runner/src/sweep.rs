@@ -18,8 +18,8 @@ use serde_json::Value as Json;
 
 use crate::chart::{self, Chart, Series, Value};
 use crate::dataset::Dataset;
-use crate::exec::{Step, run_step, shell_quote};
-use crate::files::{partial_name, replace_dir, write_atomic};
+use crate::exec::shell_quote;
+use crate::files::write_atomic;
 use crate::html::esc;
 use crate::report::Row;
 
@@ -766,49 +766,6 @@ fn resolve_base(python: &Path, scripts: &Path, base_args: &[String]) -> Result<J
     serde_json::from_slice(&out.stdout).context("reading the generator's --print-config output")
 }
 
-/// Renders a variant into `dest` through a temporary folder; returns the seconds spent.
-fn render(python: &Path, scripts: &Path, args: &[String], dest: &Path) -> Result<f64> {
-    let tmp = partial_name(dest);
-    if tmp.exists() {
-        std::fs::remove_dir_all(&tmp)?;
-    }
-    let mut argv = vec![
-        python.to_string_lossy().to_string(),
-        scripts.join("generate.py").to_string_lossy().to_string(),
-    ];
-    argv.extend(args.iter().cloned());
-    argv.push("--out".into());
-    argv.push(tmp.to_string_lossy().to_string());
-    let parent = dest.parent().unwrap_or(Path::new("."));
-    let name = dest
-        .file_name()
-        .map(|n| n.to_string_lossy().to_string())
-        .unwrap_or_default();
-    let log = parent.join(format!("{name}.log"));
-    eprintln!(
-        "sweep: rendering {name} → {} (log {})",
-        dest.display(),
-        log.display()
-    );
-    let step = Step::new(&format!("generate {name}"), argv, parent);
-    let r = run_step(&step, &log, Instant::now() + Duration::from_secs(48 * 3600));
-    if !r.success() {
-        let _ = std::fs::remove_dir_all(&tmp);
-        let tail = std::fs::read_to_string(&log)
-            .ok()
-            .and_then(|t| {
-                t.lines()
-                    .rev()
-                    .find(|l| l.contains("error"))
-                    .map(str::to_string)
-            })
-            .unwrap_or_default();
-        bail!("{} {tail} (see {})", r.failure_reason(), log.display());
-    }
-    replace_dir(&tmp, dest)?;
-    Ok(r.wall_seconds)
-}
-
 /// The whole sweep.
 pub fn sweep(a: &SweepArgs) -> Result<()> {
     let t0 = Instant::now();
@@ -891,7 +848,7 @@ pub fn sweep(a: &SweepArgs) -> Result<()> {
             seconds: None,
         };
         if !complete || a.fresh {
-            match render(&python, &scripts, &args, &dest) {
+            match crate::table1::render_dataset("sweep", &python, &scripts, &args, &dest) {
                 Ok(secs) => {
                     write_atomic(&stamp, stamp_json.as_bytes())?;
                     v.status = "rendered".into();

@@ -51,7 +51,7 @@ pub fn find_blender_scripts(given: Option<&Path>) -> Result<PathBuf> {
         .context("blender_scripts/generate.py not found: pass --blender-scripts DIR")
 }
 
-/// Renders one dataset into `dest` (through a temporary folder), returning the seconds spent.
+/// Renders one preset into `dest` (through a temporary folder), returning the seconds spent.
 fn generate(
     python: &Path,
     scripts: &Path,
@@ -60,13 +60,7 @@ fn generate(
     sets: &[String],
     dest: &Path,
 ) -> Result<f64> {
-    let tmp = partial_name(dest);
-    if tmp.exists() {
-        std::fs::remove_dir_all(&tmp)?;
-    }
-    let mut argv = vec![
-        python.to_string_lossy().to_string(),
-        scripts.join("generate.py").to_string_lossy().to_string(),
+    let mut args: Vec<String> = vec![
         "--preset".into(),
         preset.into(),
         "--set".into(),
@@ -81,28 +75,59 @@ fn generate(
     }
     overrides.extend(sets.iter().cloned());
     for s in overrides {
-        argv.push("--set".into());
-        argv.push(s);
+        args.push("--set".into());
+        args.push(s);
     }
+    render_dataset("table1", python, scripts, &args, dest)
+}
+
+/// Runs the Blender generator (`generate.py ARGS --out TMP`) into a temporary folder beside
+/// `dest`, logging to `dest.log`, and moves the dataset into `dest` when it succeeded; returns
+/// the seconds spent. A failure names the generator's last error line. `who` prefixes the
+/// progress line (`table1`, `sweep`).
+pub fn render_dataset(
+    who: &str,
+    python: &Path,
+    scripts: &Path,
+    args: &[String],
+    dest: &Path,
+) -> Result<f64> {
+    let tmp = partial_name(dest);
+    if tmp.exists() {
+        std::fs::remove_dir_all(&tmp)?;
+    }
+    let mut argv = vec![
+        python.to_string_lossy().to_string(),
+        scripts.join("generate.py").to_string_lossy().to_string(),
+    ];
+    argv.extend(args.iter().cloned());
     argv.push("--out".into());
     argv.push(tmp.to_string_lossy().to_string());
     let parent = dest.parent().unwrap_or(Path::new("."));
-    let log = parent.join(format!(
-        "{}.log",
-        dest.file_name()
-            .map(|n| n.to_string_lossy().to_string())
-            .unwrap_or_default()
-    ));
-    let step = Step::new(&format!("generate {preset}"), argv, parent);
+    let name = dest
+        .file_name()
+        .map(|n| n.to_string_lossy().to_string())
+        .unwrap_or_default();
+    let log = parent.join(format!("{name}.log"));
     eprintln!(
-        "table1: rendering {preset} → {} (log {})",
+        "{who}: rendering {name} → {} (log {})",
         dest.display(),
         log.display()
     );
+    let step = Step::new(&format!("generate {name}"), argv, parent);
     let r = run_step(&step, &log, Instant::now() + Duration::from_secs(48 * 3600));
     if !r.success() {
         let _ = std::fs::remove_dir_all(&tmp);
-        bail!("{} (see {})", r.failure_reason(), log.display());
+        let tail = std::fs::read_to_string(&log)
+            .ok()
+            .and_then(|t| {
+                t.lines()
+                    .rev()
+                    .find(|l| l.contains("error"))
+                    .map(str::to_string)
+            })
+            .unwrap_or_default();
+        bail!("{} {tail} (see {})", r.failure_reason(), log.display());
     }
     replace_dir(&tmp, dest)?;
     Ok(r.wall_seconds)
