@@ -300,6 +300,34 @@ pub(crate) mod test_scenes {
             (t0 <= t1 && t0 > 0.0).then_some(t0)
         }
     }
+
+    /// Appends `x` to `rec` as a 3D point observed, by exact projection, in every view that
+    /// sees it (`views[i]` belongs to `rec.images[i]`).
+    pub fn add_observed_point(rec: &mut Reconstruction, views: &[GtView], x: Point3) {
+        let point = rec.points.len();
+        let mut track = Vec::new();
+        for (i, v) in views.iter().enumerate() {
+            if !crate::visibility::sees(v, x) {
+                continue;
+            }
+            if let (Some((u, vv, _)), Some(im)) = (v.project(x), rec.images.get_mut(i)) {
+                track.push(crate::model::TrackElement {
+                    image: i,
+                    keypoint: im.observations.len() as u64,
+                });
+                im.observations.push(crate::model::Observation {
+                    xy: [u, vv],
+                    point: Some(point),
+                });
+            }
+        }
+        rec.points.push(crate::model::Point3D {
+            xyz: x,
+            color: None,
+            error: None,
+            track,
+        });
+    }
 }
 
 #[cfg(test)]

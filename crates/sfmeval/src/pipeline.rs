@@ -514,8 +514,8 @@ pub fn cameras_only(
 mod tests {
     use super::*;
     use crate::geometry::{GroundTruth, TriangleMesh};
-    use crate::gt_views::test_scenes::{look_at, render, sphere};
-    use crate::model::{Camera, Image, Observation, Point3D, TrackElement};
+    use crate::gt_views::test_scenes::{add_observed_point, look_at, render, sphere};
+    use crate::model::{Camera, Image};
     use crate::progress::NoProgress;
 
     /// A UV sphere of radius 1 (sag below 3e-4, far below the depth tolerance).
@@ -583,30 +583,10 @@ mod tests {
                 .wrapping_add(1442695040888963407);
             (rng_state >> 11) as f64 / (1u64 << 53) as f64
         };
-        for p in 0..400 {
+        for _ in 0..400 {
             let (lat, lon): (f64, f64) = ((next() - 0.5) * 1.6, next() * std::f64::consts::TAU);
             let x = [lat.cos() * lon.cos(), lat.sin(), lat.cos() * lon.sin()];
-            let mut track = Vec::new();
-            for (i, v) in views.iter().enumerate() {
-                if crate::visibility::sees(v, x) {
-                    let (u, vv, _) = v.project(x).unwrap();
-                    let im = &mut est.images[i];
-                    track.push(TrackElement {
-                        image: i,
-                        keypoint: im.observations.len() as u64,
-                    });
-                    im.observations.push(Observation {
-                        xy: [u, vv],
-                        point: Some(p),
-                    });
-                }
-            }
-            est.points.push(Point3D {
-                xyz: x,
-                color: None,
-                error: None,
-                track,
-            });
+            add_observed_point(&mut est, &views, x);
         }
         let recon = ReconInput {
             cloud: est.to_point_cloud(),

@@ -240,7 +240,7 @@ pub fn track_errors(
 mod tests {
     use super::*;
     use crate::gt_views::test_scenes::*;
-    use crate::model::{Camera, Image, Observation, Point3D, TrackElement};
+    use crate::model::{Camera, Image};
     use crate::progress::NoProgress;
 
     /// A recon equal to the ground truth: 8 cameras around a unit sphere, points on the sphere,
@@ -267,28 +267,8 @@ mod tests {
             });
             views.push(v);
         }
-        for (pi, p) in points.iter().enumerate() {
-            let mut track = Vec::new();
-            for (i, v) in views.iter().enumerate() {
-                let (u, vv, _) = v.project(*p).unwrap();
-                if crate::visibility::sees(v, *p) {
-                    let im = &mut rec.images[i];
-                    track.push(TrackElement {
-                        image: i,
-                        keypoint: im.observations.len() as u64,
-                    });
-                    im.observations.push(Observation {
-                        xy: [u, vv],
-                        point: Some(pi),
-                    });
-                }
-            }
-            rec.points.push(Point3D {
-                xyz: *p,
-                color: None,
-                error: None,
-                track,
-            });
+        for p in points {
+            add_observed_point(&mut rec, &views, *p);
         }
         (views, rec)
     }
