@@ -413,7 +413,8 @@ pub enum ModelFormat {
 }
 
 /// Recognises an SfM model file by content first (`NVM_V3`, `# Bundle file`, JSON with
-/// `sfm_data_version`/`views` or `"schema": "sfmeval.cameras/1"`), then by name.
+/// `sfm_data_version`/`views` or `"schema": "sfmeval.cameras/1"` at its start or end), then by
+/// name.
 pub fn detect_model_format(name: &str, bytes: &[u8]) -> Option<ModelFormat> {
     let base = name.rsplit(['/', '\\']).next().unwrap_or(name);
     let head = bytes.get(..bytes.len().min(4096)).unwrap_or_default();
@@ -426,7 +427,12 @@ pub fn detect_model_format(name: &str, bytes: &[u8]) -> Option<ModelFormat> {
         return Some(ModelFormat::Bundler);
     }
     if trimmed.starts_with('{') {
-        if head_text.contains("sfmeval.cameras/") {
+        // The schema tag may sit anywhere: writers that sort keys put it last.
+        let tail = bytes
+            .get(bytes.len().saturating_sub(4096)..)
+            .unwrap_or_default();
+        let tail_text = String::from_utf8_lossy(tail);
+        if head_text.contains("sfmeval.cameras/") || tail_text.contains("sfmeval.cameras/") {
             return Some(ModelFormat::CamerasJson);
         }
         if head_text.contains("sfm_data_version") || head_text.contains("\"views\"") {
@@ -439,6 +445,8 @@ pub fn detect_model_format(name: &str, bytes: &[u8]) -> Option<ModelFormat> {
         | "points3d.bin" => Some(ModelFormat::Colmap),
         _ if lower.ends_with(".nvm") => Some(ModelFormat::Nvm),
         _ if lower.ends_with(".out") => Some(ModelFormat::Bundler),
+        "cameras.json" => Some(ModelFormat::CamerasJson),
+        "sfm_data.json" => Some(ModelFormat::OpenMvg),
         _ => None,
     }
 }
@@ -595,6 +603,44 @@ mod tests {
         assert_eq!(
             detect_model_format("points3D.BIN", b"\0"),
             Some(ModelFormat::Colmap)
+        );
+    }
+
+    /// A cameras.json with sorted keys has its schema tag last, beyond the first 4 KiB (the
+    /// runner writes them so): still recognised, by content and under any name.
+    #[test]
+    fn cameras_json_with_the_schema_at_the_end() {
+        let images: Vec<String> = (0..100)
+            .map(|i| {
+                format!(
+                    r#"{{"cam_from_world": {{"rotation": [[1,0,0],[0,1,0],[0,0,1]], "translation": [{i},0,0]}}, "camera_id": 1, "name": "{i:04}.jpg"}}"#
+                )
+            })
+            .collect();
+        let text = format!(
+            r#"{{"cameras": [{{"cx": 320.0, "cy": 180.0, "fx": 700.0, "fy": 700.0, "height": 360, "id": 1, "model": "PINHOLE", "width": 640}}], "frame": "reconstruction", "images": [{}], "schema": "sfmeval.cameras/1"}}"#,
+            images.join(", ")
+        );
+        assert!(text.len() > 8192);
+        assert_eq!(
+            detect_model_format("run/out.json", text.as_bytes()),
+            Some(ModelFormat::CamerasJson)
+        );
+        let model = read_model_files(&std::collections::BTreeMap::from([(
+            "run/out.json".to_string(),
+            text.into_bytes(),
+        )]))
+        .unwrap();
+        assert_eq!(model.format, "cameras_json");
+        assert_eq!(model.images.len(), 100);
+        // by name when the content says nothing
+        assert_eq!(
+            detect_model_format("a/cameras.json", b"{}"),
+            Some(ModelFormat::CamerasJson)
+        );
+        assert_eq!(
+            detect_model_format("a/sfm_data.json", b"{}"),
+            Some(ModelFormat::OpenMvg)
         );
     }
 }
