@@ -123,3 +123,32 @@ def umeyama(src, dst, with_scale=True):
     s = np.trace(np.diag(S) @ D) / var_s if with_scale else 1.0
     t = mu_d - s * R @ mu_s
     return s, R, t
+
+
+def track_reprojection(rec, cams):
+    """Reprojection errors (px) of a pycolmap reconstruction's tracks (≥ 3 views) two ways:
+    through its own cameras and points, and through the ground-truth cameras of `cams`
+    (cameras.json) with every point re-triangulated (linear DLT) from the GT poses.
+
+    If the GT poses are exact, they explain the tool's own feature tracks as well as the tool's
+    optimised poses do; a wrong axis, a half-pixel shift or a bad focal shows at once."""
+    _, K, poses = camera_matrices(cams)
+    P_gt = {n: K @ np.hstack([R, t[:, None]]) for n, (R, t) in poses.items()}
+    own, gt = [], []
+    for p in rec.points3D.values():
+        obs = [(rec.images[e.image_id], rec.images[e.image_id].points2D[e.point2D_idx].xy)
+               for e in p.track.elements]
+        if len(obs) < 3:
+            continue
+        A = []
+        for im, xy in obs:
+            P = P_gt[im.name]
+            A += [xy[0] * P[2] - P[0], xy[1] * P[2] - P[1]]
+        X = np.linalg.svd(np.array(A))[2][-1]
+        X = X / X[3]
+        for im, xy in obs:
+            q = P_gt[im.name] @ X
+            gt.append(np.linalg.norm(q[:2] / q[2] - xy))
+            uv = rec.cameras[im.camera_id].img_from_cam(im.cam_from_world() * p.xyz)
+            own.append(np.linalg.norm(np.asarray(uv) - xy))
+    return np.array(own), np.array(gt)
