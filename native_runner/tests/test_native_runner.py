@@ -13,6 +13,9 @@ import pytest
 
 from runner_testlib import REAL, REPO, load, run_cli
 
+sys.path.insert(0, os.path.join(REPO, "blender_scripts", "tests"))
+from blender_testlib import track_reprojection  # noqa: E402
+
 SCHEMA = os.path.join(REPO, "schemas", "report.schema.json")
 
 
@@ -91,14 +94,38 @@ def test_report_registration_and_camera_errors(batch, pipeline):
     assert cams["ground_truth"] == 36
     assert cams["registered"] >= 0.9 * 36 and cams["matched"] == cams["registered"]
     radius = orbit_radius(batch["dataset"])
-    median = cams["center_error"]["median"]
-    sys.stderr.write("%s: centre error median %.3f %%, max %.3f %% of the orbit radius; "
-                     "rotation median %.3f deg; mean distance %.5f m\n"
-                     % (pipeline, 100 * median / radius, 100 * cams["center_error"]["max"] / radius,
-                        cams["rotation_error_deg"]["median"], rep["accuracy"]["mean"]))
+    median, worst = cams["center_error"]["median"], cams["center_error"]["max"]
+    sys.stderr.write("%s: centre error median %.3f %%, max %.3f %%, ATE RMSE %.3f %% of the orbit "
+                     "radius; rotation median %.3f deg; mean distance %.5f m\n"
+                     % (pipeline, 100 * median / radius, 100 * worst / radius,
+                        100 * cams["ate_rmse"] / radius, cams["rotation_error_deg"]["median"],
+                        rep["accuracy"]["mean"]))
     assert median < 0.01 * radius, (pipeline, median, radius)
+    assert cams["ate_rmse"] < 0.01 * radius, (pipeline, cams["ate_rmse"], radius)
+    # Every camera under 1 %. Measured worst cameras: colmap 0.44, pycolmap 0.47, pycolmap-global
+    # 0.37, theia 0.64 %. openmvg-rs keeps only ~1100 points (~100 observations per image with
+    # its ALP features, a third of pycolmap's), and its worst camera is 1.3-1.8 % (SIFT
+    # features: 1.0-1.4 %), while the GT poses explain its tracks as well as its own poses do
+    # (test_ground_truth_explains_every_tools_tracks): that is openmvg-rs's accuracy, so it
+    # gets 2 %.
+    limit = 0.02 if pipeline == "openmvg" else 0.01
+    assert worst < limit * radius, (pipeline, worst / radius)
     assert cams["rotation_error_deg"]["median"] < 1.0
     assert rep["accuracy"]["mean"] < 0.02 * rep["inputs"]["ground_truth"]["diagonal"]
+
+
+@pytest.mark.parametrize("pipeline", REAL)
+def test_ground_truth_explains_every_tools_tracks(batch, pipeline):
+    """Each tool's own feature tracks (its model/, read by pycolmap), re-triangulated from the
+    ground-truth poses, reproject as well as through the tool's own optimised poses: the
+    dataset's cameras are exact, so any camera error left is the tool's."""
+    pycolmap = pytest.importorskip("pycolmap")
+    rec = pycolmap.Reconstruction(str(run_dir(batch, pipeline) / "model"))
+    own, via_gt = track_reprojection(rec, load(os.path.join(batch["dataset"], "cameras.json")))
+    sys.stderr.write("%s: %d observations, reprojection mean %.3f px with its poses, %.3f px "
+                     "with the GT poses\n" % (pipeline, len(own), own.mean(), via_gt.mean()))
+    assert len(own) > 1000
+    assert via_gt.mean() < 1.05 * own.mean(), (pipeline, own.mean(), via_gt.mean())
 
 
 def md_table(text, first_header):
