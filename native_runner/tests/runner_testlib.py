@@ -4,8 +4,8 @@ name so that one pytest session can hold every test folder).
 - `runner_bin`: $SFMEVAL_RUNNER_BIN, else `cargo build --release -p sfmeval-runner`.
 - `small_dataset`: the generator's `small` preset (36 views, 640×360; no depth/mask pass),
   rendered once with PyPI bpy into target/test-data/small-<key>/, where <key> hashes the full
-  resolved generator config (`generate.py --print-config`), and reused while the config is
-  unchanged. $SFMEVAL_RUNNER_TEST_DATASET points at an existing dataset instead.
+  resolved generator config (`generate.py --print-config`) and the generator's source, and
+  reused while both are unchanged. $SFMEVAL_RUNNER_TEST_DATASET points at an existing dataset instead.
 - `batch`: ONE run of the five installed pipelines (+ visualsfm absent, a failing and a
   timing-out custom command) on that dataset, and its report; shared by the tests.
 """
@@ -41,10 +41,20 @@ CUSTOMS = ["--custom", "bad=no-such-sfm-tool {images} {out}",
 
 
 def _key(args):
+    """Hash of the resolved generator config and of the generator's own source (a change to a
+    built-in object's shape or texture must re-render too)."""
     out = subprocess.run([sys.executable, GENERATE] + args + ["--print-config"],
                          stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, check=True)
     cfg = json.loads(out.stdout)
-    return hashlib.sha256(json.dumps(cfg, sort_keys=True).encode()).hexdigest()[:16]
+    h = hashlib.sha256(json.dumps(cfg, sort_keys=True).encode())
+    pkg = os.path.join(REPO, "blender_scripts", "sfmeval_blender")
+    for root, dirs, files in os.walk(pkg):
+        dirs[:] = sorted(d for d in dirs if d != "__pycache__")
+        for name in sorted(files):
+            if name.endswith((".py", ".toml")):
+                with open(os.path.join(root, name), "rb") as f:
+                    h.update(name.encode() + b"\0" + f.read())
+    return h.hexdigest()[:16]
 
 
 @pytest.fixture(scope="session")
