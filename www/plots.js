@@ -15,7 +15,10 @@ function replace(el, plot) {
 }
 const width = (el) => Math.max(260, el.clientWidth || 360);
 
-/** Draws `{edges, counts}` as bars. */
+/**
+ * Draws `{edges, counts}` as bars; values beyond the last edge (`overflow`, a long tail past
+ * p99) or below the first (`underflow`) are named in a caption under the plot.
+ */
 export function histogramPlot(el, hist) {
   const centers = hist.counts.map((_, i) => (hist.edges[i] + hist.edges[i + 1]) / 2);
   const opts = {
@@ -27,6 +30,17 @@ export function histogramPlot(el, hist) {
   };
   const plot = new uPlot(opts, [centers, hist.counts], el);
   replace(el, plot);
+  const fmt = (v) => Number(v).toPrecision(3);
+  const notes = [];
+  if (hist.underflow) notes.push(`${hist.underflow} below ${fmt(hist.edges[0])}`);
+  if (hist.overflow) notes.push(`${hist.overflow} beyond ${fmt(hist.edges[hist.edges.length - 1])} (the long tail past p99)`);
+  let cap = el.parentElement && el.parentElement.querySelector('.hist-tail');
+  if (!cap && el.parentElement) {
+    cap = document.createElement('div');
+    cap.className = 'hist-tail';
+    el.parentElement.appendChild(cap);
+  }
+  if (cap) cap.textContent = notes.length ? `not shown: ${notes.join(', ')}` : '';
   return plot;
 }
 

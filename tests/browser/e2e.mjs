@@ -111,6 +111,10 @@ try {
   const stages = await page.$$eval('#stages tr', (r) => r.length);
   check('alignment-stages-shown', stages >= 3 && (await page.textContent('#r-align')) === rep.alignment.method, `${stages} rows`);
   check('camera-metrics-shown', !rep.cameras || /cameras:/.test(await page.textContent('#summary')));
+  // the histogram's long tail (far SfM background points) is named under the plot, not drawn
+  const h = rep.accuracy.histogram;
+  const tail = (await page.textContent('.hist-tail')) || '';
+  check('histogram-tail-caption', h.overflow > 0 ? tail.includes(`${h.overflow} beyond`) : tail === '', `overflow ${h.overflow}, caption "${tail}"`);
   const ply = await (async () => { const [dl] = await Promise.all([page.waitForEvent('download'), page.click('#dl-ply')]); const p = join(out, 'page.errors.ply'); await dl.saveAs(p); return readFileSync(p); })();
   execFileSync(cli, ['eval', '--gt', demo('ground_truth.glb'), ...modelArgs, '--quiet', '--colored', join(out, 'cli.errors.ply'), '--csv', join(out, 'cli.csv')]);
   check('colored-ply-equals-cli', ply.equals(readFileSync(join(out, 'cli.errors.ply'))));

@@ -121,7 +121,13 @@ def test_point_to_mesh_matches_trimesh_exactly(tmp_path, run_eval, ascii_gt):
     for q in (50, 90, 95, 99):
         np.testing.assert_allclose(acc["percentiles"][f"p{q}"], np.percentile(ref, q), rtol=1e-9)
     np.testing.assert_allclose(acc["max"], ref.max(), rtol=1e-9)
-    assert sum(acc["histogram"]["counts"]) == len(ref)
+    # the histogram against numpy's on the report's own edges; beyond them, under/overflow
+    h = acc["histogram"]
+    want, _ = np.histogram(ref, bins=np.array(h["edges"]))
+    assert h["counts"] == want.tolist()
+    assert h["underflow"] == int((ref < h["edges"][0]).sum())
+    assert h["overflow"] == int((ref > h["edges"][-1]).sum())
+    assert sum(h["counts"]) + h["underflow"] + h["overflow"] == len(ref)
 
 
 def test_point_to_mesh_matches_open3d_raycasting(tmp_path, run_eval):

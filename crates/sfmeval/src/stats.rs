@@ -18,13 +18,26 @@ pub struct Percentiles {
 }
 
 /// A histogram with `edges.len() == counts.len() + 1`; the last bin includes its right edge.
+/// Values below the first edge or above the last are not in any bin but counted in
+/// `underflow` / `overflow`, so `counts` + both always add up to the number of values.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize, Default)]
 pub struct Histogram {
     /// Bin edges, increasing.
     pub edges: Vec<f64>,
     /// Values per bin.
     pub counts: Vec<u64>,
+    /// Values below the first edge.
+    #[serde(default)]
+    pub underflow: u64,
+    /// Values above the last edge.
+    #[serde(default)]
+    pub overflow: u64,
 }
+
+/// How far beyond the 1st–99th percentile range (as a fraction of that range) a value may lie
+/// before the histogram stops stretching to it: a few far outliers (SfM background points)
+/// would otherwise squash every other value into the first bin.
+pub const HISTOGRAM_TAIL: f64 = 0.5;
 
 /// Statistics of a set of values. All zero when `count == 0`.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize, Default)]
@@ -68,8 +81,10 @@ pub fn percentile_sorted(sorted: &[f64], q: f64) -> f64 {
 }
 
 impl Statistics {
-    /// Computes the statistics of `values` (NaNs must not be present). The histogram spans
-    /// `[min(0, min), max]` in `bins` equal bins (`[min, max]` for signed values).
+    /// Computes the statistics of `values` (NaNs must not be present). The histogram has `bins`
+    /// equal bins over `[min(0, min), max]` (`[min, max]` for signed values), except where the
+    /// tail is long: an end farther than [`HISTOGRAM_TAIL`] × (p99 − p1) beyond p99 (or below p1)
+    /// is replaced by p99 (p1), and the values beyond are counted in `overflow` (`underflow`).
     pub fn of(values: &[f64], bins: usize) -> Statistics {
         let n = values.len();
         if n == 0 {
@@ -90,8 +105,12 @@ impl Statistics {
         }
         let min = sorted[0];
         let max = sorted[n - 1];
-        let lo = if min >= 0.0 { 0.0 } else { min };
         let p50 = percentile_sorted(&sorted, 50.0);
+        let (p1, p99) = (
+            percentile_sorted(&sorted, 1.0),
+            percentile_sorted(&sorted, 99.0),
+        );
+        let (lo, hi) = histogram_range(min, max, p1, p99);
         Statistics {
             count: n as u64,
             min,
@@ -104,15 +123,36 @@ impl Statistics {
                 p50,
                 p90: percentile_sorted(&sorted, 90.0),
                 p95: percentile_sorted(&sorted, 95.0),
-                p99: percentile_sorted(&sorted, 99.0),
+                p99,
             },
-            histogram: histogram(&sorted, lo, max, bins),
+            histogram: histogram(&sorted, lo, hi, bins),
         }
     }
 }
 
-/// Histogram of values into `bins` equal bins over `[lo, hi]`; values outside are clamped into
-/// the first/last bin.
+/// The histogram's `[lo, hi]` (see [`Statistics::of`]): from 0 (or the minimum when negative)
+/// to the maximum, each end pulled in to p1 / p99 when it lies beyond the tail allowance.
+fn histogram_range(min: f64, max: f64, p1: f64, p99: f64) -> (f64, f64) {
+    let lo_robust = if min >= 0.0 { 0.0 } else { p1.min(0.0) };
+    let allowance = HISTOGRAM_TAIL * (p99 - lo_robust);
+    // p99 == lo (mostly zeros): keep the maximum, or there would be no bin width at all
+    let hi = if max > p99 + allowance && p99 > lo_robust {
+        p99
+    } else {
+        max
+    };
+    let lo = if min >= 0.0 {
+        0.0
+    } else if min < p1 - HISTOGRAM_TAIL * (p99 - p1) {
+        p1
+    } else {
+        min
+    };
+    (lo, hi)
+}
+
+/// Histogram of values into `bins` equal bins over `[lo, hi]`; values outside are counted in
+/// `underflow` / `overflow`.
 pub fn histogram(values: &[f64], lo: f64, hi: f64, bins: usize) -> Histogram {
     let bins = bins.max(1);
     let width = if hi > lo {
@@ -122,19 +162,31 @@ pub fn histogram(values: &[f64], lo: f64, hi: f64, bins: usize) -> Histogram {
     };
     let edges = (0..=bins)
         .map(|i| {
-            if i == bins {
-                hi.max(lo)
+            if i == bins && hi > lo {
+                hi
             } else {
                 lo + width * i as f64
             }
         })
         .collect();
     let mut counts = vec![0u64; bins];
+    let (mut underflow, mut overflow) = (0u64, 0u64);
     for &v in values {
-        let b = (((v - lo) / width).floor().max(0.0) as usize).min(bins - 1);
-        counts[b] += 1;
+        if v < lo {
+            underflow += 1;
+        } else if v > hi {
+            overflow += 1;
+        } else {
+            let b = (((v - lo) / width).floor().max(0.0) as usize).min(bins - 1);
+            counts[b] += 1;
+        }
     }
-    Histogram { edges, counts }
+    Histogram {
+        edges,
+        counts,
+        underflow,
+        overflow,
+    }
 }
 
 #[cfg(test)]
@@ -161,5 +213,72 @@ mod tests {
         let s = Statistics::of(&[0.5], 10);
         assert_eq!((s.min, s.max, s.median, s.std), (0.5, 0.5, 0.5, 0.0));
         assert_eq!(s.histogram.counts.iter().sum::<u64>(), 1);
+    }
+
+    /// All values equal (a perfect reconstruction's distances): the edges still increase.
+    #[test]
+    fn constant_values() {
+        // [0, 0] has no width: unit bins from 0; [0, 2] puts 2 in the last bin (right edge)
+        for (v, want) in [
+            (0.0, [5, 0, 0, 0]),
+            (2.0, [0, 0, 0, 5]),
+            (-1.0, [5, 0, 0, 0]),
+        ] {
+            let s = Statistics::of(&[v; 5], 4);
+            let e = &s.histogram.edges;
+            assert!(e.windows(2).all(|w| w[0] < w[1]), "{e:?}");
+            assert_eq!(s.histogram.counts, want, "{v}");
+        }
+        let mut v = vec![0.0; 200];
+        v.push(3.0);
+        let s = Statistics::of(&v, 4);
+        assert_eq!(*s.histogram.edges.last().unwrap(), 3.0);
+        assert_eq!(s.histogram.counts, vec![200, 0, 0, 1]);
+    }
+
+    /// 1000 values in [0, 1) and two far outliers: the bins span [0, p99], the outliers are
+    /// counted in `overflow`; without outliers the bins reach the maximum and nothing overflows.
+    #[test]
+    fn long_tails_go_to_overflow_and_underflow() {
+        let mut v: Vec<f64> = (0..1000).map(|i| i as f64 / 1000.0).collect();
+        let s = Statistics::of(&v, 10);
+        assert_eq!(*s.histogram.edges.last().unwrap(), s.max);
+        assert_eq!((s.histogram.underflow, s.histogram.overflow), (0, 0));
+        assert_eq!(s.histogram.counts, vec![100; 10]);
+        v.extend([50.0, 80.0]);
+        let s = Statistics::of(&v, 10);
+        assert_eq!(*s.histogram.edges.last().unwrap(), s.percentiles.p99);
+        assert_eq!(s.histogram.edges[0], 0.0);
+        let beyond = v.iter().filter(|&&x| x > s.percentiles.p99).count() as u64;
+        assert_eq!(s.histogram.overflow, beyond);
+        assert_eq!(s.histogram.underflow, 0);
+        assert_eq!(
+            s.histogram.counts.iter().sum::<u64>() + beyond,
+            v.len() as u64
+        );
+        // signed: one far value on each side
+        let mut w: Vec<f64> = (0..1000).map(|i| i as f64 / 500.0 - 1.0).collect();
+        w.extend([-40.0, 40.0]);
+        let s = Statistics::of(&w, 8);
+        let p1 = percentile_sorted(
+            &{
+                let mut x = w.clone();
+                x.sort_by(f64::total_cmp);
+                x
+            },
+            1.0,
+        );
+        assert_eq!(s.histogram.edges[0], p1);
+        assert_eq!(*s.histogram.edges.last().unwrap(), s.percentiles.p99);
+        let below = w.iter().filter(|&&x| x < p1).count() as u64;
+        let above = w.iter().filter(|&&x| x > s.percentiles.p99).count() as u64;
+        assert_eq!(
+            (s.histogram.underflow, s.histogram.overflow),
+            (below, above)
+        );
+        assert_eq!(
+            s.histogram.counts.iter().sum::<u64>() + below + above,
+            w.len() as u64
+        );
     }
 }
