@@ -81,17 +81,57 @@ struct ToolArgs {
     customs: Vec<String>,
 }
 
+/// How the runs of a batch execute: shared by `run`, `table1` and `sweep`.
 #[derive(Args, Clone)]
-struct BatchArgs {
-    /// Pipelines: names or specs KIND[:key=value,...] separated by commas or `;`, or `all`.
-    #[arg(long, num_args = 1.., required = true)]
-    pipelines: Vec<String>,
+struct ExecArgs {
     /// Timeout per run, seconds (a pipeline's `timeout=` option overrides it).
     #[arg(long, default_value_t = 3600.0)]
     timeout: f64,
     /// Runs at once.
     #[arg(long, default_value_t = 1)]
     jobs: usize,
+    /// Intrinsics given to the tools: `exif` (the images' EXIF, default) or `known`
+    /// (the dataset's cameras.json).
+    #[arg(long, default_value = "exif", value_parser = ["exif", "known"])]
+    intrinsics: String,
+    /// Seed passed to the tools that take one.
+    #[arg(long, default_value_t = 0)]
+    seed: u64,
+}
+
+impl ExecArgs {
+    /// The batch options writing into `out`; `resume`/`retry_failed` say which finished runs
+    /// are reused. Fails on a timeout that is not positive.
+    fn batch_options(&self, out: &Path, resume: bool, retry_failed: bool) -> Result<BatchOptions> {
+        if !(self.timeout > 0.0) {
+            anyhow::bail!("--timeout must be > 0");
+        }
+        Ok(BatchOptions {
+            out: out.to_path_buf(),
+            timeout: Duration::from_secs_f64(self.timeout),
+            jobs: self.jobs.max(1),
+            resume,
+            retry_failed,
+            shard: None,
+            intrinsics: if self.intrinsics == "known" {
+                Intrinsics::Known
+            } else {
+                Intrinsics::Exif
+            },
+            seed: self.seed,
+            keep_scratch: false,
+            verbose: true,
+        })
+    }
+}
+
+#[derive(Args, Clone)]
+struct BatchArgs {
+    /// Pipelines: names or specs KIND[:key=value,...] separated by commas or `;`, or `all`.
+    #[arg(long, num_args = 1.., required = true)]
+    pipelines: Vec<String>,
+    #[command(flatten)]
+    exec: ExecArgs,
     /// Skip runs already finished in the output folder.
     #[arg(long)]
     resume: bool,
@@ -101,13 +141,6 @@ struct BatchArgs {
     /// Only the grid cells k with k % n == i (0 <= i < n), for cluster job arrays.
     #[arg(long, value_name = "i/n")]
     shard: Option<String>,
-    /// Intrinsics given to the tools: `exif` (the images' EXIF, default) or `known`
-    /// (the dataset's cameras.json).
-    #[arg(long, default_value = "exif", value_parser = ["exif", "known"])]
-    intrinsics: String,
-    /// Seed passed to the tools that take one.
-    #[arg(long, default_value_t = 0)]
-    seed: u64,
     /// Keep the tools' scratch files (databases, features) in the run folders.
     #[arg(long)]
     keep_scratch: bool,
@@ -207,18 +240,11 @@ struct Table1Args {
     /// The blender_scripts folder (default: found from the binary or the working directory).
     #[arg(long)]
     blender_scripts: Option<PathBuf>,
-    /// Timeout per run, seconds.
-    #[arg(long, default_value_t = 3600.0)]
-    timeout: f64,
-    /// Runs at once.
-    #[arg(long, default_value_t = 1)]
-    jobs: usize,
     /// Redo everything (default: reuse rendered datasets and finished runs).
     #[arg(long)]
     fresh: bool,
-    /// Intrinsics given to the tools: exif or known.
-    #[arg(long, default_value = "exif", value_parser = ["exif", "known"])]
-    intrinsics: String,
+    #[command(flatten)]
+    exec: ExecArgs,
     #[command(flatten)]
     tools: ToolArgs,
     #[command(flatten)]
@@ -282,24 +308,10 @@ fn make_env(tools: &ToolArgs, out: &Path) -> Result<Env> {
 }
 
 fn batch_options(b: &BatchArgs, out: &Path) -> Result<BatchOptions> {
-    if !(b.timeout > 0.0) {
-        anyhow::bail!("--timeout must be > 0");
-    }
     Ok(BatchOptions {
-        out: out.to_path_buf(),
-        timeout: Duration::from_secs_f64(b.timeout),
-        jobs: b.jobs.max(1),
-        resume: b.resume,
-        retry_failed: b.retry_failed,
         shard: b.shard.as_deref().map(run::parse_shard).transpose()?,
-        intrinsics: if b.intrinsics == "known" {
-            Intrinsics::Known
-        } else {
-            Intrinsics::Exif
-        },
-        seed: b.seed,
         keep_scratch: b.keep_scratch,
-        verbose: true,
+        ..b.exec.batch_options(out, b.resume, b.retry_failed)?
     })
 }
 

@@ -10,7 +10,7 @@
 
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
-use std::time::{Duration, Instant};
+use std::time::Instant;
 
 use anyhow::{Context, Result, bail};
 use clap::Args;
@@ -100,24 +100,14 @@ pub struct SweepArgs {
     /// The blender_scripts folder (default: found from the binary or the working directory).
     #[arg(long)]
     blender_scripts: Option<PathBuf>,
-    /// Timeout per run, seconds.
-    #[arg(long, default_value_t = 3600.0)]
-    timeout: f64,
-    /// Runs at once.
-    #[arg(long, default_value_t = 1)]
-    jobs: usize,
     /// Redo everything (default: reuse rendered variants and finished runs).
     #[arg(long)]
     fresh: bool,
     /// Redo runs that failed or timed out (finished ones are reused).
     #[arg(long)]
     retry_failed: bool,
-    /// Intrinsics given to the tools: exif or known.
-    #[arg(long, default_value = "exif", value_parser = ["exif", "known"])]
-    intrinsics: String,
-    /// Seed passed to the tools that take one.
-    #[arg(long, default_value_t = 0)]
-    seed: u64,
+    #[command(flatten)]
+    exec: crate::ExecArgs,
     #[command(flatten)]
     tools: crate::ToolArgs,
     #[command(flatten)]
@@ -770,7 +760,7 @@ fn resolve_base(python: &Path, scripts: &Path, base_args: &[String]) -> Result<J
 pub fn sweep(a: &SweepArgs) -> Result<()> {
     let t0 = Instant::now();
     let (factor, values) = parse_factor(&a.factor)?;
-    if !(a.timeout > 0.0) {
+    if !(a.exec.timeout > 0.0) {
         bail!("--timeout must be > 0");
     }
     // absolute paths: the generator runs in the datasets folder
@@ -882,22 +872,7 @@ pub fn sweep(a: &SweepArgs) -> Result<()> {
     let t_runs = Instant::now();
     if !datasets.is_empty() {
         let env = crate::make_env(&a.tools, &runs)?;
-        let opts = crate::run::BatchOptions {
-            out: runs.clone(),
-            timeout: Duration::from_secs_f64(a.timeout),
-            jobs: a.jobs.max(1),
-            resume: !a.fresh,
-            retry_failed: a.retry_failed,
-            shard: None,
-            intrinsics: if a.intrinsics == "known" {
-                crate::adapters::Intrinsics::Known
-            } else {
-                crate::adapters::Intrinsics::Exif
-            },
-            seed: a.seed,
-            keep_scratch: false,
-            verbose: true,
-        };
+        let opts = a.exec.batch_options(&runs, !a.fresh, a.retry_failed)?;
         let sum = crate::run::run_batch(&datasets, &specs, &customs, &env, &opts)?;
         eprintln!(
             "sweep: runs: {} executed, {} reused",

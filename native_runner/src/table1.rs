@@ -178,22 +178,7 @@ pub fn table1(a: &Table1Args) -> Result<()> {
     let customs = crate::pipelines::parse_customs(&a.tools.customs)?;
     let specs = crate::pipelines::parse_list(&a.pipelines, &customs)?;
     let env = crate::make_env(&a.tools, &runs)?;
-    let opts = crate::run::BatchOptions {
-        out: runs.clone(),
-        timeout: Duration::from_secs_f64(a.timeout.max(1.0)),
-        jobs: a.jobs.max(1),
-        resume: !a.fresh,
-        retry_failed: false,
-        shard: None,
-        intrinsics: if a.intrinsics == "known" {
-            crate::adapters::Intrinsics::Known
-        } else {
-            crate::adapters::Intrinsics::Exif
-        },
-        seed: 0,
-        keep_scratch: false,
-        verbose: true,
-    };
+    let opts = a.exec.batch_options(&runs, !a.fresh, false)?;
     let t_runs = Instant::now();
     let summary = crate::run::run_batch(&datasets, &specs, &customs, &env, &opts)?;
     let runs_seconds = t_runs.elapsed().as_secs_f64();
