@@ -14,6 +14,21 @@ fn g(v: f64) -> String {
     }
 }
 
+/// One statistics line: the same fields for every distance block, `extra` in parentheses.
+fn stats_line(s: &mut String, label: &str, st: &sfmeval::stats::Statistics, extra: &str) {
+    let _ = writeln!(
+        s,
+        "{label:<15} mean {}  median {}  rms {}  std {}  p90 {}  p99 {}  max {}  ({extra})",
+        g(st.mean),
+        g(st.median),
+        g(st.rms),
+        g(st.std),
+        g(st.percentiles.p90),
+        g(st.percentiles.p99),
+        g(st.max)
+    );
+}
+
 /// Formats the report for a person.
 pub fn render(r: &Report) -> String {
     let mut s = String::new();
@@ -65,17 +80,7 @@ pub fn render(r: &Report) -> String {
             format!("GT → recon, {} samples", r.completeness.samples),
         ),
     ] {
-        let _ = writeln!(
-            s,
-            "{label:<15} mean {}  median {}  rms {}  std {}  p90 {}  p99 {}  max {}  ({extra})",
-            g(st.mean),
-            g(st.median),
-            g(st.rms),
-            g(st.std),
-            g(st.percentiles.p90),
-            g(st.percentiles.p99),
-            g(st.max)
-        );
+        stats_line(&mut s, label, st, &extra);
     }
     if let Some(sg) = &r.accuracy.signed {
         let _ = writeln!(
@@ -116,17 +121,7 @@ pub fn render(r: &Report) -> String {
                 .map(|a| format!(", area {}", g(a)))
                 .unwrap_or_default()
         );
-        let st = &v.stats;
-        let _ = writeln!(
-            s,
-            "{:<15} mean {}  median {}  rms {}  p90 {}  max {}  (GT visible → recon)",
-            "compl. visible",
-            g(st.mean),
-            g(st.median),
-            g(st.rms),
-            g(st.percentiles.p90),
-            g(st.max)
-        );
+        stats_line(&mut s, "compl. visible", &v.stats, "GT visible → recon");
         let _ = writeln!(
             s,
             "{:>14} {:>10} {:>14} {:>14}",
@@ -144,20 +139,17 @@ pub fn render(r: &Report) -> String {
         }
     }
     if let Some(t) = &r.track_error {
-        let st = &t.stats;
-        let _ = writeln!(
-            s,
-            "{:<15} mean {}  median {}  rms {}  p90 {}  max {}  ({} of {} points measured; their surface distance: mean {}, median {})",
+        stats_line(
+            &mut s,
             "track error",
-            g(st.mean),
-            g(st.median),
-            g(st.rms),
-            g(st.percentiles.p90),
-            g(st.max),
-            t.measured,
-            t.points,
-            g(t.surface_distance.mean),
-            g(t.surface_distance.median)
+            &t.stats,
+            &format!(
+                "{} of {} points measured; their surface distance: mean {}, median {}",
+                t.measured,
+                t.points,
+                g(t.surface_distance.mean),
+                g(t.surface_distance.median)
+            ),
         );
         let _ = writeln!(
             s,
