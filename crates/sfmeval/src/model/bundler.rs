@@ -4,7 +4,7 @@
 //! unregistered. Bundler stores no image size or principal point (the image centre).
 
 use super::text::{self, Tokens};
-use super::{Camera, Image, Observation, Point3D, Reconstruction, Rigid, TrackElement};
+use super::{Camera, Image, Point3D, Reconstruction, Rigid};
 use crate::error::{Error, Result};
 
 const FMT: &str = "Bundler";
@@ -158,18 +158,7 @@ pub fn read_bundler(out: &[u8], list: Option<&[u8]>) -> Result<Reconstruction> {
             let x = t.f64("x")?;
             let y = t.f64("y")?;
             match index_of.get(cam as usize).copied().flatten() {
-                Some(i) => {
-                    if let Some(im) = rec.images.get_mut(i) {
-                        im.observations.push(Observation {
-                            xy: [x, y],
-                            point: Some(point_index),
-                        });
-                    }
-                    track.push(TrackElement {
-                        image: i,
-                        keypoint: key,
-                    });
-                }
+                Some(i) => rec.observe(&mut track, i, key, [x, y], point_index),
                 None => bad_refs += 1,
             }
         }

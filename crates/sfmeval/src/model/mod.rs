@@ -309,6 +309,26 @@ impl Reconstruction {
         self.images.iter().map(Image::center).collect()
     }
 
+    /// Records that image `image` (an index) sees the point about to be pushed as number
+    /// `point` at pixel `xy`, feature `keypoint`: the image's observation and the track element.
+    /// Readers whose tracks name images directly (NVM, Bundler, OpenMVG) share this.
+    pub(crate) fn observe(
+        &mut self,
+        track: &mut Vec<TrackElement>,
+        image: usize,
+        keypoint: u64,
+        xy: [f64; 2],
+        point: usize,
+    ) {
+        if let Some(im) = self.images.get_mut(image) {
+            im.observations.push(Observation {
+                xy,
+                point: Some(point),
+            });
+        }
+        track.push(TrackElement { image, keypoint });
+    }
+
     /// The camera of an image, if present.
     pub fn camera_of(&self, image: &Image) -> Option<&Camera> {
         self.cameras.iter().find(|c| c.id == image.camera_id)

@@ -5,7 +5,7 @@
 //! is unknown (0). Names may contain folders and backslashes; they are kept as written.
 
 use super::text::{self, clip};
-use super::{Camera, Image, Observation, Point3D, Reconstruction, Rigid, TrackElement};
+use super::{Camera, Image, Point3D, Reconstruction, Rigid};
 use crate::error::{Error, Result};
 
 const FMT: &str = "NVM";
@@ -132,18 +132,10 @@ pub fn read_nvm_models(bytes: &[u8]) -> Result<Vec<(String, Reconstruction)>> {
                 let feat: u64 = text::parse(FMT, m.get(1).copied(), "feature index", line)?;
                 let x = text::parse_f64(FMT, m.get(2).copied(), "x", line)?;
                 let y = text::parse_f64(FMT, m.get(3).copied(), "y", line)?;
-                match rec.images.get_mut(cam) {
-                    Some(im) => {
-                        im.observations.push(Observation {
-                            xy: [x, y],
-                            point: Some(point_index),
-                        });
-                        track.push(TrackElement {
-                            image: cam,
-                            keypoint: feat,
-                        });
-                    }
-                    None => bad_refs += 1,
+                if cam < rec.images.len() {
+                    rec.observe(&mut track, cam, feat, [x, y], point_index);
+                } else {
+                    bad_refs += 1;
                 }
             }
             rec.points.push(Point3D {

@@ -10,7 +10,7 @@ use std::collections::BTreeMap;
 
 use serde_json::Value;
 
-use super::{Camera, Image, Observation, Point3D, Reconstruction, Rigid, TrackElement};
+use super::{Camera, Image, Point3D, Reconstruction, Rigid};
 use crate::error::{Error, Result};
 
 const FMT: &str = "OpenMVG sfm_data";
@@ -235,16 +235,7 @@ pub fn read_openmvg_json(bytes: &[u8]) -> Result<Reconstruction> {
             let xy = vec_n::<2>(obs.get("x"), "observation x")?;
             match image_of_view.get(&view).copied() {
                 Some(i) => {
-                    if let Some(im) = rec.images.get_mut(i) {
-                        im.observations.push(Observation {
-                            xy: [xy[0] + 0.5, xy[1] + 0.5],
-                            point: Some(point_index),
-                        });
-                    }
-                    track.push(TrackElement {
-                        image: i,
-                        keypoint: feat,
-                    });
+                    rec.observe(&mut track, i, feat, [xy[0] + 0.5, xy[1] + 0.5], point_index)
                 }
                 None => bad_refs += 1,
             }
