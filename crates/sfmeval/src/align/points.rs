@@ -42,22 +42,22 @@ pub fn parse_point_pairs(bytes: &[u8]) -> Result<Vec<PointPair>> {
             ),
         )
     })?;
-    if let Some(i) = pairs
-        .iter()
-        .position(|p| !(is_finite(&p.recon) && is_finite(&p.gt)))
-    {
-        let count = pairs
-            .iter()
-            .filter(|p| !(is_finite(&p.recon) && is_finite(&p.gt)))
-            .count();
-        return Err(Error::NonFinite {
+    check_finite(&pairs)?;
+    Ok(pairs)
+}
+
+/// Fails on the first pair with a NaN or infinite coordinate (counting them all).
+fn check_finite(pairs: &[PointPair]) -> Result<()> {
+    let bad = |p: &PointPair| !(is_finite(&p.recon) && is_finite(&p.gt));
+    match pairs.iter().position(bad) {
+        Some(first_index) => Err(Error::NonFinite {
             format: "point pairs",
             what: "pair",
-            count,
-            first_index: i,
-        });
+            count: pairs.iter().filter(|p| bad(p)).count(),
+            first_index,
+        }),
+        None => Ok(()),
     }
-    Ok(pairs)
 }
 
 /// Minimum √(λ₂/λ₁) of the picked points on either side: below it they are too close to a
@@ -75,21 +75,7 @@ pub fn align_points(pairs: &[PointPair]) -> Result<(Similarity, AlignmentStage)>
     }
     let src: Vec<Point3> = pairs.iter().map(|p| p.recon).collect();
     let dst: Vec<Point3> = pairs.iter().map(|p| p.gt).collect();
-    if let Some(i) = pairs
-        .iter()
-        .position(|p| !(is_finite(&p.recon) && is_finite(&p.gt)))
-    {
-        let count = pairs
-            .iter()
-            .filter(|p| !(is_finite(&p.recon) && is_finite(&p.gt)))
-            .count();
-        return Err(Error::NonFinite {
-            format: "point pairs",
-            what: "pair",
-            count,
-            first_index: i,
-        });
-    }
+    check_finite(pairs)?;
     for (name, set) in [("reconstruction", &src), ("ground-truth", &dst)] {
         let r = planarity_ratio(set);
         if !(r >= MIN_PLANARITY) {
