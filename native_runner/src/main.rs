@@ -100,12 +100,19 @@ struct ExecArgs {
 }
 
 impl ExecArgs {
-    /// The batch options writing into `out`; `resume`/`retry_failed` say which finished runs
-    /// are reused. Fails on a timeout that is not positive.
-    fn batch_options(&self, out: &Path, resume: bool, retry_failed: bool) -> Result<BatchOptions> {
+    /// Fails on a timeout that is not positive. Commands that render first call it before
+    /// rendering, so a bad flag does not cost the renders.
+    fn check(&self) -> Result<()> {
         if !(self.timeout > 0.0) {
             anyhow::bail!("--timeout must be > 0");
         }
+        Ok(())
+    }
+
+    /// The batch options writing into `out`; `resume`/`retry_failed` say which finished runs
+    /// are reused. Fails as [`Self::check`] does.
+    fn batch_options(&self, out: &Path, resume: bool, retry_failed: bool) -> Result<BatchOptions> {
+        self.check()?;
         Ok(BatchOptions {
             out: out.to_path_buf(),
             timeout: Duration::from_secs_f64(self.timeout),

@@ -760,9 +760,7 @@ fn resolve_base(python: &Path, scripts: &Path, base_args: &[String]) -> Result<J
 pub fn sweep(a: &SweepArgs) -> Result<()> {
     let t0 = Instant::now();
     let (factor, values) = parse_factor(&a.factor)?;
-    if !(a.exec.timeout > 0.0) {
-        bail!("--timeout must be > 0");
-    }
+    a.exec.check()?;
     // absolute paths: the generator runs in the datasets folder
     let mut python = crate::find_python(a.tools.python.as_deref());
     if python.components().count() > 1 {

@@ -136,6 +136,7 @@ pub fn render_dataset(
 /// The whole experiment.
 pub fn table1(a: &Table1Args) -> Result<()> {
     let t0 = Instant::now();
+    a.exec.check()?;
     let mut python = crate::find_python(a.tools.python.as_deref());
     if python.components().count() > 1 {
         python = std::path::absolute(&python)?;
