@@ -31,6 +31,8 @@ impl Adapter for Theia {
             "min_track",
             "max_track",
             "max_sampson_error",
+            "loss",
+            "loss_width",
             "threads",
         ]
     }
