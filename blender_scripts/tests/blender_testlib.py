@@ -125,30 +125,41 @@ def umeyama(src, dst, with_scale=True):
     return s, R, t
 
 
+def _triangulate(rays_and_poses):
+    """Linear (DLT) triangulation from normalised image points and 3x4 cam_from_world poses."""
+    A = []
+    for xy, P in rays_and_poses:
+        A += [xy[0] * P[2] - P[0], xy[1] * P[2] - P[1]]
+    X = np.linalg.svd(np.array(A))[2][-1]
+    return X[:3] / X[3]
+
+
 def track_reprojection(rec, cams):
-    """Reprojection errors (px) of a pycolmap reconstruction's tracks (≥ 3 views) two ways:
-    through its own cameras and points, and through the ground-truth cameras of `cams`
-    (cameras.json) with every point re-triangulated (linear DLT) from the GT poses.
+    """Reprojection errors (px) of a pycolmap reconstruction's tracks (≥ 3 views) two ways,
+    with every point re-triangulated by the same linear DLT: from the tool's own cameras, and
+    from the ground-truth cameras of `cams` (cameras.json). Only the poses and intrinsics differ
+    between the two, not how the points are found (a tool's own points come from its bundle
+    adjustment, robust or not, and would not compare like with like).
 
     If the GT poses are exact, they explain the tool's own feature tracks as well as the tool's
     optimised poses do; a wrong axis, a half-pixel shift or a bad focal shows at once."""
     _, K, poses = camera_matrices(cams)
-    P_gt = {n: K @ np.hstack([R, t[:, None]]) for n, (R, t) in poses.items()}
+    K_inv = np.linalg.inv(K)
+    gt_pose = {n: np.hstack([R, t[:, None]]) for n, (R, t) in poses.items()}
     own, gt = [], []
     for p in rec.points3D.values():
         obs = [(rec.images[e.image_id], rec.images[e.image_id].points2D[e.point2D_idx].xy)
                for e in p.track.elements]
         if len(obs) < 3:
             continue
-        A = []
-        for im, xy in obs:
-            P = P_gt[im.name]
-            A += [xy[0] * P[2] - P[0], xy[1] * P[2] - P[1]]
-        X = np.linalg.svd(np.array(A))[2][-1]
-        X = X / X[3]
-        for im, xy in obs:
-            q = P_gt[im.name] @ X
-            gt.append(np.linalg.norm(q[:2] / q[2] - xy))
-            uv = rec.cameras[im.camera_id].img_from_cam(im.cam_from_world() * p.xyz)
+        own_views = [(np.asarray(rec.cameras[im.camera_id].cam_from_img(xy)),
+                      im.cam_from_world().matrix()) for im, xy in obs]
+        gt_views = [((K_inv @ np.array([xy[0], xy[1], 1.0]))[:2], gt_pose[im.name])
+                    for im, xy in obs]
+        X_own, X_gt = _triangulate(own_views), _triangulate(gt_views)
+        for (im, xy), (_, P_own), (_, P_gt) in zip(obs, own_views, gt_views):
+            uv = rec.cameras[im.camera_id].img_from_cam(P_own[:, :3] @ X_own + P_own[:, 3])
             own.append(np.linalg.norm(np.asarray(uv) - xy))
+            q = K @ (P_gt[:, :3] @ X_gt + P_gt[:, 3])
+            gt.append(np.linalg.norm(q[:2] / q[2] - xy))
     return np.array(own), np.array(gt)

@@ -3,6 +3,7 @@ ground-truth poses explain pycolmap's own feature tracks as well as its own pose
 camera centres agree with cameras.json after a similarity (< 0.5 % of the orbit radius, every
 camera)."""
 
+import json
 import os
 import sys
 
@@ -59,6 +60,14 @@ def test_pycolmap_registers_all_and_matches_ground_truth(small_dataset, tmp_path
     assert len(own) > 5000
     assert via_gt.mean() < 1.03 * own.mean()
     assert np.median(via_gt) < 1.03 * np.median(own)
+    # ... and the check has teeth: a principal point half a pixel off fails it.
+    shifted = json.loads(json.dumps(gt))
+    shifted["cameras"][0]["cx"] += 0.5
+    shifted["cameras"][0]["cy"] += 0.5
+    _, via_shifted = track_reprojection(rec, shifted)
+    sys.stderr.write("[pycolmap] GT principal point shifted by 0.5 px: mean %.3f px\n"
+                     % via_shifted.mean())
+    assert via_shifted.mean() > 1.03 * own.mean()
 
     # 2. Camera centres. pycolmap's mapper bundle-adjusts with a squared loss, and 3-5 % of the
     # observations have residuals over 1 px (mostly at grazing view angles near the

@@ -103,9 +103,9 @@ def test_report_registration_and_camera_errors(batch, pipeline):
     assert median < 0.01 * radius, (pipeline, median, radius)
     assert cams["ate_rmse"] < 0.01 * radius, (pipeline, cams["ate_rmse"], radius)
     # Every camera under 1 %. Measured worst cameras: colmap 0.44, pycolmap 0.47, pycolmap-global
-    # 0.37, theia 0.64 %. openmvg-rs keeps only ~1100 points (~100 observations per image with
-    # its ALP features, a third of pycolmap's), and its worst camera is 1.3-1.8 % (SIFT
-    # features: 1.0-1.4 %), while the GT poses explain its tracks as well as its own poses do
+    # 0.37, theia 0.25-0.50 % (Cauchy loss). openmvg-rs keeps only ~1100 points (~100
+    # observations per image with its ALP features, a third of pycolmap's), and its worst camera
+    # is 1.3-1.8 % (SIFT features: 1.0-1.4 %), while the GT poses explain its tracks as well as its own poses do
     # (test_ground_truth_explains_every_tools_tracks): that is openmvg-rs's accuracy, so it
     # gets 2 %.
     limit = 0.02 if pipeline == "openmvg" else 0.01
@@ -117,15 +117,24 @@ def test_report_registration_and_camera_errors(batch, pipeline):
 @pytest.mark.parametrize("pipeline", REAL)
 def test_ground_truth_explains_every_tools_tracks(batch, pipeline):
     """Each tool's own feature tracks (its model/, read by pycolmap), re-triangulated from the
-    ground-truth poses, reproject as well as through the tool's own optimised poses: the
-    dataset's cameras are exact, so any camera error left is the tool's."""
+    ground-truth poses, reproject as well as when re-triangulated from the tool's own optimised
+    poses: the dataset's cameras are exact, so any camera error left is the tool's. Within 2 %:
+    measured 0.99-1.00 for every tool; OpenCV SIFT's +0.25 px keypoint bias (before the theia
+    adapter used precise upscaling) showed as 1.04."""
     pycolmap = pytest.importorskip("pycolmap")
     rec = pycolmap.Reconstruction(str(run_dir(batch, pipeline) / "model"))
-    own, via_gt = track_reprojection(rec, load(os.path.join(batch["dataset"], "cameras.json")))
+    gt = load(os.path.join(batch["dataset"], "cameras.json"))
+    own, via_gt = track_reprojection(rec, gt)
+    # The check has teeth: the GT with its principal point off by half a pixel must fail it.
+    gt["cameras"][0]["cx"] += 0.5
+    gt["cameras"][0]["cy"] += 0.5
+    _, via_shifted = track_reprojection(rec, gt)
     sys.stderr.write("%s: %d observations, reprojection mean %.3f px with its poses, %.3f px "
-                     "with the GT poses\n" % (pipeline, len(own), own.mean(), via_gt.mean()))
+                     "with the GT poses, %.3f px with the principal point shifted by 0.5 px\n"
+                     % (pipeline, len(own), own.mean(), via_gt.mean(), via_shifted.mean()))
     assert len(own) > 1000
-    assert via_gt.mean() < 1.05 * own.mean(), (pipeline, own.mean(), via_gt.mean())
+    assert via_gt.mean() < 1.02 * own.mean(), (pipeline, own.mean(), via_gt.mean())
+    assert via_shifted.mean() > 1.02 * own.mean(), (pipeline, own.mean(), via_shifted.mean())
 
 
 def md_table(text, first_header):
