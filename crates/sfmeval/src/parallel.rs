@@ -18,8 +18,10 @@ where
     #[cfg(feature = "parallel")]
     {
         use rayon::prelude::*;
+        // Small inputs (ICP's coarse phase) still get split over every thread.
+        let chunk = (items.len() / (4 * rayon::current_num_threads())).clamp(256, CHUNK);
         let chunks: Vec<Vec<R>> = items
-            .par_chunks(CHUNK)
+            .par_chunks(chunk)
             .map(|c| {
                 let out: Vec<R> = c.iter().map(&f).collect();
                 progress.advance(c.len() as u64);
