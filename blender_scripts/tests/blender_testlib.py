@@ -125,6 +125,16 @@ def umeyama(src, dst, with_scale=True):
     return s, R, t
 
 
+def shift_principal_point(cams, px):
+    """A copy of cameras.json `cams` with every camera's principal point moved by `px` pixels in
+    x and y (what a half-pixel convention error does)."""
+    out = json.loads(json.dumps(cams))
+    for cam in out["cameras"]:
+        cam["cx"] += px
+        cam["cy"] += px
+    return out
+
+
 def _triangulate(rays_and_poses):
     """Linear (DLT) triangulation from normalised image points and 3x4 cam_from_world poses."""
     A = []
