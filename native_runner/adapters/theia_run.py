@@ -10,8 +10,9 @@ min_track (default 3), max_track (default 30), max_sampson_error (default 2.0), 
 Theia), loss_width (robust loss width in pixels, default 10 as in Theia), threads (default: all
 cores).
 
-OpenCV keypoints (with precise upscaling) have pixel centres on integers; 0.5 is added so that the features, the
-principal point (cx = W/2) and the written COLMAP model are in COLMAP's pixel convention.
+OpenCV keypoints (with precise upscaling) have pixel centres on integers; 0.5 is added so that
+the features, the principal point (cx = W/2) and the written COLMAP model are in COLMAP's pixel
+convention.
 """
 
 import os
