@@ -66,3 +66,17 @@ def test_debian_blender_matches_pypi_bpy(tmp_path):
         assert dist.max() <= 1.5, name
         ie = Image.open(deb / "images" / name).getexif().get_ifd(0x8769)
         assert float(ie[0x920A]) * float(ie[0xA20E]) / 25.4 == pytest.approx(cam["fx"], abs=1e-9)
+
+
+@requires_blender
+def test_debian_blender_denoise_true_fails_before_rendering(tmp_path):
+    """Debian's 3.4 has no OpenImageDenoise: `render.denoise = true` stops with a clear message
+    at the scene step, before any image, and writes nothing (`"auto"` renders without it:
+    test above). ~3 s."""
+    out = tmp_path / "out"
+    proc = run_blender(["--preset", "small", "--set", "render.denoise=true", "--out", str(out)],
+                       timeout=300)
+    assert proc.returncode == 1, proc.stdout[-3000:] + proc.stderr[-3000:]
+    assert "no OpenImageDenoise" in proc.stderr and "Traceback" not in proc.stderr
+    assert "render 1/" not in proc.stdout
+    assert not out.exists()

@@ -115,3 +115,43 @@ def test_fbx_written_by_blender(tmp_path):
     gt, _ = glb_vertices(str(out / "ground_truth.glb"))
     ext = np.sort(gt.max(0) - gt.min(0))
     assert ext == pytest.approx([1 / 3, 2 / 3, 1.0], abs=1e-5)     # 2×1×3 box, normalised
+
+
+def _gltf_with_external_buffers(folder):
+    """A non-binary .gltf written by trimesh: JSON plus separate .bin buffer files."""
+    import json
+    import trimesh
+    mesh = _box_mesh()
+    files = trimesh.Scene(mesh).export(file_type="gltf")
+    for name, data in files.items():
+        (folder / name).write_bytes(data)
+    uris = [b["uri"] for b in json.loads(files["model.gltf"])["buffers"]]
+    assert uris and all(u.endswith(".bin") for u in uris)          # external, not data URIs
+    return mesh, folder / "model.gltf", uris
+
+
+def test_gltf_with_external_bin(tmp_path):
+    """A .gltf whose buffers are separate .bin files next to it imports like the GLB."""
+    mesh, path, _ = _gltf_with_external_buffers(tmp_path)
+    out = _generate(tmp_path, path)
+    gt, _ = glb_vertices(str(out / "ground_truth.glb"))
+    want = _normalised(np.asarray(mesh.vertices))                 # glTF is Y-up: unchanged
+    from scipy.spatial import cKDTree
+    assert max(cKDTree(want).query(gt)[0].max(), cKDTree(gt).query(want)[0].max()) < 1e-5
+    assert load_json(out / "dataset.json")["source"]["format"] == "gltf"
+
+
+def test_gltf_missing_bin_is_a_clear_error(tmp_path):
+    """The same .gltf with its .bin files gone: exit 1 at the import step, the message names
+    the model and the missing buffer, nothing is written to --out."""
+    _, path, uris = _gltf_with_external_buffers(tmp_path)
+    for u in uris:
+        (tmp_path / u).unlink()
+    cfg = tmp_path / "d.toml"
+    cfg.write_text('preset = "small"\n[object]\nsource = "model.gltf"\n')
+    out = tmp_path / "out"
+    proc = run_generate(["--config", str(cfg), "--out", str(out)], timeout=300)
+    assert proc.returncode == 1, proc.stdout[-2000:] + proc.stderr[-2000:]
+    assert "cannot import" in proc.stderr and "model.gltf" in proc.stderr
+    assert uris[0] in proc.stderr and "Traceback" not in proc.stderr
+    assert not out.exists()
