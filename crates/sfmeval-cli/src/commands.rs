@@ -95,6 +95,12 @@ struct InputArgs {
     /// fine), an .nvm, a Bundler .out, an OpenMVG sfm_data.json, or a cameras.json.
     #[arg(long, value_name = "PATH")]
     recon: PathBuf,
+    /// The SfM model (any format --recon takes) whose cameras go with a PLY --recon in the same
+    /// frame: the PLY's points at the model's camera centres are removed (whatever their
+    /// colour), and the model's cameras serve the camera alignment and the pose metrics. A
+    /// --recon folder holding one PLY beside a model does the same by itself.
+    #[arg(long, value_name = "PATH")]
+    recon_cameras: Option<PathBuf>,
     /// Ground-truth cameras (the dataset's cameras.json): camera alignment and pose metrics.
     #[arg(long, value_name = "FILE")]
     gt_cameras: Option<PathBuf>,
@@ -413,8 +419,22 @@ fn load(input: &InputArgs, eval: EvalOptions, bars: &Bars) -> Result<Loaded> {
     let gt = io::read_ground_truth(&name_of(&gt_path), &gt_bytes, &external)
         .with_context(|| format!("ground truth '{}'", gt_path.display()))?;
     drop(gt_bytes);
-    let recon = read_reconstruction(&name_of(&input.recon), &read_path_files(&input.recon)?)
-        .with_context(|| format!("reconstruction '{}'", input.recon.display()))?;
+    let recon_files = read_path_files(&input.recon)?;
+    let recon = match &input.recon_cameras {
+        Some(p) => {
+            let cameras = model::read_model_files(&read_path_files(p)?)
+                .with_context(|| format!("reconstruction cameras '{}'", p.display()))?;
+            pipeline::read_reconstruction_with_cameras(
+                &name_of(&input.recon),
+                &recon_files,
+                cameras,
+                &name_of(p),
+            )
+        }
+        None => read_reconstruction(&name_of(&input.recon), &recon_files),
+    }
+    .with_context(|| format!("reconstruction '{}'", input.recon.display()))?;
+    drop(recon_files);
     let prepared = PreparedGroundTruth::new(&gt.ground_truth, eval.samples, eval.seed, bars)
         .with_context(|| format!("ground truth '{}'", gt_path.display()))?;
     let gt_info = GroundTruthInfo {
@@ -573,7 +593,8 @@ fn cameras_cmd(
         )
     })?;
     let given = transform.map(read_transform).transpose()?;
-    let (_, alignment, cams) = pipeline::cameras_only(&gt, &est, given, &RunOptions::default())?;
+    let (_, alignment, cams) = pipeline::cameras_only(&gt, &est, given, &RunOptions::default())
+        .with_context(|| format!("cameras of '{}'", recon.display()))?;
     let value = serde_json::json!({"alignment": alignment, "cameras": cams});
     let mut s = serde_json::to_string_pretty(&value)?;
     s.push('\n');

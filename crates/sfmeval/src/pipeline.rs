@@ -29,20 +29,32 @@ use crate::{track_error, visibility};
 pub struct ReconInput {
     /// The points to evaluate (camera-centre points removed).
     pub cloud: PointCloud,
-    /// The SfM model, for formats with cameras.
+    /// The SfM model, for formats with cameras (or the model given beside a PLY).
     pub model: Option<Reconstruction>,
     /// Name shown in the report.
     pub name: String,
-    /// `ply`, `colmap`, `nvm`, `bundler`, `openmvg`, `cameras_json`, ...
+    /// `ply`, `colmap`, `nvm`, `bundler`, `openmvg`, `cameras_json`, ...; `ply+nvm` (etc.) for
+    /// a PLY cloud with the cameras of a model.
     pub format: String,
     /// Notes for the report.
     pub warnings: Vec<String>,
+    /// Whether `cloud` is the model's own points in order ([`Reconstruction::to_point_cloud`]),
+    /// so that per-point model data (tracks) lines up with the evaluated points.
+    pub cloud_is_model_points: bool,
+}
+
+fn is_ply(name: &str) -> bool {
+    name.to_ascii_lowercase().ends_with(".ply")
 }
 
 /// Reads a reconstruction from named files: one point-cloud file (PLY, or the vertices of a
 /// mesh), or the files of an SfM model (a COLMAP folder with `sparse/N` sub-models, `.nvm`,
 /// Bundler `.out` + `list.txt`, OpenMVG `sfm_data.json`, `cameras.json`). `name` is shown in the
-/// report. PLY clouds lose the camera-centre points OpenMVG and Theia append.
+/// report. PLY clouds lose the camera-centre points OpenMVG and Theia append (by marker colour).
+///
+/// Files holding both an SfM model and one PLY (a Theia output folder with `reconstruction.nvm`
+/// and `points.ply`, COLMAP's `fused.ply` beside `sparse/`) evaluate the PLY with the model's
+/// cameras, as [`read_reconstruction_with_cameras`]; several PLYs beside a model are an error.
 pub fn read_reconstruction(name: &str, files: &BTreeMap<String, Vec<u8>>) -> Result<ReconInput> {
     if files.is_empty() {
         return Err(Error::Empty {
@@ -52,8 +64,33 @@ pub fn read_reconstruction(name: &str, files: &BTreeMap<String, Vec<u8>>) -> Res
     let is_model = files
         .iter()
         .any(|(n, b)| model::detect_model_format(n, b).is_some());
+    let plys: Vec<(&String, &Vec<u8>)> = files.iter().filter(|(n, _)| is_ply(n)).collect();
+    if is_model {
+        match plys.as_slice() {
+            [] => {}
+            [(ply_name, ply_bytes)] => {
+                let rec = model::read_model_files(files)?;
+                return cloud_with_cameras(name, ply_name, ply_bytes, rec, name);
+            }
+            more => {
+                let names: Vec<&str> = more.iter().take(5).map(|(n, _)| n.as_str()).collect();
+                return Err(Error::InvalidOption(format!(
+                    "reconstruction '{name}' holds an SfM model and {} PLY files ({}): give the one PLY to evaluate and the model as its cameras",
+                    more.len(),
+                    names.join(", ")
+                )));
+            }
+        }
+    }
     if is_model {
         let rec = model::read_model_files(files)?;
+        if rec.images.is_empty() && rec.points.is_empty() {
+            return Err(Error::Empty {
+                what: format!(
+                    "reconstruction '{name}' (an SfM model with no registered image and no 3D point)"
+                ),
+            });
+        }
         let cloud = rec.to_point_cloud();
         let mut warnings = rec.warnings.clone();
         if cloud.points.is_empty() {
@@ -65,17 +102,10 @@ pub fn read_reconstruction(name: &str, files: &BTreeMap<String, Vec<u8>>) -> Res
             format: rec.format.to_string(),
             warnings,
             model: Some(rec),
+            cloud_is_model_points: true,
         });
     }
-    let (file_name, bytes) = match files
-        .iter()
-        .find(|(n, _)| n.to_ascii_lowercase().ends_with(".ply"))
-    {
-        Some(f) => f,
-        None => files.iter().next().ok_or_else(|| Error::Empty {
-            what: name.to_string(),
-        })?,
-    };
+    let (file_name, bytes) = point_cloud_file(name, files)?;
     let loaded = io::read_point_cloud(file_name, bytes)?;
     let mut warnings = loaded.warnings;
     let stripped = model::strip::strip_camera_points(&loaded.cloud, None, name);
@@ -86,6 +116,83 @@ pub fn read_reconstruction(name: &str, files: &BTreeMap<String, Vec<u8>>) -> Res
         name: name.to_string(),
         format: loaded.format.name().to_string(),
         warnings,
+        cloud_is_model_points: false,
+    })
+}
+
+/// The point-cloud file among `files`: the PLY, else the only file.
+fn point_cloud_file<'a>(
+    name: &str,
+    files: &'a BTreeMap<String, Vec<u8>>,
+) -> Result<(&'a String, &'a Vec<u8>)> {
+    match files.iter().find(|(n, _)| is_ply(n)) {
+        Some(f) => Ok(f),
+        None => files.iter().next().ok_or_else(|| Error::Empty {
+            what: format!("reconstruction '{name}' (no files)"),
+        }),
+    }
+}
+
+/// A point cloud (`files`: a PLY, or a mesh whose vertices are the points) evaluated with the
+/// cameras of an SfM model in the same frame (`cameras`, read with
+/// [`model::read_model_files`]; `cameras_name` names it in the report). The points at the
+/// model's camera centres (the centres OpenMVG and Theia write into their PLYs, in any colour)
+/// are removed; the model provides the cameras for the `cameras` alignment and the pose metrics.
+/// Errors when `files` are themselves an SfM model.
+pub fn read_reconstruction_with_cameras(
+    name: &str,
+    files: &BTreeMap<String, Vec<u8>>,
+    cameras: Reconstruction,
+    cameras_name: &str,
+) -> Result<ReconInput> {
+    if let Some((n, _)) = files
+        .iter()
+        .find(|(n, b)| model::detect_model_format(n, b).is_some())
+    {
+        return Err(Error::InvalidOption(format!(
+            "reconstruction '{name}' is an SfM model ('{n}'), not a point cloud: separate cameras are only for a PLY"
+        )));
+    }
+    let (file_name, bytes) = point_cloud_file(name, files)?;
+    cloud_with_cameras(name, file_name, bytes, cameras, cameras_name)
+}
+
+fn cloud_with_cameras(
+    name: &str,
+    file_name: &str,
+    bytes: &[u8],
+    cameras: Reconstruction,
+    cameras_name: &str,
+) -> Result<ReconInput> {
+    if cameras.images.is_empty() {
+        return Err(Error::Empty {
+            what: format!("cameras of '{cameras_name}' (the SfM model has no registered image)"),
+        });
+    }
+    let loaded = io::read_point_cloud(file_name, bytes)?;
+    let mut warnings = cameras.warnings.clone();
+    warnings.extend(loaded.warnings);
+    warnings.push(format!(
+        "evaluating the points of '{file_name}' with the {} camera(s) of the {} model '{cameras_name}'",
+        cameras.images.len(),
+        cameras.format
+    ));
+    let centers = cameras.camera_centers();
+    let stripped = model::strip::strip_camera_points(&loaded.cloud, Some(&centers), file_name);
+    if !stripped.by_centers {
+        warnings.push(format!(
+            "no point of '{file_name}' lies at one of the {} camera centres of '{cameras_name}' (fine for a cloud without camera points; otherwise they are not in one frame)",
+            centers.len()
+        ));
+    }
+    warnings.extend(stripped.warning);
+    Ok(ReconInput {
+        cloud: stripped.cloud,
+        name: name.to_string(),
+        format: format!("{}+{}", loaded.format.name(), cameras.format),
+        warnings,
+        model: Some(cameras),
+        cloud_is_model_points: false,
     })
 }
 
@@ -210,6 +317,17 @@ pub fn run_with_views(
     if gt_cameras.is_some() && recon.model.is_none() {
         warnings.push("ground-truth cameras were given but the reconstruction has no cameras (a bare point cloud): no camera-based alignment or pose metrics".into());
     }
+    // Cameras on both sides but no image name in common: say so once, skip the camera stage
+    // and the pose metrics instead of failing the whole evaluation.
+    let no_match = match (gt_cameras, &recon.model, &matches) {
+        (Some(g), Some(e), Some(m)) if m.pairs.is_empty() => Some(no_match_detail(g, e)),
+        _ => None,
+    };
+    if let Some(detail) = &no_match {
+        warnings.push(format!(
+            "cameras: {detail}: no camera alignment and no pose metrics"
+        ));
+    }
     let alignment = match &options.align {
         AlignRequest::None => AlignmentInput::none(),
         AlignRequest::Given(t) => AlignmentInput::given(*t),
@@ -220,6 +338,13 @@ pub fn run_with_views(
                 None => (name.as_str(), name == "auto" || name == "icp"),
             };
             let method = AlignMethod::parse(base)?;
+            if method == AlignMethod::Cameras && pairs.is_empty() {
+                return Err(cameras_unavailable(
+                    gt_cameras.is_some(),
+                    recon,
+                    no_match.as_deref(),
+                ));
+            }
             progress.start(Stage::Alignment, 1);
             let input = AlignInput {
                 recon: &recon.cloud.points,
@@ -232,8 +357,20 @@ pub fn run_with_views(
                 ..AlignOptions::default()
             }
             .with_seed(options.eval.seed);
-            let (t, report) = align::align(gt, &input, method, &opts)?;
+            let (t, mut report) = align::align(gt, &input, method, &opts)?;
             progress.finish();
+            if let (AlignMethod::Auto, Some(detail)) = (method, &no_match)
+                && let Some(first) = report.stages.first_mut()
+            {
+                let fallback = format!(
+                    "cameras stage skipped ({detail}); fell back to {}",
+                    first.method
+                );
+                first.note = Some(match first.note.take() {
+                    Some(old) => format!("{fallback}; {old}"),
+                    None => fallback,
+                });
+            }
             warnings.extend(align::stage_notes(&report));
             AlignmentInput {
                 gt_from_recon: t,
@@ -250,7 +387,7 @@ pub fn run_with_views(
         warnings,
     };
     let mut evaluation = evaluate(gt, &recon.cloud, &alignment, &options.eval, &info, progress)?;
-    if let (Some(g), Some(e), Some(m)) = (gt_cameras, &recon.model, &matches) {
+    if let (Some(g), Some(e), Some(m), None) = (gt_cameras, &recon.model, &matches, &no_match) {
         // Poses are measured after the camera stage when there is one (as ATE aligns the
         // trajectory itself); the point refinement may move the scale by the SfM's own
         // camera/point inconsistency (e.g. a focal error), which the point metrics then show.
@@ -281,6 +418,9 @@ pub fn run_with_views(
     if let Some(views) = views {
         add_visibility(&mut evaluation, views, options, progress)?;
         match (gt_cameras, &recon.model) {
+            (Some(_), Some(_)) if !recon.cloud_is_model_points => evaluation.report.warnings.push(
+                "depth maps were given but the evaluated cloud is not the SfM model's own points: no track-based error".into(),
+            ),
             (Some(g), Some(e)) if e.points.iter().any(|p| !p.track.is_empty()) => {
                 add_track_error(&mut evaluation, g, e, views, &alignment, progress)?;
             }
@@ -290,6 +430,38 @@ pub fn run_with_views(
         }
     }
     Ok(evaluation)
+}
+
+/// "none of the N estimated image(s) matches one of the M ground-truth image names (e.g. ...)".
+fn no_match_detail(gt: &Reconstruction, est: &Reconstruction) -> String {
+    let example = match (gt.images.first(), est.images.first()) {
+        (Some(g), Some(e)) => format!(" (e.g. ground truth '{}', estimate '{}')", g.name, e.name),
+        _ => String::new(),
+    };
+    format!(
+        "none of the {} estimated image(s) matches one of the {} ground-truth image names{example}",
+        est.images.len(),
+        gt.images.len()
+    )
+}
+
+/// Why the `cameras` stage has no camera pair to work from.
+fn cameras_unavailable(have_gt_cameras: bool, recon: &ReconInput, no_match: Option<&str>) -> Error {
+    if !have_gt_cameras {
+        return Error::InvalidOption(
+            "the cameras alignment needs the ground-truth cameras (cameras.json)".into(),
+        );
+    }
+    if recon.model.is_none() {
+        return Error::InvalidOption(format!(
+            "the cameras alignment needs a reconstruction with cameras; '{}' is a bare point cloud",
+            recon.name
+        ));
+    }
+    match no_match {
+        Some(detail) => Error::Geometry(format!("cameras alignment: {detail}")),
+        None => Error::Geometry("cameras alignment: no matched camera".into()),
+    }
 }
 
 fn add_visibility(
@@ -486,6 +658,12 @@ pub fn cameras_only(
     crate::pose::CamerasReport,
 )> {
     let (pairs, matches) = camera_pairs(gt_cameras, recon);
+    if pairs.is_empty() && given.is_none() {
+        return Err(Error::Geometry(format!(
+            "cameras alignment: {}",
+            no_match_detail(gt_cameras, recon)
+        )));
+    }
     let (t, report) = match given {
         Some(t) => (t, AlignmentInput::given(t).report),
         None => {
@@ -594,6 +772,7 @@ mod tests {
             name: "synthetic".into(),
             format: "colmap".into(),
             warnings: vec![],
+            cloud_is_model_points: true,
         };
         let gt = GroundTruth::Mesh(uv_sphere(128, 64));
         let options = RunOptions {
@@ -653,5 +832,234 @@ mod tests {
         .unwrap();
         assert!(plain.report.completeness_visible.is_none() && plain.report.track_error.is_none());
         assert!(!plain.report.to_json().contains("completeness_visible"));
+    }
+
+    use crate::model::fuzz_tests::fixture;
+
+    /// theia.ply with its camera centres in a colour that is no OpenMVG marker.
+    fn theia_ply_recoloured() -> Vec<u8> {
+        let text = String::from_utf8(fixture("theia.ply")).unwrap();
+        let out = text.replace(" 255   0   0", " 10 200 30");
+        assert_eq!(out.matches(" 10 200 30").count(), 6);
+        out.into_bytes()
+    }
+
+    #[test]
+    fn ply_beside_a_model_is_stripped_at_the_model_camera_centres() {
+        let ply = theia_ply_recoloured();
+        // Alone, the recoloured centres are not recognised (no marker colour, no cameras).
+        let alone = read_reconstruction(
+            "points.ply",
+            &BTreeMap::from([("points.ply".to_string(), ply.clone())]),
+        )
+        .unwrap();
+        assert_eq!(alone.cloud.points.len(), 107);
+        assert!(alone.model.is_none() && alone.warnings.is_empty());
+        // Beside the Theia NVM (a Theia output folder), or with the model given separately.
+        let folder = BTreeMap::from([
+            ("reconstruction.nvm".to_string(), fixture("theia.nvm")),
+            ("points.ply".to_string(), ply.clone()),
+        ]);
+        let nvm = model::read_model_files(&BTreeMap::from([(
+            "theia.nvm".to_string(),
+            fixture("theia.nvm"),
+        )]))
+        .unwrap();
+        let files = BTreeMap::from([("points.ply".to_string(), ply)]);
+        for r in [
+            read_reconstruction("theia_out", &folder).unwrap(),
+            read_reconstruction_with_cameras("points.ply", &files, nvm, "theia.nvm").unwrap(),
+        ] {
+            assert_eq!(r.cloud.points.len(), 101, "{:?}", r.warnings);
+            assert_eq!(r.format, "ply+nvm");
+            assert!(!r.cloud_is_model_points);
+            assert_eq!(r.model.as_ref().unwrap().images.len(), 6);
+            assert!(
+                r.warnings
+                    .iter()
+                    .any(|w| w.contains("removed 6 point(s) at the 6 known camera centre(s)")),
+                "{:?}",
+                r.warnings
+            );
+            let colors = r.cloud.colors.unwrap();
+            assert!(colors.iter().all(|c| *c != [10, 200, 30]));
+        }
+    }
+
+    #[test]
+    fn ambiguous_or_wrong_cloud_files_are_errors() {
+        let folder = BTreeMap::from([
+            ("reconstruction.nvm".to_string(), fixture("theia.nvm")),
+            ("a.ply".to_string(), fixture("theia.ply")),
+            ("b.ply".to_string(), fixture("openmvg.ply")),
+        ]);
+        let e = read_reconstruction("out", &folder).unwrap_err().to_string();
+        assert!(e.contains("2 PLY files (a.ply, b.ply)"), "{e}");
+        let nvm = model::read_model_files(&BTreeMap::from([(
+            "theia.nvm".to_string(),
+            fixture("theia.nvm"),
+        )]))
+        .unwrap();
+        let model_files = BTreeMap::from([("colmap38.nvm".to_string(), fixture("colmap38.nvm"))]);
+        let e = read_reconstruction_with_cameras("m", &model_files, nvm, "theia.nvm")
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("is an SfM model"), "{e}");
+        // An SfM model with nothing in it.
+        let header = "# Camera list\n";
+        let empty = BTreeMap::from([
+            (
+                "cameras.txt".to_string(),
+                fixture("colmap_text/cameras.txt"),
+            ),
+            ("images.txt".to_string(), header.as_bytes().to_vec()),
+            ("points3D.txt".to_string(), header.as_bytes().to_vec()),
+        ]);
+        let e = read_reconstruction("empty", &empty)
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("no registered image and no 3D point"), "{e}");
+    }
+
+    fn err_of(r: Result<Evaluation>) -> String {
+        match r {
+            Ok(_) => panic!("expected an error"),
+            Err(e) => e.to_string(),
+        }
+    }
+
+    #[test]
+    fn no_image_name_in_common_skips_the_camera_stage_and_pose_metrics() {
+        // GT cameras named 0000.png...; the model's images are named differently.
+        let mut gt_cams = Reconstruction::new("cameras_json");
+        gt_cams
+            .cameras
+            .push(Camera::simple(1, "PINHOLE", 300.0, 240.0, 240.0));
+        let mut points = Vec::new();
+        for k in 0..8u64 {
+            let phi = std::f64::consts::TAU * k as f64 / 8.0;
+            let c = [3.0 * phi.cos(), 0.5 * (k % 2) as f64, 3.0 * phi.sin()];
+            gt_cams.images.push(Image {
+                id: k + 1,
+                name: format!("{k:04}.png"),
+                camera_id: 1,
+                cam_from_world: look_at(c, [0.0; 3]),
+                observations: vec![],
+            });
+        }
+        for i in 0..400 {
+            let (lat, lon) = ((i as f64 * 0.618).fract() * 2.8 - 1.4, i as f64 * 2.399_963);
+            points.push(crate::model::Point3D {
+                xyz: [lat.cos() * lon.cos(), lat.sin(), lat.cos() * lon.sin()],
+                color: None,
+                error: None,
+                track: vec![],
+            });
+        }
+        let mut est = gt_cams.clone();
+        est.format = "colmap";
+        for im in &mut est.images {
+            im.name = format!("other_{}", im.name);
+        }
+        est.points = points;
+        let recon = ReconInput {
+            cloud: est.to_point_cloud(),
+            model: Some(est),
+            name: "renamed".into(),
+            format: "colmap".into(),
+            warnings: vec![],
+            cloud_is_model_points: true,
+        };
+        let gt = GroundTruth::Mesh(uv_sphere(32, 16));
+        let prepared = PreparedGroundTruth::new(&gt, 2_000, 0, &NoProgress).unwrap();
+        let info = GroundTruthInfo::default();
+        let options = |align: &str| RunOptions {
+            eval: EvalOptions {
+                samples: 2_000,
+                ..EvalOptions::default()
+            },
+            align: AlignRequest::Stages(align.into()),
+            ..RunOptions::default()
+        };
+        let e = run(
+            &prepared,
+            &info,
+            &recon,
+            Some(&gt_cams),
+            &[],
+            &options("auto"),
+            &NoProgress,
+        )
+        .unwrap();
+        assert!(e.report.cameras.is_none());
+        let w = &e.report.warnings;
+        assert!(
+            w.iter().any(
+                |w| w.starts_with("cameras: none of the 8 estimated image(s)")
+                    && w.contains("'other_0000.png'")
+            ),
+            "{w:?}"
+        );
+        assert!(
+            w.iter().any(
+                |w| w.starts_with("alignment (global): cameras stage skipped")
+                    && w.contains("fell back to global")
+            ),
+            "{w:?}"
+        );
+        assert_eq!(e.report.alignment.method, "global+icp");
+        for method in ["cameras", "cameras+icp"] {
+            let err = err_of(run(
+                &prepared,
+                &info,
+                &recon,
+                Some(&gt_cams),
+                &[],
+                &options(method),
+                &NoProgress,
+            ));
+            assert!(
+                err.contains("none of the 8 estimated image(s) matches"),
+                "{err}"
+            );
+        }
+        // Without GT cameras, or with a bare cloud, `cameras` says what is missing.
+        let err = err_of(run(
+            &prepared,
+            &info,
+            &recon,
+            None,
+            &[],
+            &options("cameras"),
+            &NoProgress,
+        ));
+        assert!(err.contains("needs the ground-truth cameras"), "{err}");
+        let bare = ReconInput {
+            model: None,
+            ..recon.clone()
+        };
+        let err = err_of(run(
+            &prepared,
+            &info,
+            &bare,
+            Some(&gt_cams),
+            &[],
+            &options("cameras"),
+            &NoProgress,
+        ));
+        assert!(err.contains("'renamed' is a bare point cloud"), "{err}");
+        // `sfmeval cameras` (cameras_only) names the mismatch too.
+        let err = cameras_only(
+            &gt_cams,
+            recon.model.as_ref().unwrap(),
+            None,
+            &options("auto"),
+        )
+        .unwrap_err()
+        .to_string();
+        assert!(
+            err.contains("none of the 8 estimated image(s) matches"),
+            "{err}"
+        );
     }
 }

@@ -19,6 +19,9 @@ pub struct Stripped {
     pub removed: usize,
     /// A message for the report's warnings when points were removed.
     pub warning: Option<String>,
+    /// Whether the points were found at the given camera centres (else: by marker colour, or
+    /// nothing removed).
+    pub by_centers: bool,
 }
 
 /// OpenMVG's marker colours: cameras, pose priors, control points.
@@ -146,6 +149,7 @@ pub fn strip_camera_points(
             return Stripped {
                 cloud: c,
                 removed: n,
+                by_centers: true,
                 warning: Some(format!(
                     "{source}: removed {n} point(s) at the {} known camera centre(s) (written by the SfM tool)",
                     centers.len()
@@ -157,6 +161,7 @@ pub fn strip_camera_points(
     Stripped {
         cloud: c,
         removed: n,
+        by_centers: false,
         warning: (n > 0).then(|| {
             format!("{source}: removed {n} point(s) in camera-marker colours at the start/end of the cloud (camera centres written by OpenMVG/Theia)")
         }),
@@ -194,6 +199,7 @@ mod tests {
         assert!(s.warning.unwrap().contains("6 point"));
         let s = strip_camera_points(&c, None, "openmvg.ply");
         assert_eq!(s.removed, 6);
+        assert!(!s.by_centers);
         assert!(
             s.cloud
                 .colors
@@ -214,6 +220,7 @@ mod tests {
         .unwrap();
         let s = strip_camera_points(&c, Some(&model.camera_centers()), "theia.ply");
         assert_eq!(s.removed, 6);
+        assert!(s.by_centers);
         let (_, n) = remove_marker_runs(&c);
         assert_eq!(n, 6);
     }
