@@ -832,6 +832,32 @@ mod tests {
         .unwrap();
         assert!(plain.report.completeness_visible.is_none() && plain.report.track_error.is_none());
         assert!(!plain.report.to_json().contains("completeness_visible"));
+        // A cloud that is not the model's own points (a PLY with the model's cameras): the
+        // tracks do not line up with the evaluated points, so no track error.
+        let ply_like = ReconInput {
+            cloud_is_model_points: false,
+            ..recon.clone()
+        };
+        let e = run_with_views(
+            &prepared,
+            &info,
+            &ply_like,
+            Some(&gt_cams),
+            Some(&views),
+            &[],
+            &options,
+            &NoProgress,
+        )
+        .unwrap();
+        assert!(e.report.track_error.is_none() && e.report.completeness_visible.is_some());
+        assert!(
+            e.report
+                .warnings
+                .iter()
+                .any(|w| w.contains("not the SfM model's own points")),
+            "{:?}",
+            e.report.warnings
+        );
     }
 
     use crate::model::fuzz_tests::fixture;
