@@ -241,6 +241,11 @@ pub fn align_cameras(
             what: "matched cameras (none with a finite pose)".into(),
         });
     }
+    if n == 1 {
+        return Err(Error::Geometry(
+            "only 1 matched camera with a finite pose: the cameras stage needs at least 3 (2 with orientations)".into(),
+        ));
+    }
     let gt_centres: Vec<Point3> = usable.iter().map(|p| p.gt_center).collect();
     let recon_centres: Vec<Point3> = usable.iter().map(|p| p.recon_center).collect();
     let spread =
@@ -576,6 +581,10 @@ mod tests {
             Err(Error::Geometry(_))
         ));
         assert!(matches!(align_cameras(&[], &o), Err(Error::Empty { .. })));
+        let one = make_pairs(&truth, &orbit(1, true));
+        assert!(
+            matches!(align_cameras(&one, &o), Err(Error::Geometry(m)) if m.contains("only 1 matched camera"))
+        );
         let same = vec![CameraPair::centers([1.0; 3], [2.0; 3]); 5];
         assert!(matches!(align_cameras(&same, &o), Err(Error::Geometry(_))));
         let nan = vec![CameraPair::centers([f64::NAN; 3], [2.0; 3]); 5];
