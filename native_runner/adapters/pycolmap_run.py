@@ -63,6 +63,13 @@ def main():
         recs = pycolmap.incremental_mapping(db, a.images, sparse, options=opts)
     else:
         opts = pycolmap.GlobalPipelineOptions()
+        if a.known:
+            # GLOMAP's bundle adjustment refines the focal length and extra parameters by
+            # default (principal point not); the known camera stays fixed, as in incremental.
+            ba = opts.mapper.bundle_adjustment
+            ba.refine_focal_length = False
+            ba.refine_principal_point = False
+            ba.refine_extra_params = False
         opts.random_seed = a.seed
         if threads > 0:
             opts.num_threads = threads

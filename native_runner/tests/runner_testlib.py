@@ -5,9 +5,11 @@ name so that one pytest session can hold every test folder).
 - `small_dataset`: the generator's `small` preset (36 views, 640×360; no depth/mask pass),
   rendered once with PyPI bpy into target/test-data/small-<key>/, where <key> hashes the full
   resolved generator config (`generate.py --print-config`) and the generator's source, and
-  reused while both are unchanged. $SFMEVAL_RUNNER_TEST_DATASET points at an existing dataset instead.
-- `batch`: ONE run of the five installed pipelines (+ visualsfm absent, a failing and a
-  timing-out custom command) on that dataset, and its report; shared by the tests.
+  reused while both are unchanged. $SFMEVAL_RUNNER_TEST_DATASET points at an existing dataset
+  instead.
+- `batch`: ONE run of the seven built-in pipelines that install from registries (+ visualsfm
+  absent, a failing and a timing-out custom command) on that dataset, and its report; shared by
+  the tests.
 """
 
 import hashlib
@@ -24,7 +26,8 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 REPO = os.path.dirname(os.path.dirname(HERE))
 GENERATE = os.path.join(REPO, "blender_scripts", "generate.py")
 CACHE = os.path.join(REPO, "target", "test-data")
-DATASET_ARGS = ["--preset", "small", "--set", "outputs.depth=false", "--set", "outputs.masks=false"]
+DATASET_ARGS = ["--preset", "small", "--set", "outputs.depth=false",
+                "--set", "outputs.masks=false"]
 
 # The pipelines of the end-to-end batch. COLMAP's sequential matcher (window 12: both rings'
 # neighbours) instead of exhaustive keeps the COLMAP CLI within the CI budget (exhaustive
@@ -34,10 +37,20 @@ DATASET_ARGS = ["--preset", "small", "--set", "outputs.depth=false", "--set", "o
 # EXIF, pycolmap's refined focal was once 1.6 % off, giving 1.4 % median centre error). Theia
 # with its default squared loss is not deterministic and its worst camera reached 1.08 % of the
 # radius once in CI (0.55-0.78 % over 12 runs here); a 2 px Cauchy loss gave 0.25-0.50 %.
+# theia-incremental and openmvg-global run with the images' EXIF (`intrinsics=exif`), so the
+# Theia adapter's EXIF focal reading and openmvg-rs's own are exercised too (they add ~25 s and
+# ~8 s of run time).
+THEIA = "max_features=2000,loss=cauchy,loss_width=2"
 PIPELINES = ("colmap:matcher=sequential,overlap=12,max_features=2048;"
              "pycolmap:max_features=2048;pycolmap-global:max_features=2048;"
-             "theia:max_features=2000,loss=cauchy,loss_width=2;openmvg;visualsfm;bad;slow:timeout=3")
-REAL = ["colmap", "pycolmap", "pycolmap-global", "theia", "openmvg"]
+             "theia:%s;theia-incremental:%s,intrinsics=exif;"
+             "openmvg;openmvg-global:intrinsics=exif;visualsfm;bad;slow:timeout=3"
+             % (THEIA, THEIA))
+REAL = ["colmap", "pycolmap", "pycolmap-global", "theia", "theia-incremental", "openmvg",
+        "openmvg-global"]
+# The intrinsics each real pipeline of the batch gets (the batch's default: known).
+INTRINSICS = {p: "known" for p in REAL}
+INTRINSICS.update({"theia-incremental": "exif", "openmvg-global": "exif"})
 CUSTOMS = ["--custom", "bad=no-such-sfm-tool {images} {out}",
            "--custom", "slow=sleep 60; echo {out}"]
 
