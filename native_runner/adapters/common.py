@@ -7,7 +7,8 @@ Every adapter is called as
                       [--option key=value ...] [--seed N]
 
 and writes the final model as a COLMAP text model (cameras.txt, images.txt, points3D.txt) in
---out, plus --out/../tool.json with {"tool", "version", "registered", "points"}.
+--out, plus --out/../tool.json with {"tool", "version", "registered", "points"}; an adapter may
+also keep the tool's own exports in --out/../raw/ (the run folder's raw/).
 `--known` gives the dataset's intrinsics in COLMAP's pixel convention (cx = W/2 for a centred
 camera); without it the adapter uses the images' EXIF like a user would.
 """

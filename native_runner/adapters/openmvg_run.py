@@ -3,6 +3,8 @@
 Options (--option key=value): features (alp | sift, default alp), threads (default all cores).
 openmvg-rs puts pixel (0, 0) at the centre of the top-left pixel, so known intrinsics are written
 to K.txt with cx - 0.5, cy - 0.5; its COLMAP export is in COLMAP's convention again.
+openmvg-rs's own PLY export (white points, green camera centres) is kept as raw/scene.ply in the
+run folder.
 """
 
 import os
@@ -46,6 +48,11 @@ def main():
         src = tmp
     for name in os.listdir(src):
         shutil.copy(os.path.join(src, name), os.path.join(a.out, name))
+    # openmvg-rs's own PLY export (white points, then the registered camera centres in green),
+    # kept in the run folder's raw/.
+    raw = os.path.join(os.path.dirname(os.path.abspath(a.out)), "raw")
+    os.makedirs(raw, exist_ok=True)
+    scene.write_ply(os.path.join(raw, "scene.ply"))
     common.write_tool_json(a.out, "openmvg-rs", getattr(openmvg_rs, "__version__", "?"),
                            scene.num_registered_images, scene.num_points)
 

@@ -13,6 +13,10 @@ cores).
 OpenCV keypoints (with precise upscaling) have pixel centres on integers; 0.5 is added so that
 the features, the principal point (cx = W/2) and the written COLMAP model are in COLMAP's pixel
 convention.
+
+Besides the COLMAP text model in --out, Theia's own writers export the reconstruction into the run
+folder's raw/: reconstruction.nvm (WriteNVMFile) and points.ply (WritePlyFile; the camera
+centres appended in red).
 """
 
 import os
@@ -159,6 +163,15 @@ def main():
             recon.RemoveView(v)
     if not pt.io.WriteColmapFiles(recon, a.out):
         common.fail("WriteColmapFiles failed", 4)
+    # Theia's own exports, kept in the run folder's raw/: the NVM (cameras + points) and the
+    # PLY cloud with every camera centre appended in red (255, 0, 0), as a Theia user gets them.
+    raw = os.path.join(os.path.dirname(os.path.abspath(a.out)), "raw")
+    os.makedirs(raw, exist_ok=True)
+    if not pt.io.WriteNVMFile(os.path.join(raw, "reconstruction.nvm"), recon):
+        common.fail("WriteNVMFile failed", 4)
+    red = np.array([255, 0, 0], dtype=np.int32)
+    if not pt.io.WritePlyFile(os.path.join(raw, "points.ply"), recon, red, 0):
+        common.fail("WritePlyFile failed", 4)
     version = "?"
     try:
         from importlib.metadata import version as pkg_version

@@ -125,26 +125,28 @@ pub fn sparse_ply(points: &[[f64; 3]], colors: Option<&[[u8; 3]]>) -> Vec<u8> {
     out
 }
 
+/// Whether COLMAP knows `camera`'s model with that many parameters (NVM's `NVM_RADIAL`,
+/// Bundler's `BUNDLER_RADIAL` and OpenMVG's models are not COLMAP models).
+pub fn is_colmap_camera(camera: &sfmeval::model::Camera) -> bool {
+    sfmeval::model::colmap::camera_model_by_name(&camera.model)
+        .is_some_and(|m| m.num_params == camera.params.len())
+}
+
 /// A COLMAP text model (cameras.txt, images.txt, points3D.txt) of `rec`, for tools whose own
-/// output is another format (NVM, Bundler). Image and point ids are 1-based indices.
+/// output is another format (NVM, Bundler). Image and point ids are 1-based indices. A camera
+/// whose model COLMAP lacks ([`is_colmap_camera`]) is written as `PINHOLE fx fy cx cy`, without
+/// its distortion (width and height stay 0 when the format stores none).
 pub fn colmap_text(rec: &Reconstruction) -> BTreeMap<&'static str, String> {
     let mut cams = String::from(
         "# Camera list written by sfmeval-runner\n# CAMERA_ID, MODEL, WIDTH, HEIGHT, PARAMS[]\n",
     );
     for c in &rec.cameras {
-        let params: Vec<String> = if c.params.is_empty() {
-            [c.fx, c.fy, c.cx, c.cy]
-                .iter()
-                .map(|v| v.to_string())
-                .collect()
+        let (model, params): (&str, Vec<f64>) = if is_colmap_camera(c) {
+            (c.model.as_str(), c.params.clone())
         } else {
-            c.params.iter().map(|v| v.to_string()).collect()
+            ("PINHOLE", vec![c.fx, c.fy, c.cx, c.cy])
         };
-        let model = if c.params.is_empty() {
-            "PINHOLE"
-        } else {
-            c.model.as_str()
-        };
+        let params: Vec<String> = params.iter().map(|v| v.to_string()).collect();
         let _ = writeln!(
             cams,
             "{} {} {} {} {}",
@@ -277,6 +279,38 @@ mod tests {
                 assert!((back[k] - q[k]).abs() < 1e-12, "{q:?} {back:?}");
             }
         }
+    }
+
+    #[test]
+    fn nvm_cameras_become_pinhole_in_colmap_text() {
+        // NVM_V3: 2 cameras (name f qw qx qy qz cx cy cz r 0), 1 point (xyz rgb, 2 measurements).
+        let nvm = "NVM_V3\n\n2\na.jpg 700 1 0 0 0 0 0 -5 0.01 0\nb.jpg 710 1 0 0 0 1 0 -5 0 0\n\n1\n0.1 0.2 0.3 10 20 30 2 0 0 12.5 -3 1 0 40 -3\n";
+        let files: BTreeMap<String, Vec<u8>> =
+            BTreeMap::from([("m.nvm".to_string(), nvm.as_bytes().to_vec())]);
+        let rec = sfmeval::model::read_model_files(&files).unwrap();
+        assert!(rec.cameras.iter().all(|c| !is_colmap_camera(c)));
+        let written = colmap_text(&rec);
+        assert!(written["cameras.txt"].contains(" PINHOLE 0 0 710 710 0 0\n"));
+        let written: BTreeMap<String, Vec<u8>> = written
+            .into_iter()
+            .map(|(k, v)| (k.to_string(), v.into_bytes()))
+            .collect();
+        let back = sfmeval::model::read_model_files(&written).unwrap();
+        assert_eq!(back.images.len(), 2);
+        assert_eq!(back.points.len(), 1);
+        for (a, b) in rec.images.iter().zip(&back.images) {
+            assert_eq!(a.name, b.name);
+            let (ca, cb) = (a.cam_from_world.center(), b.cam_from_world.center());
+            assert!(
+                (0..3).all(|k| (ca[k] - cb[k]).abs() < 1e-12),
+                "{ca:?} {cb:?}"
+            );
+        }
+        let (fa, fb): (Vec<f64>, Vec<f64>) = (
+            rec.cameras.iter().map(|c| c.fx).collect(),
+            back.cameras.iter().map(|c| c.fx).collect(),
+        );
+        assert_eq!(fa, fb);
     }
 
     #[test]

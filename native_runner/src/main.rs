@@ -306,8 +306,16 @@ fn find_python(given: Option<&Path>) -> PathBuf {
 
 fn make_env(tools: &ToolArgs, out: &Path) -> Result<Env> {
     let scripts = run::install_scripts(out)?;
+    // The commands run inside the run folders: a relative interpreter path (`.venv/bin/python`
+    // from --python or $SFMEVAL_PYTHON) must not be resolved there. A bare name is searched on
+    // PATH as it is.
+    let mut python = find_python(tools.python.as_deref());
+    if python.is_relative() && python.components().count() > 1 {
+        python = std::path::absolute(&python)
+            .with_context(|| format!("resolving the Python path {}", python.display()))?;
+    }
     Ok(Env::new(
-        find_python(tools.python.as_deref()),
+        python,
         scripts,
         tools.colmap.clone(),
         tools.visualsfm.clone(),

@@ -579,6 +579,19 @@ fn collect(work: &Path, output: &Path, rec: &mut RunRecord) -> Result<()> {
                     .with_context(|| format!("copying {f}"))?;
             }
         } else {
+            let mut odd: Vec<&str> = model
+                .cameras
+                .iter()
+                .filter(|c| !crate::files::is_colmap_camera(c))
+                .map(|c| c.model.as_str())
+                .collect();
+            odd.dedup();
+            if !odd.is_empty() {
+                rec.warnings.push(format!(
+                    "model/: camera model {} is not a COLMAP model: written as PINHOLE without its distortion",
+                    odd.join(", ")
+                ));
+            }
             for (name, text) in colmap_text(model) {
                 write_atomic(&model_dir.join(name), text.as_bytes())?;
             }

@@ -1,5 +1,6 @@
 //! The COLMAP command line (Debian `colmap` 3.8 or newer): feature_extractor, exhaustive or
-//! sequential matcher, mapper, then model_converter of the largest sub-model to text. CPU only:
+//! sequential matcher, mapper, then model_converter of the largest sub-model to text (the
+//! binary sub-model itself is kept as the run folder's `raw/sparse/N`). CPU only:
 //! SIFT extraction and matching need `use_gpu 0` (no OpenGL context headless).
 
 use std::collections::BTreeMap;
@@ -160,25 +161,35 @@ impl Adapter for Colmap {
         let Some((_, dir)) = best else {
             bail!("the mapper wrote no model (no image pair could be registered)");
         };
-        Ok(vec![Step::new(
-            "model_converter",
-            vec![
-                env.colmap.clone(),
-                "model_converter".into(),
-                "--input_path".into(),
-                format!(
-                    "{}/sparse/{}",
-                    job.scratch_rel,
-                    dir.file_name()
-                        .map(|n| n.to_string_lossy().to_string())
-                        .unwrap_or_default()
-                ),
-                "--output_path".into(),
-                job.output_rel.clone(),
-                "--output_type".into(),
-                "TXT".into(),
-            ],
-            &job.work,
-        )])
+        let sub = dir
+            .file_name()
+            .map(|n| n.to_string_lossy().to_string())
+            .unwrap_or_default();
+        let model = format!("{}/sparse/{sub}", job.scratch_rel);
+        // The mapper's own binary model (the largest) is kept as raw/sparse/N (a few MB at
+        // most): scratch/ is deleted after the run.
+        let raw = job.work.join("raw").join("sparse");
+        std::fs::create_dir_all(&raw).with_context(|| format!("creating {}", raw.display()))?;
+        Ok(vec![
+            Step::new(
+                "model_converter",
+                vec![
+                    env.colmap.clone(),
+                    "model_converter".into(),
+                    "--input_path".into(),
+                    model.clone(),
+                    "--output_path".into(),
+                    job.output_rel.clone(),
+                    "--output_type".into(),
+                    "TXT".into(),
+                ],
+                &job.work,
+            ),
+            Step::new(
+                "copy_binary_model",
+                vec!["cp".into(), "-R".into(), model, format!("raw/sparse/{sub}")],
+                &job.work,
+            ),
+        ])
     }
 }
