@@ -2,7 +2,6 @@
 
 import os
 
-import pytest
 
 from blender_testlib import requires_bpy, run_generate
 

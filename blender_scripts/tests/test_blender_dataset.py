@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 from PIL import Image
 
-from blender_testlib import BLENDER_SCRIPTS, REPO, load_json, requires_bpy, run_generate
+from blender_testlib import REPO, load_json, requires_bpy, run_generate
 from blender_testlib import bilinear, camera_matrices, glb_vertices, project
 
 pytestmark = requires_bpy

@@ -2,7 +2,6 @@
 shift (principal point off centre), PNG output, floor + walls, sphere and shell views.
 The GT must still project exactly onto the masks and depth maps."""
 
-import os
 
 import numpy as np
 import pytest

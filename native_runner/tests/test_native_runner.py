@@ -1,7 +1,6 @@
 """End-to-end tests of sfmeval-runner on one small rendered dataset (see conftest.py)."""
 
 import csv
-import json
 import os
 import re
 import signal

@@ -10,7 +10,6 @@ and a stand-in VisualSFM, all on the shared `batch` (see runner_testlib.py).
 """
 
 import glob
-import json
 import os
 import re
 import shutil
