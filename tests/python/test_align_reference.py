@@ -22,6 +22,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from numpy_ref import (apply, decompose, random_rotation, rot_err_deg, similarity,
+                       umeyama_np)
+
 ROOT = Path(__file__).resolve().parents[2]
 
 
@@ -48,54 +51,6 @@ def run_tool(tool, *args, expect_ok=True):
 
 
 # ---------------------------------------------------------------- independent reference code
-
-def umeyama_np(src, dst, with_scale=True):
-    """Umeyama (1991), eqs. 38-42."""
-    mu_s, mu_d = src.mean(0), dst.mean(0)
-    a, b = src - mu_s, dst - mu_d
-    sigma = b.T @ a / len(src)
-    u, d, vt = np.linalg.svd(sigma)
-    s = np.eye(3)
-    if np.linalg.det(u) * np.linalg.det(vt) < 0:
-        s[2, 2] = -1
-    r = u @ s @ vt
-    c = np.trace(np.diag(d) @ s) / ((a ** 2).sum(1).mean()) if with_scale else 1.0
-    m = np.eye(4)
-    m[:3, :3] = c * r
-    m[:3, 3] = mu_d - c * r @ mu_s
-    return m
-
-
-def random_rotation(rng):
-    q = rng.normal(size=4)
-    q /= np.linalg.norm(q)
-    w, x, y, z = q
-    return np.array([
-        [1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
-        [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
-        [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)],
-    ])
-
-
-def similarity(scale, r, t):
-    m = np.eye(4)
-    m[:3, :3] = scale * r
-    m[:3, 3] = t
-    return m
-
-
-def apply(m, p):
-    return p @ m[:3, :3].T + m[:3, 3]
-
-
-def decompose(m):
-    s = np.cbrt(np.linalg.det(m[:3, :3]))
-    return s, m[:3, :3] / s
-
-
-def rot_err_deg(a, b):
-    ra, rb = decompose(a)[1], decompose(b)[1]
-    return float(np.degrees(np.arccos(np.clip((np.trace(ra @ rb.T) - 1) / 2, -1, 1))))
 
 
 def blob_mesh(n_lat, n_lon):

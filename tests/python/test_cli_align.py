@@ -19,36 +19,15 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from numpy_ref import (apply, decompose, quat_to_rot, random_rotation, rot_err_deg,
+                       scale_err, similarity, umeyama_np)
+
 ROOT = Path(__file__).resolve().parents[2]
 MODELS = ROOT / "tests" / "fixtures" / "models"
 SUZANNE = ROOT / "tests" / "fixtures" / "core" / "blender_monkey.glb"
 
 
 # ---------------------------------------------------------------- independent helpers
-
-def umeyama_np(src, dst):
-    """Umeyama (1991), eqs. 38-42: the similarity m with dst ≈ m(src)."""
-    mu_s, mu_d = src.mean(0), dst.mean(0)
-    a, b = src - mu_s, dst - mu_d
-    u, d, vt = np.linalg.svd(b.T @ a / len(src))
-    s = np.eye(3)
-    if np.linalg.det(u) * np.linalg.det(vt) < 0:
-        s[2, 2] = -1
-    r = u @ s @ vt
-    c = np.trace(np.diag(d) @ s) / (a ** 2).sum(1).mean()
-    m = np.eye(4)
-    m[:3, :3] = c * r
-    m[:3, 3] = mu_d - c * r @ mu_s
-    return m
-
-
-def quat_to_rot(q):
-    w, x, y, z = np.asarray(q, float) / np.linalg.norm(q)
-    return np.array([
-        [1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
-        [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
-        [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)],
-    ])
 
 
 def rot_to_quat(r):
@@ -70,35 +49,6 @@ def rot_to_quat(r):
         q[1 + kk] = (r[kk, i] + r[i, kk]) / (4 * v)
     q = np.array(q)
     return q if q[0] >= 0 else -q
-
-
-def random_rotation(rng):
-    return quat_to_rot(rng.normal(size=4))
-
-
-def similarity(scale, r, t):
-    m = np.eye(4)
-    m[:3, :3] = scale * np.asarray(r)
-    m[:3, 3] = t
-    return m
-
-
-def apply(m, p):
-    return np.asarray(p) @ m[:3, :3].T + m[:3, 3]
-
-
-def decompose(m):
-    s = np.cbrt(np.linalg.det(m[:3, :3]))
-    return s, m[:3, :3] / s
-
-
-def rot_err_deg(a, b):
-    ra, rb = decompose(a)[1], decompose(b)[1]
-    return float(np.degrees(np.arccos(np.clip((np.trace(ra @ rb.T) - 1) / 2, -1, 1))))
-
-
-def scale_err(a, b):
-    return abs(decompose(a)[0] / decompose(b)[0] - 1)
 
 
 def colmap_centres(images_txt):

@@ -17,6 +17,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from numpy_ref import random_rotation, rot_err_deg, scale_err, similarity, umeyama_np
+
 ROOT = Path(__file__).resolve().parents[2]
 FIX = ROOT / "tests" / "fixtures" / "global"
 GT = ROOT / "data" / "demo" / "ground_truth.glb"
@@ -51,52 +53,28 @@ def write_ply_xyzrgb(path, xyz, rgb):
     Path(path).write_bytes(head.encode() + v.tobytes())
 
 
-def umeyama(src, dst):
-    """Similarity dst ≈ s R src + t (Umeyama 1991), as a 4x4."""
-    mu_s, mu_d = src.mean(0), dst.mean(0)
-    xs, xd = src - mu_s, dst - mu_d
-    u, d, vt = np.linalg.svd(xd.T @ xs / len(src))
-    e = np.eye(3)
-    if np.linalg.det(u) * np.linalg.det(vt) < 0:
-        e[2, 2] = -1
-    r = u @ e @ vt
-    s = np.trace(np.diag(d) @ e) / (xs ** 2).sum(1).mean()
-    m = np.eye(4)
-    m[:3, :3], m[:3, 3] = s * r, mu_d - s * r @ mu_s
-    return m
-
-
 def camera_reference(tool):
     """gt_from_recon from the run's estimated camera centres to the ground-truth ones."""
-    est = {i["name"]: i["center"] for i in json.loads((FIX / (tool + "_cameras.json")).read_text())["images"]}
+    est_json = json.loads((FIX / (tool + "_cameras.json")).read_text())
+    est = {i["name"]: i["center"] for i in est_json["images"]}
     gt = {i["name"]: i["center"] for i in json.loads(GT_CAMERAS.read_text())["images"]}
     names = sorted(set(est) & set(gt))
     assert len(names) == 36
-    return umeyama(np.array([est[n] for n in names]), np.array([gt[n] for n in names]))
+    return umeyama_np([est[n] for n in names], [gt[n] for n in names])
 
 
 def random_similarity(rng):
-    q = rng.normal(size=4)
-    w, x, y, z = q / np.linalg.norm(q)
-    r = np.array([[1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
-                  [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
-                  [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)]])
-    m = np.eye(4)
-    m[:3, :3] = 10 ** rng.uniform(-1.3, 1.3) * r
-    m[:3, 3] = rng.uniform(-50, 50, 3)
-    return m
+    return similarity(10 ** rng.uniform(-1.3, 1.3), random_rotation(rng), rng.uniform(-50, 50, 3))
 
 
 def pose_error(m, ref, diag):
     """Rotation angle (deg), relative scale error, RMS displacement of the GT box corners / diag."""
-    sm, sr = np.cbrt(np.linalg.det(m[:3, :3])), np.cbrt(np.linalg.det(ref[:3, :3]))
-    rel = (m[:3, :3] / sm) @ (ref[:3, :3] / sr).T
-    ang = np.degrees(np.arccos(np.clip((np.trace(rel) - 1) / 2, -1, 1)))
+    ang, ds = rot_err_deg(m, ref), scale_err(m, ref)
     # Corners of the GT box mapped back by the reference, then forward by both.
     corners = np.array([[x, y, z, 1] for x in (-.22, .22) for y in (-.5, .5) for z in (-.28, .28)])
     back = corners @ np.linalg.inv(ref).T
     disp = np.linalg.norm((back @ m.T - back @ ref.T)[:, :3], axis=1)
-    return ang, abs(sm / sr - 1), np.sqrt((disp ** 2).mean()) / diag
+    return ang, ds, np.sqrt((disp ** 2).mean()) / diag
 
 
 @pytest.mark.parametrize("tool", sorted(CLOUDS))
