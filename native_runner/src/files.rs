@@ -281,6 +281,15 @@ mod tests {
         }
     }
 
+    /// The model in written COLMAP text files, read back by the core.
+    fn read_back(written: BTreeMap<&'static str, String>) -> Reconstruction {
+        let files: BTreeMap<String, Vec<u8>> = written
+            .into_iter()
+            .map(|(k, v)| (k.to_string(), v.into_bytes()))
+            .collect();
+        sfmeval::model::read_model_files(&files).unwrap()
+    }
+
     #[test]
     fn nvm_cameras_become_pinhole_in_colmap_text() {
         // NVM_V3: 2 cameras (name f qw qx qy qz cx cy cz r 0), 1 point (xyz rgb, 2 measurements).
@@ -291,11 +300,7 @@ mod tests {
         assert!(rec.cameras.iter().all(|c| !is_colmap_camera(c)));
         let written = colmap_text(&rec);
         assert!(written["cameras.txt"].contains(" PINHOLE 0 0 710 710 0 0\n"));
-        let written: BTreeMap<String, Vec<u8>> = written
-            .into_iter()
-            .map(|(k, v)| (k.to_string(), v.into_bytes()))
-            .collect();
-        let back = sfmeval::model::read_model_files(&written).unwrap();
+        let back = read_back(written);
         assert_eq!(back.images.len(), 2);
         assert_eq!(back.points.len(), 1);
         for (a, b) in rec.images.iter().zip(&back.images) {
@@ -324,11 +329,7 @@ mod tests {
         .map(|(k, v)| (k.to_string(), v.as_bytes().to_vec()))
         .collect();
         let rec = sfmeval::model::read_model_files(&files).unwrap();
-        let written: BTreeMap<String, Vec<u8>> = colmap_text(&rec)
-            .into_iter()
-            .map(|(k, v)| (k.to_string(), v.into_bytes()))
-            .collect();
-        let back = sfmeval::model::read_model_files(&written).unwrap();
+        let back = read_back(colmap_text(&rec));
         assert_eq!(back.images.len(), 2);
         assert_eq!(back.points.len(), 1);
         assert_eq!(back.points[0].track.len(), 2);
