@@ -61,11 +61,8 @@ pub fn read_reconstruction(name: &str, files: &BTreeMap<String, Vec<u8>>) -> Res
             what: format!("reconstruction '{name}' (no files)"),
         });
     }
-    let is_model = files
-        .iter()
-        .any(|(n, b)| model::detect_model_format(n, b).is_some());
-    let plys: Vec<(&String, &Vec<u8>)> = files.iter().filter(|(n, _)| is_ply(n)).collect();
-    if is_model {
+    if model_file(files).is_some() {
+        let plys: Vec<(&String, &Vec<u8>)> = files.iter().filter(|(n, _)| is_ply(n)).collect();
         match plys.as_slice() {
             [] => {}
             [(ply_name, ply_bytes)] => {
@@ -81,8 +78,6 @@ pub fn read_reconstruction(name: &str, files: &BTreeMap<String, Vec<u8>>) -> Res
                 )));
             }
         }
-    }
-    if is_model {
         let rec = model::read_model_files(files)?;
         if rec.images.is_empty() && rec.points.is_empty() {
             return Err(Error::Empty {
@@ -120,6 +115,14 @@ pub fn read_reconstruction(name: &str, files: &BTreeMap<String, Vec<u8>>) -> Res
     })
 }
 
+/// The first of `files` that is (part of) an SfM model.
+fn model_file(files: &BTreeMap<String, Vec<u8>>) -> Option<&String> {
+    files
+        .iter()
+        .find(|(n, b)| model::detect_model_format(n, b).is_some())
+        .map(|(n, _)| n)
+}
+
 /// The point-cloud file among `files`: the PLY, else the only file.
 fn point_cloud_file<'a>(
     name: &str,
@@ -145,10 +148,7 @@ pub fn read_reconstruction_with_cameras(
     cameras: Reconstruction,
     cameras_name: &str,
 ) -> Result<ReconInput> {
-    if let Some((n, _)) = files
-        .iter()
-        .find(|(n, b)| model::detect_model_format(n, b).is_some())
-    {
+    if let Some(n) = model_file(files) {
         return Err(Error::InvalidOption(format!(
             "reconstruction '{name}' is an SfM model ('{n}'), not a point cloud: separate cameras are only for a PLY"
         )));
