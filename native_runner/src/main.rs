@@ -281,8 +281,19 @@ fn main() -> ExitCode {
 }
 
 /// The venv interpreter: flag, $SFMEVAL_PYTHON, ./.venv, a .venv beside an ancestor of the
-/// binary (the repository's), then `python3`.
-fn find_python(given: Option<&Path>) -> PathBuf {
+/// binary (the repository's), then `python3`. The commands run in other folders (the run
+/// folders, the generator's datasets folder), so a relative path with a folder part
+/// (`.venv/bin/python`) is made absolute here; a bare name is searched on PATH as it is.
+fn find_python(given: Option<&Path>) -> Result<PathBuf> {
+    let python = candidate_python(given);
+    if python.is_relative() && python.components().count() > 1 {
+        return std::path::absolute(&python)
+            .with_context(|| format!("resolving the Python path {}", python.display()));
+    }
+    Ok(python)
+}
+
+fn candidate_python(given: Option<&Path>) -> PathBuf {
     if let Some(p) = given {
         return p.to_path_buf();
     }
@@ -291,7 +302,7 @@ fn find_python(given: Option<&Path>) -> PathBuf {
     }
     let local = PathBuf::from(".venv/bin/python");
     if local.exists() {
-        return std::path::absolute(&local).unwrap_or(local);
+        return local;
     }
     if let Ok(exe) = std::env::current_exe() {
         for dir in exe.ancestors().skip(1) {
@@ -306,14 +317,7 @@ fn find_python(given: Option<&Path>) -> PathBuf {
 
 fn make_env(tools: &ToolArgs, out: &Path) -> Result<Env> {
     let scripts = run::install_scripts(out)?;
-    // The commands run inside the run folders: a relative interpreter path (`.venv/bin/python`
-    // from --python or $SFMEVAL_PYTHON) must not be resolved there. A bare name is searched on
-    // PATH as it is.
-    let mut python = find_python(tools.python.as_deref());
-    if python.is_relative() && python.components().count() > 1 {
-        python = std::path::absolute(&python)
-            .with_context(|| format!("resolving the Python path {}", python.display()))?;
-    }
+    let python = find_python(tools.python.as_deref())?;
     Ok(Env::new(
         python,
         scripts,

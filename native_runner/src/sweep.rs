@@ -762,10 +762,7 @@ pub fn sweep(a: &SweepArgs) -> Result<()> {
     let (factor, values) = parse_factor(&a.factor)?;
     a.exec.check()?;
     // absolute paths: the generator runs in the datasets folder
-    let mut python = crate::find_python(a.tools.python.as_deref());
-    if python.components().count() > 1 {
-        python = std::path::absolute(&python)?;
-    }
+    let python = crate::find_python(a.tools.python.as_deref())?;
     let scripts = std::path::absolute(crate::table1::find_blender_scripts(
         a.blender_scripts.as_deref(),
     )?)?;

@@ -137,10 +137,7 @@ pub fn render_dataset(
 pub fn table1(a: &Table1Args) -> Result<()> {
     let t0 = Instant::now();
     a.exec.check()?;
-    let mut python = crate::find_python(a.tools.python.as_deref());
-    if python.components().count() > 1 {
-        python = std::path::absolute(&python)?;
-    }
+    let python = crate::find_python(a.tools.python.as_deref())?;
     let scripts = std::path::absolute(find_blender_scripts(a.blender_scripts.as_deref())?)?;
     let presets: Vec<String> = if a.presets.is_empty() {
         PRESETS.iter().map(|s| s.to_string()).collect()
