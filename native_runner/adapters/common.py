@@ -84,6 +84,13 @@ def exif_focal_px(path):
     return None, w, h
 
 
+def run_subdir(out, name):
+    """The run folder's sub-folder `name` (the folder holding --out: `scratch`, `raw`), created."""
+    d = os.path.join(os.path.dirname(os.path.abspath(out)), name)
+    os.makedirs(d, exist_ok=True)
+    return d
+
+
 def write_tool_json(out, tool, version, registered, points, extra=None):
     doc = {"tool": tool, "version": version, "registered": int(registered), "points": int(points)}
     doc.update(extra or {})

@@ -24,8 +24,7 @@ def main():
               "progress": False}
     if "threads" in o:
         kwargs["max_workers"] = int(o["threads"])
-    work = os.path.join(os.path.dirname(os.path.abspath(a.out)), "scratch")
-    os.makedirs(work, exist_ok=True)
+    work = common.run_subdir(a.out, "scratch")
     if a.known:
         fx, fy, cx, cy = a.known
         k = os.path.join(work, "K.txt")
@@ -50,8 +49,7 @@ def main():
         shutil.copy(os.path.join(src, name), os.path.join(a.out, name))
     # openmvg-rs's own PLY export (white points, then the registered camera centres in green),
     # kept in the run folder's raw/.
-    raw = os.path.join(os.path.dirname(os.path.abspath(a.out)), "raw")
-    os.makedirs(raw, exist_ok=True)
+    raw = common.run_subdir(a.out, "raw")
     scene.write_ply(os.path.join(raw, "scene.ply"))
     common.write_tool_json(a.out, "openmvg-rs", getattr(openmvg_rs, "__version__", "?"),
                            scene.num_registered_images, scene.num_points)

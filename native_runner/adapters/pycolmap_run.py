@@ -18,8 +18,7 @@ def main():
     import pycolmap
 
     o = a.options
-    work = os.path.join(os.path.dirname(os.path.abspath(a.out)), "scratch")
-    os.makedirs(work, exist_ok=True)
+    work = common.run_subdir(a.out, "scratch")
     db = os.path.join(work, "database.db")
     if os.path.exists(db):
         os.remove(db)

@@ -165,8 +165,7 @@ def main():
         common.fail("WriteColmapFiles failed", 4)
     # Theia's own exports, kept in the run folder's raw/: the NVM (cameras + points) and the
     # PLY cloud with every camera centre appended in red (255, 0, 0), as a Theia user gets them.
-    raw = os.path.join(os.path.dirname(os.path.abspath(a.out)), "raw")
-    os.makedirs(raw, exist_ok=True)
+    raw = common.run_subdir(a.out, "raw")
     if not pt.io.WriteNVMFile(os.path.join(raw, "reconstruction.nvm"), recon):
         common.fail("WriteNVMFile failed", 4)
     red = np.array([255, 0, 0], dtype=np.int32)
