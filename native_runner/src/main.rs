@@ -198,18 +198,32 @@ struct EvalArgs {
     /// Completeness samples on the ground-truth mesh.
     #[arg(long, default_value_t = sfmeval::evaluate::DEFAULT_SAMPLES)]
     samples: usize,
-    /// Thresholds in metres (comma-separated).
+    /// Thresholds in ground-truth units (metres for Blender datasets), comma-separated.
     #[arg(long, value_delimiter = ',')]
     tau: Vec<f64>,
-    /// Thresholds in % of the ground-truth diagonal (default 0.5,1,2).
-    #[arg(long, value_delimiter = ',')]
-    tau_relative: Vec<f64>,
-    /// Alignment stages (`auto`, `cameras`, `cameras+icp`, ...).
-    #[arg(long, default_value = "auto")]
+    /// Thresholds in percent of the ground-truth bounding-box diagonal (default 0.5,1,2).
+    #[arg(long, value_delimiter = ',', alias = "tau-relative")]
+    tau_percent: Vec<f64>,
+    /// Alignment: auto (cameras, else global; then ICP), cameras, global, cameras+icp,
+    /// global+icp, icp or none (given and points need inputs a batch does not have).
+    #[arg(long, default_value = "auto", value_parser = clap::builder::PossibleValuesParser::new(sfmeval::align::AlignMode::names()))]
     align: String,
     /// Seed of the surface sampler.
     #[arg(long = "eval-seed", default_value_t = 0)]
     eval_seed: u64,
+}
+
+impl EvalArgs {
+    /// The alignment request of `--align` (validated: modes that need a transform or point
+    /// pairs are refused, a batch has neither).
+    fn align_request(&self) -> Result<sfmeval::align::AlignRequest> {
+        let mode = sfmeval::align::AlignMode::parse(&self.align)?;
+        Ok(sfmeval::align::AlignRequest::new(
+            Some(mode),
+            None,
+            Vec::new(),
+        )?)
+    }
 }
 
 #[derive(Args)]
@@ -375,7 +389,7 @@ fn eval_options(e: &EvalArgs) -> Result<sfmeval::evaluate::EvalOptions> {
     };
     Ok(sfmeval::evaluate::EvalOptions {
         tau: e.tau.clone(),
-        tau_percent_of_diagonal: e.tau_relative.clone(),
+        tau_percent_of_diagonal: e.tau_percent.clone(),
         samples: e.samples,
         seed: e.eval_seed,
         crop,
@@ -389,7 +403,7 @@ fn cmd_report(a: &ReportCmd) -> Result<()> {
         out: a.out.clone(),
         datasets: a.datasets.clone(),
         eval: eval_options(&a.eval)?,
-        align: a.eval.align.clone(),
+        align: a.eval.align_request()?,
         verbose: true,
     };
     let rows = report::report(&args)?;

@@ -7,22 +7,24 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result, bail};
 use serde::{Deserialize, Serialize};
-use sfmeval::evaluate::{EvalOptions, PreparedGroundTruth};
-use sfmeval::pipeline::{self, GroundTruthInfo, RunOptions};
+use sfmeval::align::AlignRequest;
+use sfmeval::dataset::{Dataset, DatasetPaths};
+use sfmeval::evaluate::EvalOptions;
+use sfmeval::pipeline::{self, EvalRequest};
 use sfmeval::progress::NoProgress;
 use sfmeval::report::Report;
+use sfmeval_fs::{path_str, read_input_files, write_atomic};
 
 use crate::adapters::BUILTIN;
-use crate::files::{read_model_dir, write_atomic};
 use crate::run::{RunRecord, Status, list_runs, read_record};
 
 /// One threshold's precision / recall / F.
 #[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
 pub struct Prf {
-    /// Threshold (m).
+    /// Threshold in ground-truth units (metres for Blender datasets).
     pub tau: f64,
-    /// Threshold as a fraction of the GT diagonal.
-    pub tau_relative: f64,
+    /// The same threshold in percent of the ground-truth bounding-box diagonal.
+    pub tau_percent_of_diagonal: f64,
     /// Precision.
     pub precision: f64,
     /// Recall.
@@ -94,7 +96,7 @@ pub struct ReportArgs {
     /// Measurement options.
     pub eval: EvalOptions,
     /// Alignment (`auto` by default).
-    pub align: String,
+    pub align: AlignRequest,
     /// Print progress.
     pub verbose: bool,
 }
@@ -143,8 +145,8 @@ pub fn report(args: &ReportArgs) -> Result<Vec<Row>> {
                 .unwrap_or_default(),
         };
         let any_ok = records.iter().any(|(r, _)| r.status == Status::Ok);
-        let gt = if any_ok {
-            match load_gt(&ds_dir, &args.eval) {
+        let mut gt = if any_ok {
+            match load_gt(&ds_dir) {
                 Ok(g) => Some(g),
                 Err(e) => {
                     eprintln!("{ds}: ground truth: {e:#}");
@@ -157,7 +159,7 @@ pub fn report(args: &ReportArgs) -> Result<Vec<Row>> {
         for (rec, dir) in &records {
             let mut row = base_row(rec);
             if rec.status == Status::Ok {
-                match &gt {
+                match &mut gt {
                     None => {
                         row.status = "evaluation failed".into();
                         row.reason = Some(format!(
@@ -198,69 +200,9 @@ pub fn report(args: &ReportArgs) -> Result<Vec<Row>> {
     Ok(rows)
 }
 
-struct Gt {
-    prepared: PreparedGroundTruth,
-    info: GroundTruthInfo,
-    cameras: Option<sfmeval::model::Reconstruction>,
-    /// The dataset's cameras with their depth maps (`depth/`), when it has them: visible
-    /// completeness and track error.
-    views: Option<Vec<sfmeval::gt_views::GtView>>,
-}
-
-/// Reads `depth/<image stem>.npy` for every image of `cameras` when the dataset has `depth/`.
-fn load_views(
-    dir: &Path,
-    cameras: Option<&sfmeval::model::Reconstruction>,
-) -> Result<Option<Vec<sfmeval::gt_views::GtView>>> {
-    let depth = dir.join("depth");
-    let (Some(cameras), true) = (cameras, depth.is_dir()) else {
-        return Ok(None);
-    };
-    let mut maps = BTreeMap::new();
-    for im in &cameras.images {
-        let stem = sfmeval::gt_views::depth_stem(&im.name);
-        let path = depth.join(format!("{stem}.npy"));
-        let bytes = std::fs::read(&path).with_context(|| {
-            format!(
-                "reading {} (depth map of image {})",
-                path.display(),
-                im.name
-            )
-        })?;
-        let map = sfmeval::io::npy::DepthMap::from_npy(&bytes)
-            .with_context(|| format!("{}", path.display()))?;
-        maps.insert(stem, map);
-    }
-    let views = sfmeval::gt_views::build_views(cameras, &maps)
-        .with_context(|| format!("{}", depth.display()))?;
-    Ok(Some(views))
-}
-
-fn load_gt(dir: &Path, eval: &EvalOptions) -> Result<Gt> {
-    let glb = dir.join("ground_truth.glb");
-    let bytes = std::fs::read(&glb).with_context(|| format!("reading {}", glb.display()))?;
-    let gt = sfmeval::io::read_ground_truth("ground_truth.glb", &bytes, &BTreeMap::new())
-        .with_context(|| format!("{}", glb.display()))?;
-    let prepared =
-        PreparedGroundTruth::new(&gt.ground_truth, eval.samples, eval.seed, &NoProgress)?;
-    let cameras = match std::fs::read(dir.join("cameras.json")) {
-        Ok(b) => Some(
-            sfmeval::model::read_model_files(&BTreeMap::from([("cameras.json".to_string(), b)]))
-                .with_context(|| format!("{}/cameras.json", dir.display()))?,
-        ),
-        Err(_) => None,
-    };
-    let views = load_views(dir, cameras.as_ref())?;
-    Ok(Gt {
-        views,
-        prepared,
-        info: GroundTruthInfo {
-            name: "ground_truth.glb".into(),
-            format: gt.format.name().into(),
-            warnings: gt.warnings,
-        },
-        cameras,
-    })
+/// The dataset's ground truth with its cameras.json and depth maps when present.
+fn load_gt(dir: &Path) -> Result<Dataset> {
+    sfmeval_fs::read_dataset(&DatasetPaths::folder(path_str(dir)?))
 }
 
 /// Points of the cumulative distribution of `distances`: 201 quantiles `(distance, share)`.
@@ -284,14 +226,14 @@ fn cdf_points(distances: &[f64]) -> Vec<(f64, f64)> {
 }
 
 fn evaluate_run(
-    gt: &Gt,
+    gt: &mut Dataset,
     dir: &Path,
     rec: &RunRecord,
     args: &ReportArgs,
 ) -> Result<(Report, Vec<(f64, f64)>)> {
     let model = dir.join("model");
     let mut files = if model.is_dir() {
-        read_model_dir(&model)?
+        read_input_files(&model)?
     } else {
         BTreeMap::new()
     };
@@ -301,21 +243,12 @@ fn evaluate_run(
     }
     let name = format!("{}/{}", rec.dataset, rec.pipeline);
     let recon = pipeline::read_reconstruction(&name, &files)?;
-    let options = RunOptions {
+    let request = EvalRequest {
         eval: args.eval.clone(),
-        align: pipeline::AlignRequest::Stages(args.align.clone()),
-        ..RunOptions::default()
+        align: args.align.clone(),
+        ..EvalRequest::default()
     };
-    let evaluation = pipeline::run_with_views(
-        &gt.prepared,
-        &gt.info,
-        &recon,
-        gt.cameras.as_ref(),
-        gt.views.as_deref(),
-        &[],
-        &options,
-        &NoProgress,
-    )?;
+    let evaluation = pipeline::run(gt, &recon, &request, &NoProgress)?;
     let kept: Vec<f64> = evaluation
         .distances
         .iter()
@@ -367,21 +300,19 @@ fn fill_row(row: &mut Row, r: &Report) {
         .iter()
         .map(|t| Prf {
             tau: t.tau,
-            tau_relative: t.tau_relative_to_diagonal,
+            tau_percent_of_diagonal: t.tau_percent_of_diagonal,
             precision: t.precision,
             recall: t.recall,
             f_score: t.f_score,
         })
         .collect();
     if let Some(c) = &r.cameras {
-        let get = |a: &str, b: &str| c.get(a).and_then(|x| x.get(b)).and_then(|x| x.as_f64());
-        row.rotation_median_deg = get("rotation_error_deg", "median");
-        row.center_median = get("center_error", "median");
-        row.center_median_percent = get("center_error_percent", "median");
-        row.center_max_percent = get("center_error_percent", "max");
-        if let Some(n) = c.get("registered").and_then(|x| x.as_u64()) {
-            row.images_registered = n as usize;
-        }
+        let c = &c.errors;
+        row.rotation_median_deg = Some(c.rotation_error_deg.median);
+        row.center_median = Some(c.center_error.median);
+        row.center_median_percent = Some(c.center_error_percent.median);
+        row.center_max_percent = Some(c.center_error_percent.max);
+        row.images_registered = c.registered;
     }
 }
 
@@ -472,7 +403,7 @@ fn wide_columns(rows: &[Row]) -> Vec<String> {
     .collect();
     if let Some(r) = rows.iter().find(|r| !r.thresholds.is_empty()) {
         for t in &r.thresholds {
-            let pct = (t.tau_relative * 100.0 * 1e6).round() / 1e6;
+            let pct = (t.tau_percent_of_diagonal * 1e6).round() / 1e6;
             cols.push(format!("P@{pct}%"));
             cols.push(format!("R@{pct}%"));
             cols.push(format!("F@{pct}%"));

@@ -10,13 +10,12 @@ use std::time::{Duration, Instant, SystemTime, UNIX_EPOCH};
 
 use anyhow::{Context, Result, bail};
 use serde::{Deserialize, Serialize};
+use sfmeval_fs::write_atomic;
 
 use crate::adapters::{Adapter, Availability, Env, Intrinsics, Job, SCRIPTS};
 use crate::dataset::Dataset;
 use crate::exec::{StepResult, run_step};
-use crate::files::{
-    colmap_text, partial_name, read_model_dir, replace_dir, sparse_ply, write_atomic,
-};
+use crate::files::{partial_name, replace_dir};
 use crate::pipelines::PipelineSpec;
 
 /// Schema id of run.json.
@@ -558,7 +557,7 @@ fn last_error_line(log: &Path) -> Option<String> {
 /// Turns the tool's output into the run files: `model/` (COLMAP text), `sparse.ply`,
 /// `cameras.json`.
 fn collect(work: &Path, output: &Path, rec: &mut RunRecord) -> Result<()> {
-    let files = read_model_dir(output)?;
+    let files = sfmeval_fs::read_input_files(output)?;
     if files.is_empty() {
         bail!("the tool wrote no model or cloud into its output folder");
     }
@@ -582,7 +581,7 @@ fn collect(work: &Path, output: &Path, rec: &mut RunRecord) -> Result<()> {
             let mut odd: Vec<&str> = model
                 .cameras
                 .iter()
-                .filter(|c| !crate::files::is_colmap_camera(c))
+                .filter(|c| !sfmeval::model::colmap_write::is_colmap_camera(c))
                 .map(|c| c.model.as_str())
                 .collect();
             odd.dedup();
@@ -592,7 +591,7 @@ fn collect(work: &Path, output: &Path, rec: &mut RunRecord) -> Result<()> {
                     odd.join(", ")
                 ));
             }
-            for (name, text) in colmap_text(model) {
+            for (name, text) in sfmeval::model::colmap_write::write_colmap_text(model) {
                 write_atomic(&model_dir.join(name), text.as_bytes())?;
             }
         }
@@ -611,7 +610,7 @@ fn collect(work: &Path, output: &Path, rec: &mut RunRecord) -> Result<()> {
             }
         }
     }
-    let ply = sparse_ply(&input.cloud.points, input.cloud.colors.as_deref());
+    let ply = sfmeval::export::points_ply(&input.cloud.points, input.cloud.colors.as_deref());
     write_atomic(&work.join("sparse.ply"), &ply)?;
     Ok(())
 }

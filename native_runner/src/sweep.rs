@@ -19,9 +19,9 @@ use serde_json::Value as Json;
 use crate::chart::{self, Chart, Series, Value};
 use crate::dataset::Dataset;
 use crate::exec::shell_quote;
-use crate::files::write_atomic;
 use crate::html::esc;
 use crate::report::Row;
+use sfmeval_fs::write_atomic;
 
 /// Metrics plotted by default: `(path, label)`. `[*]` expands to one metric per element
 /// (the report's thresholds). Paths start at `report.` (the run's `sfmeval.report/1`) or `run.`
@@ -474,16 +474,12 @@ pub fn expand_metric(path: &str, label: &str, docs: &[&Json]) -> Vec<Metric> {
         .map(|k| {
             let el = first.and_then(|d| d.pointer(&format!("{pointer}/{k}")));
             let tau = el.and_then(|e| e.get("tau")).and_then(Json::as_f64);
-            let rel = el
-                .and_then(|e| e.get("tau_relative_to_diagonal"))
+            let percent = el
+                .and_then(|e| e.get("tau_percent_of_diagonal"))
                 .and_then(Json::as_f64);
-            let suffix_label = match (tau, rel) {
-                (Some(t), Some(r)) if r > 0.0 => {
-                    format!(
-                        " at τ = {} m ({} % of the diagonal)",
-                        sig(t),
-                        sig(r * 100.0)
-                    )
+            let suffix_label = match (tau, percent) {
+                (Some(t), Some(p)) if p > 0.0 => {
+                    format!(" at τ = {} m ({} % of the diagonal)", sig(t), sig(p))
                 }
                 (Some(t), _) => format!(" at τ = {} m", sig(t)),
                 _ => format!(" [{k}]"),
@@ -886,7 +882,7 @@ pub fn sweep(a: &SweepArgs) -> Result<()> {
             out: table.clone(),
             datasets: Vec::new(),
             eval,
-            align: a.eval.align.clone(),
+            align: a.eval.align_request()?,
             verbose: true,
         })?
     };
@@ -1093,8 +1089,8 @@ mod tests {
     #[test]
     fn metric_paths() {
         let doc = json!({"report": {"accuracy": {"mean": 0.5},
-            "thresholds": [{"tau": 0.006, "tau_relative_to_diagonal": 0.005, "recall": 0.1},
-                           {"tau": 0.012, "tau_relative_to_diagonal": 0.01, "recall": 0.3}]},
+            "thresholds": [{"tau": 0.006, "tau_percent_of_diagonal": 0.5, "recall": 0.1},
+                           {"tau": 0.012, "tau_percent_of_diagonal": 1.0, "recall": 0.3}]},
             "run": {"wall_seconds": 3.0}});
         assert_eq!(lookup(&doc, "report.accuracy.mean"), Some(0.5));
         assert_eq!(lookup(&doc, "report.thresholds[1].recall"), Some(0.3));

@@ -12,7 +12,9 @@ use anyhow::{Context, Result, bail};
 use crate::Table1Args;
 use crate::dataset::Dataset;
 use crate::exec::{Step, run_step};
-use crate::files::{partial_name, replace_dir, write_atomic};
+use sfmeval_fs::write_atomic;
+
+use crate::files::{partial_name, replace_dir};
 
 /// The seed paper's five datasets, as generator presets.
 pub const PRESETS: [&str; 5] = ["statue", "vase", "bicycle", "hydrant", "vehicle"];
@@ -186,7 +188,7 @@ pub fn table1(a: &Table1Args) -> Result<()> {
         out: table.clone(),
         datasets: Vec::new(),
         eval: crate::eval_options(&a.eval)?,
-        align: a.eval.align.clone(),
+        align: a.eval.align_request()?,
         verbose: false,
     })?;
     let report_seconds = t_rep.elapsed().as_secs_f64();

@@ -4,21 +4,21 @@ use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
 use anyhow::{Context as _, Result, bail};
+use clap::builder::PossibleValuesParser;
 use clap::{Args, Parser, Subcommand};
-use sfmeval::align::{PointPair, parse_point_pairs};
+use sfmeval::align::{AlignMode, AlignRequest, PointPair, parse_point_pairs};
 use sfmeval::crop::{Crop, Volume};
-use sfmeval::evaluate::{DEFAULT_SAMPLES, EvalOptions, PreparedGroundTruth};
+use sfmeval::dataset::{Dataset, DatasetPaths, Part};
+use sfmeval::evaluate::{DEFAULT_SAMPLES, EvalOptions};
+use sfmeval::export;
 use sfmeval::geometry::{Aabb, GroundTruth};
-use sfmeval::gt_views::{GtView, build_views, depth_stem};
 use sfmeval::io;
-use sfmeval::io::npy::DepthMap;
-use sfmeval::model::{self, Reconstruction};
-use sfmeval::pipeline::{
-    self, AlignRequest, GroundTruthInfo, ReconInput, RunOptions, read_reconstruction,
-};
+use sfmeval::model;
+use sfmeval::pipeline::{self, EvalRequest, ReconInput, read_reconstruction};
+use sfmeval::pose::PoseOptions;
 use sfmeval::transform::Similarity;
+use sfmeval_fs::{Disk, name_of, path_str, read, read_input_files, write_atomic};
 
-use crate::files::{name_of, read, write_atomic};
 use crate::progress::Bars;
 use crate::summary;
 
@@ -107,7 +107,7 @@ struct InputArgs {
     /// Alignment: auto (cameras, else points, else global; then icp), cameras, points, global
     /// (alone, or refined: cameras+icp, points+icp, global+icp), icp (from --transform or the
     /// identity), given (needs --transform) or none. Default: given with --transform, else auto.
-    #[arg(long, value_name = "METHOD", value_parser = ["auto", "cameras", "points", "global", "icp", "cameras+icp", "points+icp", "global+icp", "given", "none"])]
+    #[arg(long, value_name = "METHOD", value_parser = PossibleValuesParser::new(AlignMode::names()))]
     align: Option<String>,
     /// A 4×4 row-major similarity gt_from_recon (JSON or 16 numbers as text): used as is with
     /// `--align given`, as the start of `--align icp`.
@@ -153,9 +153,10 @@ struct EvalArgs {
         long,
         value_name = "LIST",
         value_delimiter = ',',
-        allow_hyphen_values = true
+        allow_hyphen_values = true,
+        alias = "tau-relative"
     )]
-    tau_relative: Vec<f64>,
+    tau_percent: Vec<f64>,
     /// Completeness samples drawn on a ground-truth mesh.
     #[arg(long, value_name = "N", default_value_t = DEFAULT_SAMPLES)]
     samples: usize,
@@ -276,192 +277,85 @@ fn crop_from_args(args: &EvalArgs) -> Result<Crop> {
     Ok(crop)
 }
 
-/// Reads every file under a folder (relative paths with `/`), or one file with its Bundler
-/// list / glTF neighbours.
-fn read_path_files(path: &Path) -> Result<BTreeMap<String, Vec<u8>>> {
-    let mut files = BTreeMap::new();
-    if path.is_dir() {
-        let mut stack = vec![path.to_path_buf()];
-        while let Some(dir) = stack.pop() {
-            let entries = std::fs::read_dir(&dir)
-                .with_context(|| format!("cannot list '{}'", dir.display()))?;
-            for entry in entries {
-                let p = entry
-                    .with_context(|| format!("cannot list '{}'", dir.display()))?
-                    .path();
-                if p.is_dir() {
-                    stack.push(p);
-                } else if is_model_file(&p) {
-                    let rel = p
-                        .strip_prefix(path)
-                        .unwrap_or(&p)
-                        .to_string_lossy()
-                        .replace('\\', "/");
-                    files.insert(rel, read(&p)?);
-                }
-            }
-        }
-        if files.is_empty() {
-            bail!(
-                "'{}' holds no SfM model or point cloud file",
-                path.display()
-            );
-        }
-    } else {
-        files.insert(name_of(path), read(path)?);
-        let lower = name_of(path).to_ascii_lowercase();
-        if lower.ends_with(".out") {
-            let dir = path.parent().unwrap_or(Path::new("."));
-            let stem = lower
-                .trim_end_matches(".out")
-                .trim_end_matches(".bundle")
-                .to_string();
-            let original = name_of(path);
-            let stem = &original[..stem.len().min(original.len())];
-            for list in [format!("{stem}.list.txt"), "list.txt".to_string()] {
-                if let Ok(b) = std::fs::read(dir.join(&list)) {
-                    files.insert(list, b);
-                }
-            }
-        }
-    }
-    Ok(files)
-}
-
-/// Files worth reading from a model folder (skips images and logs).
-fn is_model_file(p: &Path) -> bool {
-    let n = name_of(p).to_ascii_lowercase();
-    [".bin", ".txt", ".nvm", ".out", ".json", ".ply"]
-        .iter()
-        .any(|e| n.ends_with(e))
-}
-
-/// Reads `<dir>/<image stem>.npy` for every image of the ground-truth cameras and pairs them
-/// into views; errors name the file.
-fn load_views(dir: &Path, gt_cameras: &Reconstruction) -> Result<Vec<GtView>> {
-    let mut maps = BTreeMap::new();
-    for im in &gt_cameras.images {
-        let stem = depth_stem(&im.name);
-        let path = dir.join(format!("{stem}.npy"));
-        if !path.is_file() {
-            bail!(
-                "missing depth map '{}' for image '{}'",
-                path.display(),
-                im.name
-            );
-        }
-        let map = DepthMap::from_npy(&read(&path)?)
-            .with_context(|| format!("depth map '{}'", path.display()))?;
-        maps.insert(stem, map);
-    }
-    build_views(gt_cameras, &maps).with_context(|| format!("depth maps in '{}'", dir.display()))
-}
-
-struct Loaded {
-    prepared: PreparedGroundTruth,
-    gt_info: GroundTruthInfo,
-    recon: ReconInput,
-    gt_cameras: Option<Reconstruction>,
-    pairs: Vec<PointPair>,
-    run_options: RunOptions,
-}
-
 /// Reads a `gt_from_recon` file (JSON or 16 numbers), naming it in errors.
 fn read_transform(path: &Path) -> Result<Similarity> {
     Similarity::parse(&read(path)?).with_context(|| format!("transform file '{}'", path.display()))
 }
 
-fn load(input: &InputArgs, eval: EvalOptions, bars: &Bars) -> Result<Loaded> {
+/// The alignment request of `--align`, `--transform` and `--pairs`.
+fn align_request(input: &InputArgs) -> Result<AlignRequest> {
     let transform = input.transform.as_deref().map(read_transform).transpose()?;
-    let method = input.align.clone().unwrap_or_else(|| {
-        if transform.is_some() {
-            "given".into()
-        } else {
-            "auto".into()
-        }
-    });
-    let align = match method.as_str() {
-        "none" if transform.is_some() => bail!(
-            "--align none ignores --transform: use --align given (the default with --transform)"
-        ),
-        "none" => AlignRequest::None,
-        "given" => AlignRequest::Given(
-            transform.ok_or_else(|| anyhow::anyhow!("--align given needs --transform FILE"))?,
-        ),
-        other => AlignRequest::Stages(other.to_string()),
-    };
-    let pairs = match &input.pairs {
+    let pairs: Vec<PointPair> = match &input.pairs {
         Some(p) => parse_point_pairs(&read(p)?)
             .with_context(|| format!("point pairs '{}'", p.display()))?,
         None => Vec::new(),
     };
-    if method == "points" && pairs.is_empty() {
-        bail!("--align points needs --pairs FILE");
+    let mode = input.align.as_deref().map(AlignMode::parse).transpose()?;
+    AlignRequest::new(mode, transform, pairs).map_err(|e| {
+        // Name the flags the user types.
+        let text = e.to_string();
+        let text = text
+            .replace("needs a transform", "needs --transform FILE")
+            .replace("needs point pairs", "needs --pairs FILE")
+            .replace("ignores the transform", "ignores --transform");
+        anyhow::anyhow!(text)
+    })
+}
+
+/// Where the ground truth's parts are: `--dataset` gives the folder layout, `--gt`,
+/// `--gt-cameras` and `--depth` override a part.
+fn dataset_paths(
+    input: &InputArgs,
+    depth: Option<&Path>,
+    with_depth: bool,
+) -> Result<DatasetPaths> {
+    let mut paths = match &input.dataset {
+        Some(d) => DatasetPaths::folder(path_str(d)?),
+        None => {
+            let gt = input
+                .gt
+                .as_deref()
+                .ok_or_else(|| anyhow::anyhow!("--gt FILE or --dataset DIR is required"))?;
+            DatasetPaths::ground_truth(path_str(gt)?)
+        }
+    };
+    if let Some(gt) = &input.gt {
+        paths.ground_truth = path_str(gt)?.to_string();
     }
-    let gt_path: PathBuf = match (&input.gt, &input.dataset) {
-        (Some(p), _) => p.clone(),
-        (None, Some(d)) => d.join("ground_truth.glb"),
-        (None, None) => bail!("--gt FILE or --dataset DIR is required"),
+    if let Some(c) = &input.gt_cameras {
+        paths.cameras = Part::Required(path_str(c)?.to_string());
+    }
+    paths.depth = match (with_depth, depth) {
+        (false, _) => Part::Off,
+        (true, Some(d)) => Part::Required(path_str(d)?.to_string()),
+        (true, None) => paths.depth,
     };
-    let gt_cameras_path: Option<PathBuf> = input.gt_cameras.clone().or_else(|| {
-        let p = input.dataset.as_ref()?.join("cameras.json");
-        p.is_file().then_some(p)
-    });
-    let gt_cameras = match &gt_cameras_path {
-        Some(p) => Some(
-            model::read_model_files(&read_path_files(p)?)
-                .with_context(|| format!("ground-truth cameras '{}'", p.display()))?,
-        ),
-        None => None,
-    };
-    let gt_bytes = read(&gt_path)?;
-    let external = gltf_neighbours(&gt_path, &gt_bytes);
-    let gt = io::read_ground_truth(&name_of(&gt_path), &gt_bytes, &external)
-        .with_context(|| format!("ground truth '{}'", gt_path.display()))?;
-    drop(gt_bytes);
-    let recon_files = read_path_files(&input.recon)?;
-    let recon = match &input.recon_cameras {
+    Ok(paths)
+}
+
+/// Reads the reconstruction of `--recon` (with `--recon-cameras`).
+fn read_recon(input: &InputArgs) -> Result<ReconInput> {
+    let files = read_input_files(&input.recon)?;
+    match &input.recon_cameras {
         Some(p) => {
-            let cameras = model::read_model_files(&read_path_files(p)?)
+            let cameras = model::read_model_files(&read_input_files(p)?)
                 .with_context(|| format!("reconstruction cameras '{}'", p.display()))?;
             pipeline::read_reconstruction_with_cameras(
                 &name_of(&input.recon),
-                &recon_files,
+                &files,
                 cameras,
                 &name_of(p),
             )
         }
-        None => read_reconstruction(&name_of(&input.recon), &recon_files),
+        None => read_reconstruction(&name_of(&input.recon), &files),
     }
-    .with_context(|| format!("reconstruction '{}'", input.recon.display()))?;
-    drop(recon_files);
-    let prepared = PreparedGroundTruth::new(&gt.ground_truth, eval.samples, eval.seed, bars)
-        .with_context(|| format!("ground truth '{}'", gt_path.display()))?;
-    let gt_info = GroundTruthInfo {
-        name: name_of(&gt_path),
-        format: gt.format.name().into(),
-        warnings: gt.warnings,
-    };
-    let run_options = RunOptions {
-        eval,
-        align,
-        icp_start: transform,
-        ..RunOptions::default()
-    };
-    Ok(Loaded {
-        prepared,
-        gt_info,
-        recon,
-        gt_cameras,
-        pairs,
-        run_options,
-    })
+    .with_context(|| format!("reconstruction '{}'", input.recon.display()))
 }
 
 fn eval(args: &EvalArgs) -> Result<()> {
-    let options = EvalOptions {
+    let eval = EvalOptions {
         tau: args.tau.clone(),
-        tau_percent_of_diagonal: args.tau_relative.clone(),
+        tau_percent_of_diagonal: args.tau_percent.clone(),
         samples: args.samples,
         seed: args.seed,
         signed: args.signed,
@@ -469,37 +363,20 @@ fn eval(args: &EvalArgs) -> Result<()> {
         crop: crop_from_args(args)?,
         min_views: args.min_views,
     };
-    options.validate()?;
-    let bars = Bars::new(args.quiet);
-    let l = load(&args.input, options, &bars)?;
-    let depth_dir = args.depth.clone().or_else(|| {
-        let d = args.input.dataset.as_ref()?.join("depth");
-        d.is_dir().then_some(d)
-    });
-    let views = match &depth_dir {
-        Some(dir) => {
-            let cams = l.gt_cameras.as_ref().ok_or_else(|| {
-                anyhow::anyhow!(
-                    "--depth needs the ground-truth cameras (--gt-cameras or --dataset)"
-                )
-            })?;
-            Some(load_views(dir, cams)?)
-        }
-        None => None,
+    eval.validate()?;
+    let request = EvalRequest {
+        align: align_request(&args.input)?,
+        eval,
+        pose: PoseOptions::default(),
     };
-    let evaluation = pipeline::run_with_views(
-        &l.prepared,
-        &l.gt_info,
-        &l.recon,
-        l.gt_cameras.as_ref(),
-        views.as_deref(),
-        &l.pairs,
-        &l.run_options,
-        &bars,
-    )
-    .with_context(|| format!("evaluating '{}'", args.input.recon.display()))?;
+    let bars = Bars::new(args.quiet);
+    let mut dataset =
+        sfmeval_fs::read_dataset(&dataset_paths(&args.input, args.depth.as_deref(), true)?)?;
+    let recon = read_recon(&args.input)?;
+    let evaluation = pipeline::run(&mut dataset, &recon, &request, &bars)
+        .with_context(|| format!("evaluating '{}'", args.input.recon.display()))?;
     if let Some(path) = &args.samples_csv {
-        write_atomic(path, io::write::samples_csv(&evaluation).as_bytes())?;
+        write_atomic(path, export::samples_csv(&evaluation).as_bytes())?;
     }
     let report = &evaluation.report;
     let json = report.to_json();
@@ -510,10 +387,10 @@ fn eval(args: &EvalArgs) -> Result<()> {
         let clip = args
             .color_clip
             .unwrap_or(report.accuracy.stats.percentiles.p95);
-        write_atomic(path, &io::write::colored_ply(&evaluation, clip))?;
+        write_atomic(path, &export::colored_ply(&evaluation, clip))?;
     }
     if let Some(path) = &args.csv {
-        write_atomic(path, io::write::distances_csv(&evaluation).as_bytes())?;
+        write_atomic(path, export::distances_csv(&evaluation).as_bytes())?;
     }
     if args.json {
         print!("{json}");
@@ -524,22 +401,19 @@ fn eval(args: &EvalArgs) -> Result<()> {
 }
 
 fn align_cmd(input: &InputArgs, out: Option<&Path>, seed: u64) -> Result<()> {
-    let eval = EvalOptions {
-        samples: 1,
-        seed,
-        ..EvalOptions::default()
+    let request = EvalRequest {
+        align: align_request(input)?,
+        eval: EvalOptions {
+            samples: 1,
+            seed,
+            ..EvalOptions::default()
+        },
+        pose: PoseOptions::default(),
     };
     let bars = Bars::new(false);
-    let l = load(input, eval, &bars)?;
-    let evaluation = pipeline::run(
-        &l.prepared,
-        &l.gt_info,
-        &l.recon,
-        l.gt_cameras.as_ref(),
-        &l.pairs,
-        &l.run_options,
-        &bars,
-    )?;
+    let mut dataset = sfmeval_fs::read_dataset(&dataset_paths(input, None, false)?)?;
+    let recon = read_recon(input)?;
+    let evaluation = pipeline::run(&mut dataset, &recon, &request, &bars)?;
     let a = &evaluation.report.alignment;
     let text: String = a
         .gt_from_recon
@@ -582,9 +456,9 @@ fn cameras_cmd(
     report: Option<&Path>,
     json: bool,
 ) -> Result<()> {
-    let gt = model::read_model_files(&read_path_files(gt_cameras)?)
+    let gt = model::read_model_files(&read_input_files(gt_cameras)?)
         .with_context(|| format!("ground-truth cameras '{}'", gt_cameras.display()))?;
-    let est = read_reconstruction(&name_of(recon), &read_path_files(recon)?)
+    let est = read_reconstruction(&name_of(recon), &read_input_files(recon)?)
         .with_context(|| format!("reconstruction '{}'", recon.display()))?;
     let est = est.model.ok_or_else(|| {
         anyhow::anyhow!(
@@ -593,7 +467,7 @@ fn cameras_cmd(
         )
     })?;
     let given = transform.map(read_transform).transpose()?;
-    let (_, alignment, cams) = pipeline::cameras_only(&gt, &est, given, &RunOptions::default())
+    let (_, alignment, cams) = pipeline::cameras_only(&gt, &est, given, 0, &PoseOptions::default())
         .with_context(|| format!("cameras of '{}'", recon.display()))?;
     let value = serde_json::json!({"alignment": alignment, "cameras": cams});
     let mut s = serde_json::to_string_pretty(&value)?;
@@ -604,36 +478,12 @@ fn cameras_cmd(
     if json {
         print!("{s}");
     } else {
-        print!("{}", summary::render_cameras(&value));
+        print!(
+            "{}",
+            summary::render_cameras(&cams, &alignment.method, alignment.scale)
+        );
     }
     Ok(())
-}
-
-/// Files next to a `.gltf` that its buffers may refer to.
-fn gltf_neighbours(path: &Path, bytes: &[u8]) -> BTreeMap<String, Vec<u8>> {
-    let mut out = BTreeMap::new();
-    if io::gltf::is_glb(bytes) || !name_of(path).to_ascii_lowercase().ends_with(".gltf") {
-        return out;
-    }
-    let Ok(v) = serde_json::from_slice::<serde_json::Value>(bytes) else {
-        return out;
-    };
-    let dir = path.parent().unwrap_or(Path::new("."));
-    for b in v
-        .get("buffers")
-        .and_then(|b| b.as_array())
-        .into_iter()
-        .flatten()
-    {
-        let uri = b.get("uri").and_then(|u| u.as_str());
-        let local = uri.filter(|u| !u.starts_with("data:") && !u.contains(".."));
-        if let Some((uri, data)) =
-            local.and_then(|u| std::fs::read(dir.join(u)).ok().map(|d| (u, d)))
-        {
-            out.insert(uri.to_string(), data);
-        }
-    }
-    out
 }
 
 fn info(path: &Path) -> Result<()> {
@@ -650,9 +500,8 @@ fn info(path: &Path) -> Result<()> {
             println!("comment   {c}");
         }
     }
-    let external = gltf_neighbours(path, &bytes);
-    let gt = io::read_ground_truth(&name, &bytes, &external)
-        .with_context(|| format!("'{}'", path.display()))?;
+    let dataset = Dataset::read(&Disk, &DatasetPaths::ground_truth(path_str(path)?))?;
+    let gt = &dataset.loaded;
     let (kind, pts, tris, area) = match &gt.ground_truth {
         GroundTruth::Mesh(m) => ("mesh", m.vertices.len(), m.triangles.len(), m.area()),
         GroundTruth::Cloud(c) => ("point cloud", c.points.len(), 0, 0.0),
@@ -694,38 +543,19 @@ const DEMO_MODEL: [(&str, &[u8]); 3] = [
 /// The demo: 36 rendered views of the built-in statue (Blender), reconstructed by pycolmap,
 /// evaluated with `auto` alignment (camera centres, then ICP) and camera-pose metrics.
 fn demo(json: bool, report_path: Option<&Path>) -> Result<()> {
-    let gt = io::read_ground_truth("ground_truth.glb", DEMO_GT, &BTreeMap::new())?;
-    let files: BTreeMap<String, Vec<u8>> = DEMO_MODEL
+    let mut files: BTreeMap<String, Vec<u8>> = DEMO_MODEL
         .iter()
-        .map(|(n, b)| (n.to_string(), b.to_vec()))
+        .map(|(n, b)| (format!("demo/{n}"), b.to_vec()))
         .collect();
-    let recon = read_reconstruction("sparse", &files)?;
-    let gt_cameras = model::read_model_files(&BTreeMap::from([(
-        "cameras.json".to_string(),
-        DEMO_CAMERAS.to_vec(),
-    )]))?;
-    let options = RunOptions::default();
+    files.insert("demo/ground_truth.glb".into(), DEMO_GT.to_vec());
+    files.insert("demo/cameras.json".into(), DEMO_CAMERAS.to_vec());
+    let mut dataset = Dataset::read(&files, &DatasetPaths::folder("demo"))?;
+    let recon = read_reconstruction(
+        "sparse",
+        &sfmeval::files::read_input_files(&files, "demo/sparse")?,
+    )?;
     let bars = Bars::new(false);
-    let prepared = PreparedGroundTruth::new(
-        &gt.ground_truth,
-        options.eval.samples,
-        options.eval.seed,
-        &bars,
-    )?;
-    let gt_info = GroundTruthInfo {
-        name: "ground_truth.glb".into(),
-        format: "glb".into(),
-        warnings: gt.warnings,
-    };
-    let evaluation = pipeline::run(
-        &prepared,
-        &gt_info,
-        &recon,
-        Some(&gt_cameras),
-        &[],
-        &options,
-        &bars,
-    )?;
+    let evaluation = pipeline::run(&mut dataset, &recon, &EvalRequest::default(), &bars)?;
     if let Some(p) = report_path {
         write_atomic(p, evaluation.report.to_json().as_bytes())?;
     }

@@ -1,7 +1,6 @@
 //! `sfmeval`: evaluate SfM reconstructions against ground truth from the command line.
 
 mod commands;
-mod files;
 mod progress;
 mod summary;
 

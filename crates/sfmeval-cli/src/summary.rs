@@ -2,6 +2,7 @@
 
 use std::fmt::Write as _;
 
+use sfmeval::pose::CamerasReport;
 use sfmeval::report::Report;
 
 fn g(v: f64) -> String {
@@ -102,7 +103,7 @@ pub fn render(r: &Report) -> String {
             s,
             "{:>14} {:>10.3} {:>10.4} {:>10.4} {:>10.4}",
             g(t.tau),
-            t.tau_relative_to_diagonal * 100.0,
+            t.tau_percent_of_diagonal,
             t.precision,
             t.recall,
             t.f_score
@@ -179,8 +180,11 @@ pub fn render(r: &Report) -> String {
         }
     }
     if let Some(c) = &r.cameras {
-        let v = serde_json::json!({"cameras": c, "alignment": r.alignment});
-        s.push_str(&render_cameras(&v));
+        s.push_str(&render_cameras(
+            &c.errors,
+            &c.alignment.stage,
+            c.alignment.scale,
+        ));
     }
     for w in &r.warnings {
         let _ = writeln!(s, "warning: {w}");
@@ -188,58 +192,44 @@ pub fn render(r: &Report) -> String {
     s
 }
 
-/// Formats the `sfmeval cameras` result (alignment + cameras sections) for a person.
-pub fn render_cameras(v: &serde_json::Value) -> String {
+/// Formats camera-pose errors measured after the alignment `stage` of scale `scale` for a
+/// person (the `cameras` section of `eval`, and `sfmeval cameras`).
+pub fn render_cameras(c: &CamerasReport, stage: &str, scale: f64) -> String {
     let mut s = String::new();
-    let num = |p: &str| v.pointer(p).and_then(|x| x.as_f64()).unwrap_or(f64::NAN);
     let _ = writeln!(
         s,
         "cameras         {} ground truth, {} registered, {} matched, {} model(s)",
-        num("/cameras/ground_truth"),
-        num("/cameras/registered"),
-        num("/cameras/matched"),
-        num("/cameras/models")
+        c.ground_truth, c.registered, c.matched, c.models
     );
+    let focal: Vec<String> = c
+        .focal
+        .iter()
+        .map(|f| format!("{:.3}", f.error_percent))
+        .collect();
     let _ = writeln!(
         s,
-        "pose alignment  {} (scale {}); focal error {} %",
-        v.pointer("/cameras/alignment/stage")
-            .or_else(|| v.pointer("/alignment/method"))
-            .and_then(|m| m.as_str())
-            .unwrap_or("?"),
-        g(v.pointer("/cameras/alignment/scale")
-            .and_then(|x| x.as_f64())
-            .unwrap_or(num("/alignment/scale"))),
-        v.pointer("/cameras/focal")
-            .and_then(|f| f.as_array())
-            .map(|f| f
-                .iter()
-                .filter_map(|c| c.get("error_percent").and_then(|e| e.as_f64()))
-                .map(|e| format!("{e:.3}"))
-                .collect::<Vec<_>>()
-                .join(", "))
-            .unwrap_or_default()
+        "pose alignment  {stage} (scale {}); focal error {} %",
+        g(scale),
+        focal.join(", ")
     );
     let _ = writeln!(
         s,
         "rotation error  mean {}°  median {}°  max {}°",
-        g(num("/cameras/rotation_error_deg/mean")),
-        g(num("/cameras/rotation_error_deg/median")),
-        g(num("/cameras/rotation_error_deg/max"))
+        g(c.rotation_error_deg.mean),
+        g(c.rotation_error_deg.median),
+        g(c.rotation_error_deg.max)
     );
     let _ = writeln!(
         s,
         "centre error    mean {}  median {}  max {}  (ATE RMSE {}, mean {} % of scene radius)",
-        g(num("/cameras/center_error/mean")),
-        g(num("/cameras/center_error/median")),
-        g(num("/cameras/center_error/max")),
-        g(num("/cameras/ate_rmse")),
-        g(num("/cameras/center_error_percent/mean"))
+        g(c.center_error.mean),
+        g(c.center_error.median),
+        g(c.center_error.max),
+        g(c.ate_rmse),
+        g(c.center_error_percent.mean)
     );
-    if let Some(w) = v.pointer("/cameras/warnings").and_then(|w| w.as_array()) {
-        for w in w.iter().filter_map(|w| w.as_str()) {
-            let _ = writeln!(s, "warning: {w}");
-        }
+    for w in &c.warnings {
+        let _ = writeln!(s, "warning: {w}");
     }
     s
 }

@@ -2,7 +2,7 @@
 //!
 //! Thin wasm-bindgen bindings over the sfmeval core, for the npm package `sfmeval` and the
 //! browser page. Bytes go in (`Uint8Array`), options go in as plain JS objects (deserialised with
-//! serde-wasm-bindgen into the core's own option types), and the `sfmeval.report/1` JSON plus
+//! serde-wasm-bindgen into the core's own option types), and the `sfmeval.report/2` JSON plus
 //! typed arrays come out. Every number is computed by the core (`crates/sfmeval`) exactly as the
 //! CLI computes it; errors become JS `Error`s carrying the core's message.
 
@@ -11,15 +11,17 @@ use std::sync::atomic::{AtomicU64, Ordering};
 
 use js_sys::{Float32Array, Float64Array, Function, Object, Uint8Array, Uint32Array};
 use serde::Serialize as _;
-use sfmeval::align::{PointPair, parse_point_pairs};
+use sfmeval::align::{AlignMode, AlignRequest, PointPair, parse_point_pairs};
 use sfmeval::colormap::distance_color;
 use sfmeval::crop::Crop;
-use sfmeval::evaluate::{EvalOptions, PreparedGroundTruth};
+use sfmeval::dataset::Dataset;
+use sfmeval::evaluate::EvalOptions;
+use sfmeval::export;
 use sfmeval::geometry::{Aabb, GroundTruth as CoreGroundTruth};
-use sfmeval::gt_views::{GtView, build_views, depth_stem};
+use sfmeval::gt_views::depth_stem;
+use sfmeval::io;
 use sfmeval::io::npy::DepthMap;
-use sfmeval::io::{self, LoadedGroundTruth};
-use sfmeval::pipeline::{self, AlignRequest, GroundTruthInfo, ReconInput, RunOptions};
+use sfmeval::pipeline::{self, EvalRequest, ReconInput};
 use sfmeval::progress::{Progress, Stage};
 use sfmeval::transform::Similarity;
 use wasm_bindgen::prelude::*;
@@ -78,11 +80,7 @@ fn points_f32(points: &[[f64; 3]]) -> Float32Array {
 /// sample count and seed stay the same.
 #[wasm_bindgen]
 pub struct GroundTruth {
-    loaded: LoadedGroundTruth,
-    name: String,
-    prepared: Option<(usize, u64, PreparedGroundTruth)>,
-    cameras: Option<sfmeval::model::Reconstruction>,
-    views: Option<Vec<GtView>>,
+    dataset: Dataset,
 }
 
 #[wasm_bindgen]
@@ -102,40 +100,36 @@ impl GroundTruth {
         let loaded = io::read_ground_truth(name, &bytes.to_vec(), &external)
             .map_err(|e| js_err(&format!("ground truth '{name}'"), e))?;
         Ok(GroundTruth {
-            loaded,
-            name: name.to_string(),
-            prepared: None,
-            cameras: None,
-            views: None,
+            dataset: Dataset::new(name, loaded),
         })
     }
 
     /// File name given when reading.
     #[wasm_bindgen(getter)]
     pub fn name(&self) -> String {
-        self.name.clone()
+        self.dataset.name.clone()
     }
 
     /// Format read (`glb`, `gltf`, `obj`, `ply`).
     #[wasm_bindgen(getter)]
     pub fn format(&self) -> String {
-        self.loaded.format.name().to_string()
+        self.dataset.loaded.format.name().to_string()
     }
 
     /// Whether the ground truth is a triangle mesh (else a point cloud).
     #[wasm_bindgen(getter, js_name = isMesh)]
     pub fn is_mesh(&self) -> bool {
-        matches!(self.loaded.ground_truth, CoreGroundTruth::Mesh(_))
+        matches!(self.dataset.loaded.ground_truth, CoreGroundTruth::Mesh(_))
     }
 
     /// Vertices (or cloud points), `x0, y0, z0, x1, ...`, in the ground-truth frame.
     pub fn vertices(&self) -> Float64Array {
-        points_f64(self.loaded.ground_truth.points())
+        points_f64(self.dataset.loaded.ground_truth.points())
     }
 
     /// Triangle vertex indices (empty for a cloud).
     pub fn triangles(&self) -> Uint32Array {
-        match &self.loaded.ground_truth {
+        match &self.dataset.loaded.ground_truth {
             CoreGroundTruth::Mesh(m) => {
                 let flat: Vec<u32> = m.triangles.iter().flatten().copied().collect();
                 Uint32Array::from(flat.as_slice())
@@ -146,7 +140,7 @@ impl GroundTruth {
 
     /// Bounding box `[xmin, ymin, zmin, xmax, ymax, zmax]`.
     pub fn bounds(&self) -> Vec<f64> {
-        Aabb::of(self.loaded.ground_truth.points())
+        Aabb::of(self.dataset.loaded.ground_truth.points())
             .map(|b| b.min.iter().chain(&b.max).copied().collect())
             .unwrap_or_default()
     }
@@ -154,22 +148,20 @@ impl GroundTruth {
     /// Notes from reading.
     #[wasm_bindgen(getter)]
     pub fn warnings(&self) -> Vec<String> {
-        self.loaded.warnings.clone()
+        self.dataset.loaded.warnings.clone()
     }
 
     /// Attaches the ground-truth cameras used by later evaluations (camera alignment and pose
     /// metrics). Takes ownership: the `Cameras` object cannot be used afterwards.
     #[wasm_bindgen(js_name = setCameras)]
     pub fn set_cameras(&mut self, cameras: Cameras) {
-        self.cameras = Some(cameras.model);
-        self.views = None;
+        self.dataset.set_cameras(Some(cameras.model));
     }
 
     /// Removes the attached ground-truth cameras (and the depth maps, which need them).
     #[wasm_bindgen(js_name = clearCameras)]
     pub fn clear_cameras(&mut self) {
-        self.cameras = None;
-        self.views = None;
+        self.dataset.set_cameras(None);
     }
 
     /// Attaches the dataset's depth maps (`depth/<image stem>.npy`, one per ground-truth image,
@@ -177,37 +169,38 @@ impl GroundTruth {
     /// completeness and the track-based error, as `sfmeval eval --depth`. Needs the cameras.
     #[wasm_bindgen(js_name = setDepthMaps)]
     pub fn set_depth_maps(&mut self, files: Object) -> Result<(), JsError> {
-        let Some(cameras) = self.cameras.as_ref() else {
+        if self.dataset.cameras().is_none() {
             return Err(JsError::new(
                 "depth maps need the ground-truth cameras (cameras.json) first",
             ));
-        };
+        }
         let mut maps = BTreeMap::new();
         for (name, bytes) in files_of(&files)? {
             let map = DepthMap::from_npy(&bytes)
                 .map_err(|e| js_err(&format!("depth map '{name}'"), e))?;
             maps.insert(depth_stem(&name), map);
         }
-        self.views = Some(build_views(cameras, &maps).map_err(|e| js_err("depth maps", e))?);
-        Ok(())
+        self.dataset
+            .set_depth_maps(&maps)
+            .map_err(|e| js_err("depth maps", e))
     }
 
     /// Removes the attached depth maps.
     #[wasm_bindgen(js_name = clearDepthMaps)]
     pub fn clear_depth_maps(&mut self) {
-        self.views = None;
+        self.dataset.clear_depth_maps();
     }
 
     /// Whether depth maps are attached.
     #[wasm_bindgen(getter, js_name = hasDepthMaps)]
     pub fn has_depth_maps(&self) -> bool {
-        self.views.is_some()
+        self.dataset.views().is_some()
     }
 
     /// Whether ground-truth cameras are attached.
     #[wasm_bindgen(getter, js_name = hasCameras)]
     pub fn has_cameras(&self) -> bool {
-        self.cameras.is_some()
+        self.dataset.cameras().is_some()
     }
 }
 
@@ -390,11 +383,11 @@ impl Drop for CallbackGuard {
 #[derive(serde::Deserialize, Default)]
 #[serde(deny_unknown_fields)]
 struct AlignOptions {
-    /// `auto`, `cameras`, `points`, `global`, `icp`, `given` or `none`.
+    /// One of [`AlignMode::names`] (see `alignModes()`).
     align: Option<String>,
     /// A row-major 4×4 `gt_from_recon`, or the text of a transform file.
     transform: Option<serde_json::Value>,
-    /// Point pairs for the `points` stage.
+    /// Point pairs for the `points` stages.
     pairs: Option<Vec<PointPair>>,
 }
 
@@ -429,32 +422,38 @@ fn parse_transform(v: &serde_json::Value) -> Result<Similarity, JsError> {
     Similarity::parse(text.as_bytes()).map_err(|e| js_err("transform", e))
 }
 
-/// Builds the alignment request exactly as the CLI does from `--align` and `--transform`.
-fn align_request(a: &AlignOptions) -> Result<(AlignRequest, Option<Similarity>), JsError> {
+/// Builds the alignment request: the core's [`AlignRequest::new`], as the CLI's.
+fn align_request(a: AlignOptions) -> Result<AlignRequest, JsError> {
     let transform = a.transform.as_ref().map(parse_transform).transpose()?;
-    let method = a.align.clone().unwrap_or_else(|| {
-        if transform.is_some() {
-            "given".into()
-        } else {
-            "auto".into()
-        }
-    });
-    let request = match method.as_str() {
-        "none" if transform.is_some() => {
-            return Err(JsError::new(
-                "align 'none' ignores the transform: use align 'given' (the default with a transform)",
-            ));
-        }
-        "none" => AlignRequest::None,
-        "given" => AlignRequest::Given(
-            transform.ok_or_else(|| JsError::new("align 'given' needs a transform"))?,
-        ),
-        "points" if a.pairs.as_ref().is_none_or(|p| p.is_empty()) => {
-            return Err(JsError::new("align 'points' needs point pairs"));
-        }
-        other => AlignRequest::Stages(other.to_string()),
-    };
-    Ok((request, transform))
+    let mode = a
+        .align
+        .as_deref()
+        .map(AlignMode::parse)
+        .transpose()
+        .map_err(|e| js_err("options", e))?;
+    AlignRequest::new(mode, transform, a.pairs.unwrap_or_default())
+        .map_err(|e| js_err("options", e))
+}
+
+/// Every alignment mode, as `[{name, description, needsTransform, needsPairs, needsCameras}]`,
+/// in the order menus list them.
+#[wasm_bindgen(js_name = alignModes)]
+pub fn align_modes() -> Result<JsValue, JsError> {
+    let modes: Vec<serde_json::Value> = AlignMode::ALL
+        .iter()
+        .map(|m| {
+            serde_json::json!({
+                "name": m.name(),
+                "description": m.description(),
+                "needsTransform": m.needs_transform(),
+                "needsPairs": m.needs_pairs(),
+                "needsCameras": m.needs_cameras(),
+            })
+        })
+        .collect();
+    modes
+        .serialize(&serde_wasm_bindgen::Serializer::json_compatible())
+        .map_err(|e| js_err("alignment modes", e.to_string()))
 }
 
 /// The result of [`evaluate`]: the report and per-point arrays for the viewer and exports.
@@ -465,7 +464,7 @@ pub struct Evaluation {
 
 #[wasm_bindgen]
 impl Evaluation {
-    /// The `sfmeval.report/1` JSON, byte for byte what `sfmeval eval --report` writes.
+    /// The `sfmeval.report/2` JSON, byte for byte what `sfmeval eval --report` writes.
     #[wasm_bindgen(js_name = reportJson)]
     pub fn report_json(&self) -> String {
         self.inner.report.to_json()
@@ -524,12 +523,12 @@ impl Evaluation {
     /// The kept points coloured by error as binary PLY, as `sfmeval eval --colored`.
     #[wasm_bindgen(js_name = coloredPly)]
     pub fn colored_ply(&self, clip: f64) -> Uint8Array {
-        Uint8Array::from(io::write::colored_ply(&self.inner, clip).as_slice())
+        Uint8Array::from(export::colored_ply(&self.inner, clip).as_slice())
     }
 
     /// Per-point distances as CSV, as `sfmeval eval --csv`.
     pub fn csv(&self) -> String {
-        io::write::distances_csv(&self.inner)
+        export::distances_csv(&self.inner)
     }
 
     /// The completeness samples used (inside the crop volume), `x0, y0, z0, ...`, as 32-bit
@@ -593,41 +592,15 @@ pub fn evaluate(
 ) -> Result<Evaluation, JsError> {
     let (eval, align) = parse_options(options)?;
     eval.validate().map_err(|e| js_err("options", e))?;
-    let (request, icp_start) = align_request(&align)?;
+    let request = EvalRequest {
+        align: align_request(align)?,
+        eval,
+        ..EvalRequest::default()
+    };
     let _guard = CallbackGuard::set(progress);
     let bar = JsProgress::new();
-    let fresh = !matches!(&gt.prepared, Some((n, s, _)) if *n == eval.samples && *s == eval.seed);
-    if fresh {
-        gt.prepared = None;
-        let p = PreparedGroundTruth::new(&gt.loaded.ground_truth, eval.samples, eval.seed, &bar)
-            .map_err(|e| js_err(&format!("ground truth '{}'", gt.name), e))?;
-        gt.prepared = Some((eval.samples, eval.seed, p));
-    }
-    let Some((_, _, prepared)) = gt.prepared.as_ref() else {
-        return Err(JsError::new("ground truth not prepared"));
-    };
-    let info = GroundTruthInfo {
-        name: gt.name.clone(),
-        format: gt.loaded.format.name().into(),
-        warnings: gt.loaded.warnings.clone(),
-    };
-    let run_options = RunOptions {
-        eval,
-        align: request,
-        icp_start,
-        ..RunOptions::default()
-    };
-    let inner = pipeline::run_with_views(
-        prepared,
-        &info,
-        &recon.input,
-        gt.cameras.as_ref(),
-        gt.views.as_deref(),
-        align.pairs.as_deref().unwrap_or(&[]),
-        &run_options,
-        &bar,
-    )
-    .map_err(|e| js_err(&format!("evaluating '{}'", recon.input.name), e))?;
+    let inner = pipeline::run(&mut gt.dataset, &recon.input, &request, &bar)
+        .map_err(|e| js_err(&format!("evaluating '{}'", recon.input.name), e))?;
     Ok(Evaluation { inner })
 }
 

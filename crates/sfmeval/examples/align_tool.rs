@@ -14,7 +14,7 @@ use std::collections::BTreeMap;
 use std::time::Instant;
 
 use sfmeval::align::{self, AlignInput, AlignMethod, AlignOptions, CameraPair, IcpOptions};
-use sfmeval::evaluate::PreparedGroundTruth;
+use sfmeval::prepared::PreparedGroundTruth;
 use sfmeval::progress::NoProgress;
 use sfmeval::transform::Similarity;
 

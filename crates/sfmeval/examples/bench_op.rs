@@ -30,8 +30,8 @@ use std::time::Instant;
 use serde_json::{Value, json};
 use sfmeval::align::{IcpOptions, refine_icp};
 use sfmeval::distance::{CloudIndex, MeshIndex};
-use sfmeval::evaluate::PreparedGroundTruth;
 use sfmeval::geometry::{GroundTruth, Point3, TriangleMesh};
+use sfmeval::prepared::PreparedGroundTruth;
 use sfmeval::progress::NoProgress;
 use sfmeval::transform::Similarity;
 

@@ -69,6 +69,32 @@ pub enum Error {
     /// Geometry that cannot be used (all triangles degenerate, zero-size scene, ...).
     #[error("unusable geometry: {0}")]
     Geometry(String),
+    /// A file that could not be read at all (reported by a [`crate::files::FileSource`]).
+    #[error("cannot read '{file}': {message}")]
+    Io {
+        /// The file's path as the source names it.
+        file: String,
+        /// What the system said.
+        message: String,
+    },
+    /// A file an input needs is absent.
+    #[error("missing {what} '{file}'")]
+    Missing {
+        /// What the file is for ("depth map for image 'a.jpg'", ...).
+        what: String,
+        /// The path looked for.
+        file: String,
+    },
+    /// An error in one named input file: its role and path, then what is wrong in it.
+    #[error("{role} '{file}': {cause}")]
+    InFile {
+        /// What the file is (`ground truth`, `reconstruction`, `ground-truth cameras`, ...).
+        role: &'static str,
+        /// The file's path as the front end named it.
+        file: String,
+        /// What is wrong.
+        cause: Box<Error>,
+    },
 }
 
 /// Shorthand result type of the core.
@@ -87,6 +113,18 @@ impl Error {
             Error::UnknownFormat(_) => "unknown_format",
             Error::InvalidOption(_) => "invalid_option",
             Error::Geometry(_) => "geometry",
+            Error::Io { .. } => "io",
+            Error::Missing { .. } => "missing",
+            Error::InFile { cause, .. } => cause.kind(),
+        }
+    }
+
+    /// This error, as an error in the file `file` playing `role`.
+    pub fn in_file(self, role: &'static str, file: impl Into<String>) -> Self {
+        Error::InFile {
+            role,
+            file: file.into(),
+            cause: Box::new(self),
         }
     }
 

@@ -3,15 +3,16 @@
 
 use serde::{Deserialize, Serialize};
 
+use crate::align::AlignMode;
 use crate::crop::Crop;
-use crate::distance::{CloudIndex, MeshIndex};
+use crate::distance::CloudIndex;
 use crate::error::{Error, Result};
-use crate::geometry::{Aabb, GroundTruth, Point3, PointCloud};
-use crate::metrics::{f_score, share_below};
+use crate::geometry::{Point3, PointCloud};
+use crate::metrics::{Thresholds, f_score, share_below};
 use crate::parallel;
+use crate::prepared::PreparedGroundTruth;
 use crate::progress::{Progress, Stage};
 use crate::report::*;
-use crate::sampling::sample_surface;
 use crate::stats::{DEFAULT_BINS, Statistics};
 use crate::transform::Similarity;
 
@@ -20,9 +21,6 @@ use crate::transform::Similarity;
 /// 0.05 percentage points, and the mean completeness distance varies by well under 0.1 % between
 /// seeds, while sampling and querying 1M points stays well under a second natively.
 pub const DEFAULT_SAMPLES: usize = 1_000_000;
-
-/// Default thresholds in percent of the ground-truth diagonal when none are given.
-pub const DEFAULT_TAU_PERCENT: [f64; 3] = [0.5, 1.0, 2.0];
 
 /// Options of an evaluation. Every field changes numbers and is echoed in the report.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -62,6 +60,11 @@ impl Default for EvalOptions {
 }
 
 impl EvalOptions {
+    /// The thresholds in ground-truth units for a ground truth of this diagonal.
+    pub fn thresholds(&self, diagonal: f64) -> Thresholds {
+        Thresholds::resolve(&self.tau, &self.tau_percent_of_diagonal, diagonal)
+    }
+
     /// Checks ranges.
     pub fn validate(&self) -> Result<()> {
         self.crop.validate()?;
@@ -110,113 +113,6 @@ pub struct InputInfo {
     pub warnings: Vec<String>,
 }
 
-enum GtIndex {
-    Mesh(Box<MeshIndex>),
-    Cloud(CloudIndex),
-}
-
-/// A ground truth ready for many evaluations: its BVH or k-d tree and its completeness samples.
-pub struct PreparedGroundTruth {
-    index: GtIndex,
-    samples: Vec<Point3>,
-    sample_seed: u64,
-    requested_samples: usize,
-    /// Bounding box of the ground truth.
-    pub aabb: Aabb,
-    vertices: u64,
-    triangles: u64,
-    area: f64,
-}
-
-impl PreparedGroundTruth {
-    /// Indexes the ground truth and draws `samples` surface samples with `seed` (a cloud ground
-    /// truth uses its own points instead).
-    pub fn new(
-        gt: &GroundTruth,
-        samples: usize,
-        seed: u64,
-        progress: &dyn Progress,
-    ) -> Result<Self> {
-        let aabb = Aabb::of(gt.points()).ok_or_else(|| Error::Empty {
-            what: "ground truth".into(),
-        })?;
-        if !(aabb.diagonal() > 0.0) {
-            return Err(Error::Geometry(
-                "the ground truth has zero extent (all points identical)".into(),
-            ));
-        }
-        progress.start(Stage::IndexGroundTruth, 1);
-        let (index, pts, vertices, triangles, area) = match gt {
-            GroundTruth::Mesh(m) => {
-                let idx = MeshIndex::new(m)?;
-                progress.finish();
-                progress.start(Stage::Sampling, 1);
-                let s = sample_surface(m, samples, seed)?;
-                (
-                    GtIndex::Mesh(Box::new(idx)),
-                    s,
-                    m.vertices.len(),
-                    m.triangles.len(),
-                    m.area(),
-                )
-            }
-            GroundTruth::Cloud(c) => (
-                GtIndex::Cloud(CloudIndex::new(&c.points)?),
-                c.points.clone(),
-                c.points.len(),
-                0,
-                0.0,
-            ),
-        };
-        progress.finish();
-        Ok(PreparedGroundTruth {
-            index,
-            samples: pts,
-            sample_seed: seed,
-            requested_samples: samples,
-            aabb,
-            vertices: vertices as u64,
-            triangles: triangles as u64,
-            area,
-        })
-    }
-
-    /// Distance from `p` to the ground truth, and its signed version (mesh only).
-    pub fn distance(&self, p: Point3, signed: bool) -> (f64, Option<f64>) {
-        match &self.index {
-            GtIndex::Mesh(m) => {
-                let hit = m.closest(p);
-                (hit.distance, signed.then(|| m.signed(p, &hit)))
-            }
-            GtIndex::Cloud(c) => (c.nearest(p).0, None),
-        }
-    }
-
-    /// The closest ground-truth point to `p` (for ICP correspondences).
-    pub fn closest_point(&self, p: Point3) -> (Point3, f64) {
-        match &self.index {
-            GtIndex::Mesh(m) => {
-                let hit = m.closest(p);
-                (hit.closest, hit.distance)
-            }
-            GtIndex::Cloud(c) => {
-                let (d, i) = c.nearest(p);
-                (self.samples.get(i).copied().unwrap_or(p), d)
-            }
-        }
-    }
-
-    /// Whether the ground truth is a mesh.
-    pub fn is_mesh(&self) -> bool {
-        matches!(self.index, GtIndex::Mesh(_))
-    }
-
-    /// The completeness samples (surface samples, or the cloud's points).
-    pub fn samples(&self) -> &[Point3] {
-        &self.samples
-    }
-}
-
 /// Why a reconstructed point was discarded.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
 #[repr(u8)]
@@ -262,6 +158,8 @@ pub struct AlignmentInput {
     pub gt_from_recon: Similarity,
     /// The report section describing how it was found.
     pub report: AlignmentReport,
+    /// The mode that was asked for (the report's `options.align`).
+    pub requested: AlignMode,
 }
 
 impl AlignmentInput {
@@ -279,6 +177,7 @@ impl AlignmentInput {
                 converged: true,
                 stages: Vec::new(),
             },
+            requested: AlignMode::None,
         }
     }
 
@@ -306,6 +205,7 @@ impl AlignmentInput {
                 converged: true,
                 stages: vec![stage],
             },
+            requested: AlignMode::Given,
         }
     }
 }
@@ -405,21 +305,16 @@ pub fn evaluate(
     }
 
     let diagonal = gt.aabb.diagonal();
-    let mut taus: Vec<f64> = options.tau.clone();
-    let percents = if options.tau.is_empty() && options.tau_percent_of_diagonal.is_empty() {
-        DEFAULT_TAU_PERCENT.to_vec()
-    } else {
-        options.tau_percent_of_diagonal.clone()
-    };
-    taus.extend(percents.iter().map(|p| p / 100.0 * diagonal));
-    let thresholds = taus
+    let resolved = options.thresholds(diagonal);
+    let thresholds = resolved
+        .taus
         .iter()
         .map(|&tau| {
             let precision = share_below(&kept_distances, tau);
             let recall = share_below(&completeness_distances, tau);
             ThresholdReport {
                 tau,
-                tau_relative_to_diagonal: tau / diagonal,
+                tau_percent_of_diagonal: resolved.percent_of_diagonal(tau),
                 precision,
                 recall,
                 f_score: f_score(precision, recall),
@@ -465,8 +360,8 @@ pub fn evaluate(
             signed: options.signed,
             histogram_bins: bins as u64,
             tau: options.tau.clone(),
-            tau_percent_of_diagonal: percents,
-            align: alignment.report.method.clone(),
+            tau_percent_of_diagonal: resolved.percents_used.clone(),
+            align: alignment.requested.name().into(),
             min_views: None,
         },
         crop: CropReport {

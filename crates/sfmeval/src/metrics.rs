@@ -1,6 +1,45 @@
 //! Precision, recall and F-score at a distance threshold, as the Tanks and Temples evaluation
 //! defines them: a distance counts when it is strictly below tau.
 
+/// Default thresholds in percent of the ground-truth diagonal when none are given.
+pub const DEFAULT_TAU_PERCENT: [f64; 3] = [0.5, 1.0, 2.0];
+
+/// The thresholds of an evaluation, resolved once: each τ in ground-truth units, in the order
+/// given (those in ground-truth units first, then those in percent of the diagonal).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Thresholds {
+    /// τ in ground-truth units.
+    pub taus: Vec<f64>,
+    /// The percents of the diagonal that were used (the defaults when nothing was given).
+    pub percents_used: Vec<f64>,
+    /// The ground-truth bounding-box diagonal they refer to.
+    pub diagonal: f64,
+}
+
+impl Thresholds {
+    /// Resolves `tau` (ground-truth units) and `percent_of_diagonal`; with neither,
+    /// [`DEFAULT_TAU_PERCENT`].
+    pub fn resolve(tau: &[f64], percent_of_diagonal: &[f64], diagonal: f64) -> Thresholds {
+        let percents_used = if tau.is_empty() && percent_of_diagonal.is_empty() {
+            DEFAULT_TAU_PERCENT.to_vec()
+        } else {
+            percent_of_diagonal.to_vec()
+        };
+        let mut taus = tau.to_vec();
+        taus.extend(percents_used.iter().map(|p| p / 100.0 * diagonal));
+        Thresholds {
+            taus,
+            percents_used,
+            diagonal,
+        }
+    }
+
+    /// τ in percent of the diagonal.
+    pub fn percent_of_diagonal(&self, tau: f64) -> f64 {
+        tau / self.diagonal * 100.0
+    }
+}
+
 /// Share of `distances` strictly below `tau` (0 for an empty list).
 pub fn share_below(distances: &[f64], tau: f64) -> f64 {
     if distances.is_empty() {

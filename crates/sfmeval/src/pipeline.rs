@@ -1,26 +1,25 @@
-//! One evaluation request as every front end makes it: read the inputs from named bytes, align
-//! (none, a given transform, or the alignment stages), measure, and add camera-pose metrics when
-//! both sides have cameras. The CLI, the wasm bindings and the runner all call [`run`], so they
-//! give the same report for the same inputs.
+//! One evaluation request as every front end makes it: read the reconstruction from named
+//! bytes, align (none, a given transform, or the alignment stages), measure against a
+//! [`Dataset`], and add what the dataset's parts allow (camera-pose metrics, visible
+//! completeness, track error). The CLI, the wasm bindings and the runner all call [`run`] with
+//! an [`EvalRequest`], so they give the same report for the same inputs.
 
 use std::collections::BTreeMap;
 
-use crate::align::{self, AlignInput, AlignMethod, AlignOptions, CameraPair, PointPair};
-use crate::error::{Error, Result};
-use crate::evaluate::{
-    AlignmentInput, EvalOptions, Evaluation, InputInfo, PointStatus, PreparedGroundTruth, evaluate,
+use crate::align::{
+    self, AlignInput, AlignMethod, AlignMode, AlignOptions, AlignRequest, CameraPair,
 };
+use crate::dataset::Dataset;
+use crate::error::{Error, Result};
+use crate::evaluate::{AlignmentInput, EvalOptions, Evaluation, InputInfo, PointStatus, evaluate};
 use crate::geometry::PointCloud;
 use crate::gt_views::GtView;
 use crate::io;
-use crate::metrics::{f_score, share_below};
 use crate::model::{self, Reconstruction};
 use crate::pose::{PoseOptions, evaluate_cameras_matched};
+use crate::prepared::PreparedGroundTruth;
 use crate::progress::{Progress, Stage};
-use crate::report::{
-    SlidingThresholdReport, TrackErrorReport, VisibleCompletenessReport, VisibleThresholdReport,
-};
-use crate::stats::Statistics;
+use crate::report::{CamerasAlignment, CamerasSection};
 use crate::transform::Similarity;
 use crate::{track_error, visibility};
 
@@ -196,62 +195,28 @@ fn cloud_with_cameras(
     })
 }
 
-/// How to bring the reconstruction into the ground-truth frame.
-#[derive(Debug, Clone, PartialEq)]
-pub enum AlignRequest {
-    /// The reconstruction is already in the ground-truth frame.
-    None,
-    /// Use this `gt_from_recon`.
-    Given(Similarity),
-    /// Run the alignment stages (`auto`, `cameras`, `points`, `global`, `icp`).
-    Stages(String),
-}
-
-/// Everything besides the inputs that changes the numbers.
-#[derive(Debug, Clone, PartialEq)]
-pub struct RunOptions {
-    /// Measurement options.
-    pub eval: EvalOptions,
+/// One evaluation request: how to align, what to measure, how to score the cameras. Every
+/// front end builds one and hands it to [`run`].
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct EvalRequest {
     /// Alignment.
     pub align: AlignRequest,
-    /// Start of an `icp`-only alignment.
-    pub icp_start: Option<Similarity>,
+    /// Measurement options.
+    pub eval: EvalOptions,
     /// Pose metric options.
     pub pose: PoseOptions,
 }
 
-impl Default for RunOptions {
-    fn default() -> Self {
-        RunOptions {
-            eval: EvalOptions::default(),
-            align: AlignRequest::Stages("auto".into()),
-            icp_start: None,
-            pose: PoseOptions::default(),
-        }
-    }
-}
-
-/// Names and formats of the ground truth, for the report.
-#[derive(Debug, Clone, Default)]
-pub struct GroundTruthInfo {
-    /// File name.
-    pub name: String,
-    /// Format name.
-    pub format: String,
-    /// Notes from reading.
-    pub warnings: Vec<String>,
-}
-
 fn camera_pairs(
-    gt_cams: &Reconstruction,
+    gt_cameras: &Reconstruction,
     est: &Reconstruction,
 ) -> (Vec<CameraPair>, model::matching::ImageMatches) {
-    let matches = model::matching::match_images(gt_cams, est);
+    let matches = model::matching::match_images(gt_cameras, est);
     let pairs = matches
         .pairs
         .iter()
         .filter_map(|&(g, e)| {
-            let (gi, ei) = (gt_cams.images.get(g)?, est.images.get(e)?);
+            let (gi, ei) = (gt_cameras.images.get(g)?, est.images.get(e)?);
             Some(CameraPair {
                 recon_center: ei.center(),
                 gt_center: gi.center(),
@@ -263,45 +228,27 @@ fn camera_pairs(
     (pairs, matches)
 }
 
-/// Aligns, measures and evaluates cameras. `gt_cameras` is the dataset's `cameras.json` (or any
-/// model in the ground-truth frame); `point_pairs` feed the `points` stage.
+/// Aligns `recon` to the ground truth of `dataset`, measures it, and adds what the dataset's
+/// parts allow: camera-pose metrics with its cameras, completeness over the visible surface
+/// and (for models with tracks) the track-based error with its depth maps. The dataset is
+/// prepared for the request's sample count and seed first (reused when they match).
 pub fn run(
-    gt: &PreparedGroundTruth,
-    gt_info: &GroundTruthInfo,
+    dataset: &mut Dataset,
     recon: &ReconInput,
-    gt_cameras: Option<&Reconstruction>,
-    point_pairs: &[PointPair],
-    options: &RunOptions,
+    request: &EvalRequest,
     progress: &dyn Progress,
 ) -> Result<Evaluation> {
-    run_with_views(
-        gt,
-        gt_info,
-        recon,
-        gt_cameras,
-        None,
-        point_pairs,
-        options,
-        progress,
-    )
-}
-
-/// [`run`] with the ground-truth views (cameras + depth maps, [`crate::gt_views::build_views`]
-/// over the same `gt_cameras`): adds completeness over the visible surface
-/// ([`crate::visibility`]) and, for reconstructions with tracks, the track-based true error
-/// ([`crate::track_error`]).
-#[allow(clippy::too_many_arguments)]
-pub fn run_with_views(
-    gt: &PreparedGroundTruth,
-    gt_info: &GroundTruthInfo,
-    recon: &ReconInput,
-    gt_cameras: Option<&Reconstruction>,
-    views: Option<&[GtView]>,
-    point_pairs: &[PointPair],
-    options: &RunOptions,
-    progress: &dyn Progress,
-) -> Result<Evaluation> {
-    let mut warnings: Vec<String> = gt_info
+    request.eval.validate()?;
+    request.align.validate()?;
+    dataset.prepare(request.eval.samples, request.eval.seed, progress)?;
+    let Some(gt) = dataset.prepared() else {
+        return Err(Error::InvalidOption(
+            "the ground truth is not prepared".into(),
+        ));
+    };
+    let gt_cameras = dataset.cameras();
+    let mut warnings: Vec<String> = dataset
+        .loaded
         .warnings
         .iter()
         .chain(&recon.warnings)
@@ -328,101 +275,43 @@ pub fn run_with_views(
             "cameras: {detail}: no camera alignment and no pose metrics"
         ));
     }
-    let alignment = match &options.align {
-        AlignRequest::None => AlignmentInput::none(),
-        AlignRequest::Given(t) => AlignmentInput::given(*t),
-        AlignRequest::Stages(name) => {
-            // `cameras`, `points`, `global` run alone; `cameras+icp` (etc.) and `auto` refine.
-            let (base, refine) = match name.strip_suffix("+icp") {
-                Some(b) => (b, true),
-                None => (name.as_str(), name == "auto" || name == "icp"),
-            };
-            let method = AlignMethod::parse(base)?;
-            if method == AlignMethod::Cameras && pairs.is_empty() {
-                return Err(cameras_unavailable(
-                    gt_cameras.is_some(),
-                    recon,
-                    no_match.as_deref(),
-                ));
-            }
-            progress.start(Stage::Alignment, 1);
-            let input = AlignInput {
-                recon: &recon.cloud.points,
-                cameras: &pairs,
-                point_pairs,
-                start: options.icp_start,
-            };
-            let opts = AlignOptions {
-                refine,
-                ..AlignOptions::default()
-            }
-            .with_seed(options.eval.seed);
-            let (t, mut report) = align::align(gt, &input, method, &opts)?;
-            progress.finish();
-            if let (AlignMethod::Auto, Some(detail)) = (method, &no_match)
-                && let Some(first) = report.stages.first_mut()
-            {
-                let fallback = format!(
-                    "cameras stage skipped ({detail}); fell back to {}",
-                    first.method
-                );
-                first.note = Some(match first.note.take() {
-                    Some(old) => format!("{fallback}; {old}"),
-                    None => fallback,
-                });
-            }
-            warnings.extend(align::stage_notes(&report));
-            AlignmentInput {
-                gt_from_recon: t,
-                report,
-            }
-        }
-    };
+    let alignment = align_recon(
+        gt,
+        recon,
+        &pairs,
+        no_match.as_deref(),
+        gt_cameras.is_some(),
+        request,
+        progress,
+    )?;
+    warnings.extend(align::stage_notes(&alignment.report));
     let info = InputInfo {
         recon_name: recon.name.clone(),
         recon_format: recon.format.clone(),
         recon_images: recon.model.as_ref().map_or(0, |m| m.images.len() as u64),
-        gt_name: gt_info.name.clone(),
-        gt_format: gt_info.format.clone(),
+        gt_name: dataset.name.clone(),
+        gt_format: dataset.loaded.format.name().into(),
         warnings,
     };
-    let mut evaluation = evaluate(gt, &recon.cloud, &alignment, &options.eval, &info, progress)?;
+    let mut evaluation = evaluate(gt, &recon.cloud, &alignment, &request.eval, &info, progress)?;
     if let (Some(g), Some(e), Some(m), None) = (gt_cameras, &recon.model, &matches, &no_match) {
-        // Poses are measured after the camera stage when there is one (as ATE aligns the
-        // trajectory itself); the point refinement may move the scale by the SfM's own
-        // camera/point inconsistency (e.g. a focal error), which the point metrics then show.
-        let camera_stage = alignment
-            .report
-            .stages
-            .iter()
-            .find(|s| s.method == "cameras");
-        let (t, used) = match camera_stage {
-            Some(stage) => (Similarity::from_matrix(stage.gt_from_recon)?, "cameras"),
-            None => (alignment.gt_from_recon, alignment.report.method.as_str()),
-        };
-        let cams = evaluate_cameras_matched(g, e, m, &t, &options.pose)?;
-        evaluation
-            .report
-            .warnings
-            .extend(cams.warnings.iter().map(|w| format!("cameras: {w}")));
-        let mut value = serde_json::to_value(&cams)
-            .map_err(|e| Error::InvalidOption(format!("camera report: {e}")))?;
-        if let Some(obj) = value.as_object_mut() {
-            obj.insert(
-                "alignment".into(),
-                serde_json::json!({"stage": used, "gt_from_recon": t.matrix, "scale": t.scale()}),
-            );
-        }
-        evaluation.report.cameras = Some(value);
+        evaluation.report.cameras = Some(camera_section(
+            g,
+            e,
+            m,
+            &alignment,
+            &request.pose,
+            &mut evaluation,
+        )?);
     }
-    if let Some(views) = views {
-        add_visibility(&mut evaluation, views, options, progress)?;
+    if let Some(views) = dataset.views() {
+        add_visibility(&mut evaluation, views, request, progress);
         match (gt_cameras, &recon.model) {
             (Some(_), Some(_)) if !recon.cloud_is_model_points => evaluation.report.warnings.push(
                 "depth maps were given but the evaluated cloud is not the SfM model's own points: no track-based error".into(),
             ),
             (Some(g), Some(e)) if e.points.iter().any(|p| !p.track.is_empty()) => {
-                add_track_error(&mut evaluation, g, e, views, &alignment, progress)?;
+                add_track_error(&mut evaluation, g, e, views, &alignment, request, progress)?;
             }
             _ => evaluation.report.warnings.push(
                 "depth maps were given but the reconstruction has no tracks (or no ground-truth cameras): no track-based error".into(),
@@ -430,6 +319,95 @@ pub fn run_with_views(
         }
     }
     Ok(evaluation)
+}
+
+/// Runs the requested alignment (none, the given transform, or the stages).
+fn align_recon(
+    gt: &PreparedGroundTruth,
+    recon: &ReconInput,
+    pairs: &[CameraPair],
+    no_match: Option<&str>,
+    have_gt_cameras: bool,
+    request: &EvalRequest,
+    progress: &dyn Progress,
+) -> Result<AlignmentInput> {
+    let a = &request.align;
+    let Some((method, refine)) = a.mode.stages() else {
+        return Ok(match (a.mode, a.transform) {
+            (AlignMode::Given, Some(t)) => AlignmentInput::given(t),
+            _ => AlignmentInput::none(),
+        });
+    };
+    if a.mode.needs_cameras() && pairs.is_empty() {
+        return Err(cameras_unavailable(have_gt_cameras, recon, no_match));
+    }
+    progress.start(Stage::Alignment, 1);
+    let input = AlignInput {
+        recon: &recon.cloud.points,
+        cameras: pairs,
+        point_pairs: &a.pairs,
+        start: a.transform,
+    };
+    let opts = AlignOptions {
+        refine,
+        ..AlignOptions::default()
+    }
+    .with_seed(request.eval.seed);
+    let (t, mut report) = align::align(gt, &input, method, &opts)?;
+    progress.finish();
+    if let (AlignMethod::Auto, Some(detail)) = (method, no_match)
+        && let Some(first) = report.stages.first_mut()
+    {
+        let fallback = format!(
+            "cameras stage skipped ({detail}); fell back to {}",
+            first.method
+        );
+        first.note = Some(match first.note.take() {
+            Some(old) => format!("{fallback}; {old}"),
+            None => fallback,
+        });
+    }
+    Ok(AlignmentInput {
+        gt_from_recon: t,
+        report,
+        requested: a.mode,
+    })
+}
+
+/// The pose errors of the matched cameras. They are measured after the camera stage when
+/// there is one (as ATE aligns the trajectory itself): the point refinement may move the scale
+/// by the SfM's own camera/point inconsistency (e.g. a focal error), which the point metrics
+/// then show.
+fn camera_section(
+    gt_cameras: &Reconstruction,
+    est: &Reconstruction,
+    matches: &model::matching::ImageMatches,
+    alignment: &AlignmentInput,
+    pose: &PoseOptions,
+    evaluation: &mut Evaluation,
+) -> Result<CamerasSection> {
+    let camera_stage = alignment
+        .report
+        .stages
+        .iter()
+        .find(|s| s.method == "cameras");
+    let (t, used) = match camera_stage {
+        Some(stage) => (Similarity::from_matrix(stage.gt_from_recon)?, "cameras"),
+        None => (alignment.gt_from_recon, alignment.report.method.as_str()),
+    };
+    let errors = evaluate_cameras_matched(gt_cameras, est, matches, &t, pose)?;
+    evaluation
+        .report
+        .warnings
+        .extend(errors.warnings.iter().map(|w| format!("cameras: {w}")));
+    Ok(CamerasSection {
+        errors,
+        alignment: CamerasAlignment {
+            stage: used.to_string(),
+            gt_from_recon: t.matrix,
+            scale: t.scale(),
+        },
+    })
 }
 
 /// "none of the N estimated image(s) matches one of the M ground-truth image names (e.g. ...)".
@@ -467,10 +445,10 @@ fn cameras_unavailable(have_gt_cameras: bool, recon: &ReconInput, no_match: Opti
 fn add_visibility(
     evaluation: &mut Evaluation,
     views: &[GtView],
-    options: &RunOptions,
+    request: &EvalRequest,
     progress: &dyn Progress,
-) -> Result<()> {
-    let min_views = options.eval.min_views;
+) {
+    let min_views = request.eval.min_views;
     progress.start(
         Stage::Visibility,
         evaluation.completeness_points.len() as u64,
@@ -478,60 +456,26 @@ fn add_visibility(
     let counts = visibility::count_views(views, &evaluation.completeness_points, progress);
     progress.finish();
     let report = &mut evaluation.report;
-    let visible: Vec<f64> = counts
-        .iter()
-        .zip(&evaluation.completeness_distances)
-        .filter(|(n, _)| **n >= min_views)
-        .map(|(_, d)| *d)
-        .collect();
-    let finite: Vec<f64> = visible.iter().copied().filter(|d| d.is_finite()).collect();
-    let samples = counts.len();
-    let fraction = if samples > 0 {
-        visible.len() as f64 / samples as f64
-    } else {
-        0.0
-    };
-    let thresholds = report
-        .thresholds
-        .iter()
-        .map(|t| {
-            let recall_visible = share_below(&visible, t.tau);
-            VisibleThresholdReport {
-                tau: t.tau,
-                recall: t.recall,
-                recall_visible,
-                f_score_visible: f_score(t.precision, recall_visible),
-            }
-        })
-        .collect();
-    let labels_tau = report.thresholds.first().map_or(0.0, |t| t.tau);
     let whole_surface = report.crop.volume.is_none() && report.inputs.ground_truth.area > 0.0;
-    if visible.is_empty() {
-        report.warnings.push(format!(
-            "no ground-truth sample is seen in {min_views} or more images: check that the depth maps belong to these cameras"
-        ));
-    }
+    let (section, warning) = visibility::visible_completeness(
+        &counts,
+        &evaluation.completeness_distances,
+        &report.thresholds,
+        min_views,
+        views.len(),
+        whole_surface.then_some(report.inputs.ground_truth.area),
+        request.eval.histogram_bins,
+    );
+    report.warnings.extend(warning);
     report.options.min_views = Some(u64::from(min_views));
-    report.completeness_visible = Some(VisibleCompletenessReport {
-        direction: "ground_truth_to_reconstruction".into(),
-        min_views: u64::from(min_views),
-        views: views.len() as u64,
-        samples: samples as u64,
-        visible_samples: visible.len() as u64,
-        visible_fraction: fraction,
-        visible_area: whole_surface.then_some(fraction * report.inputs.ground_truth.area),
-        labels_tau,
-        stats: Statistics::of(&finite, report.options.histogram_bins as usize),
-        thresholds,
-    });
     evaluation.sample_labels = Some(visibility::labels(
         &counts,
         &evaluation.completeness_distances,
         min_views,
-        labels_tau,
+        section.labels_tau,
     ));
+    report.completeness_visible = Some(section);
     evaluation.sample_views = Some(counts);
-    Ok(())
 }
 
 fn add_track_error(
@@ -540,6 +484,7 @@ fn add_track_error(
     est: &Reconstruction,
     views: &[GtView],
     alignment: &AlignmentInput,
+    request: &EvalRequest,
     progress: &dyn Progress,
 ) -> Result<()> {
     if views.len() != gt_cameras.images.len() {
@@ -575,72 +520,22 @@ fn add_track_error(
         ));
         return Ok(());
     }
-    let mut errors = Vec::new();
-    let mut surface = Vec::new();
-    let mut sums = [0u64; 7];
-    let mut kept_points = 0u64;
-    for ((o, d), s) in outcomes
+    let kept: Vec<bool> = evaluation
+        .status
         .iter()
-        .zip(&evaluation.distances)
-        .zip(&evaluation.status)
-    {
-        if *s != PointStatus::Kept {
-            continue;
-        }
-        kept_points += 1;
-        sums[0] += u64::from(o.observations);
-        sums[1] += u64::from(o.used);
-        sums[2] += u64::from(o.trimmed);
-        for k in 0..4 {
-            sums[3 + k] += u64::from(o.rejected[k]);
-        }
-        if let Some(e) = o.true_error {
-            errors.push(e);
-            surface.push(*d);
-        }
-    }
-    let bins = report.options.histogram_bins as usize;
-    let n = errors.len().max(1) as f64;
-    let thresholds = report
-        .thresholds
-        .iter()
-        .map(|t| SlidingThresholdReport {
-            tau: t.tau,
-            sliding_fraction: errors
-                .iter()
-                .zip(&surface)
-                .filter(|(e, s)| **e - **s > t.tau)
-                .count() as f64
-                / n,
-            true_error_below: share_below(&errors, t.tau),
-        })
+        .map(|s| *s == PointStatus::Kept)
         .collect();
-    if errors.is_empty() {
-        report.warnings.push(
-            "no reconstructed point could be measured against its track (no image matched by name, or every observation fell on a silhouette)".into(),
-        );
-    }
-    let convention = serde_json::to_value(convention)
-        .ok()
-        .and_then(|v| v.as_str().map(str::to_string))
-        .unwrap_or_default();
-    report.track_error = Some(TrackErrorReport {
-        direction: "reconstruction_to_track_truth".into(),
-        observation_convention: convention,
-        min_observations: track_error::MIN_OBSERVATIONS as u64,
-        points: kept_points,
-        measured: errors.len() as u64,
-        observations: sums[0],
-        observations_used: sums[1],
-        observations_trimmed: sums[2],
-        rejected_unmatched_image: sums[3],
-        rejected_outside_image: sums[4],
-        rejected_background: sums[5],
-        rejected_discontinuity: sums[6],
-        stats: Statistics::of(&errors, bins),
-        surface_distance: Statistics::of(&surface, bins),
-        thresholds,
-    });
+    let taus: Vec<f64> = report.thresholds.iter().map(|t| t.tau).collect();
+    let (section, warning) = track_error::aggregate(
+        convention,
+        &outcomes,
+        &evaluation.distances,
+        &kept,
+        &taus,
+        request.eval.histogram_bins,
+    );
+    report.warnings.extend(warning);
+    report.track_error = Some(section);
     evaluation.track_errors = Some(outcomes.iter().map(|o| o.true_error).collect());
     Ok(())
 }
@@ -651,7 +546,8 @@ pub fn cameras_only(
     gt_cameras: &Reconstruction,
     recon: &Reconstruction,
     given: Option<Similarity>,
-    options: &RunOptions,
+    seed: u64,
+    pose: &PoseOptions,
 ) -> Result<(
     Similarity,
     crate::report::AlignmentReport,
@@ -667,7 +563,7 @@ pub fn cameras_only(
     let (t, report) = match given {
         Some(t) => (t, AlignmentInput::given(t).report),
         None => {
-            let opts = AlignOptions::default().with_seed(options.eval.seed);
+            let opts = AlignOptions::default().with_seed(seed);
             let (t, stage) = align::align_cameras(&pairs, &opts.cameras)?;
             let report = crate::report::AlignmentReport {
                 method: stage.method.clone(),
@@ -682,7 +578,7 @@ pub fn cameras_only(
             (t, report)
         }
     };
-    let cams = evaluate_cameras_matched(gt_cameras, recon, &matches, &t, &options.pose)?;
+    let cams = evaluate_cameras_matched(gt_cameras, recon, &matches, &t, pose)?;
     Ok((t, report, cams))
 }
 
@@ -775,28 +671,17 @@ mod tests {
             cloud_is_model_points: true,
         };
         let gt = GroundTruth::Mesh(uv_sphere(128, 64));
-        let options = RunOptions {
+        let options = EvalRequest {
             eval: EvalOptions {
                 samples: 20_000,
                 tau: vec![0.01, 0.05],
                 ..EvalOptions::default()
             },
-            align: AlignRequest::None,
-            ..RunOptions::default()
+            align: AlignRequest::none(),
+            ..EvalRequest::default()
         };
-        let prepared = PreparedGroundTruth::new(&gt, 20_000, 0, &NoProgress).unwrap();
-        let info = GroundTruthInfo::default();
-        let e = run_with_views(
-            &prepared,
-            &info,
-            &recon,
-            Some(&gt_cams),
-            Some(&views),
-            &[],
-            &options,
-            &NoProgress,
-        )
-        .unwrap();
+        let mut with_views = dataset(gt.clone(), Some(gt_cams.clone()), Some(views));
+        let e = run(&mut with_views, &recon, &options, &NoProgress).unwrap();
         let vis = e.report.completeness_visible.as_ref().unwrap();
         assert_eq!((vis.views, vis.min_views, vis.samples), (36, 2, 20_000));
         let expected = 3f64.sqrt() / 2.0;
@@ -820,16 +705,8 @@ mod tests {
         let json = e.report.to_json();
         assert!(json.contains("\"completeness_visible\"") && json.contains("\"track_error\""));
         // Without views, nothing changes in the report shape.
-        let plain = run(
-            &prepared,
-            &info,
-            &recon,
-            Some(&gt_cams),
-            &[],
-            &options,
-            &NoProgress,
-        )
-        .unwrap();
+        let mut plain_dataset = dataset(gt, Some(gt_cams), None);
+        let plain = run(&mut plain_dataset, &recon, &options, &NoProgress).unwrap();
         assert!(plain.report.completeness_visible.is_none() && plain.report.track_error.is_none());
         assert!(!plain.report.to_json().contains("completeness_visible"));
         // A cloud that is not the model's own points (a PLY with the model's cameras): the
@@ -838,17 +715,7 @@ mod tests {
             cloud_is_model_points: false,
             ..recon.clone()
         };
-        let e = run_with_views(
-            &prepared,
-            &info,
-            &ply_like,
-            Some(&gt_cams),
-            Some(&views),
-            &[],
-            &options,
-            &NoProgress,
-        )
-        .unwrap();
+        let e = run(&mut with_views, &ply_like, &options, &NoProgress).unwrap();
         assert!(e.report.track_error.is_none() && e.report.completeness_visible.is_some());
         assert!(
             e.report
@@ -947,6 +814,25 @@ mod tests {
         assert!(e.contains("no registered image and no 3D point"), "{e}");
     }
 
+    /// A dataset of `gt` with these cameras and views.
+    fn dataset(
+        gt: GroundTruth,
+        cameras: Option<Reconstruction>,
+        views: Option<Vec<GtView>>,
+    ) -> Dataset {
+        let loaded = crate::io::LoadedGroundTruth {
+            ground_truth: gt,
+            format: crate::io::Format::Ply,
+            warnings: vec![],
+        };
+        let mut d = Dataset::new("gt.ply", loaded);
+        d.set_cameras(cameras);
+        if let Some(v) = views {
+            d.set_views(v);
+        }
+        d
+    }
+
     fn err_of(r: Result<Evaluation>) -> String {
         match r {
             Ok(_) => panic!("expected an error"),
@@ -997,26 +883,17 @@ mod tests {
             cloud_is_model_points: true,
         };
         let gt = GroundTruth::Mesh(uv_sphere(32, 16));
-        let prepared = PreparedGroundTruth::new(&gt, 2_000, 0, &NoProgress).unwrap();
-        let info = GroundTruthInfo::default();
-        let options = |align: &str| RunOptions {
+        let mut with_cameras = dataset(gt.clone(), Some(gt_cams.clone()), None);
+        let mut without_cameras = dataset(gt, None, None);
+        let options = |align: &str| EvalRequest {
             eval: EvalOptions {
                 samples: 2_000,
                 ..EvalOptions::default()
             },
-            align: AlignRequest::Stages(align.into()),
-            ..RunOptions::default()
+            align: AlignRequest::mode(AlignMode::parse(align).unwrap()),
+            ..EvalRequest::default()
         };
-        let e = run(
-            &prepared,
-            &info,
-            &recon,
-            Some(&gt_cams),
-            &[],
-            &options("auto"),
-            &NoProgress,
-        )
-        .unwrap();
+        let e = run(&mut with_cameras, &recon, &options("auto"), &NoProgress).unwrap();
         assert!(e.report.cameras.is_none());
         let w = &e.report.warnings;
         assert!(
@@ -1036,11 +913,8 @@ mod tests {
         assert_eq!(e.report.alignment.method, "global+icp");
         for method in ["cameras", "cameras+icp"] {
             let err = err_of(run(
-                &prepared,
-                &info,
+                &mut with_cameras,
                 &recon,
-                Some(&gt_cams),
-                &[],
                 &options(method),
                 &NoProgress,
             ));
@@ -1051,11 +925,8 @@ mod tests {
         }
         // Without GT cameras, or with a bare cloud, `cameras` says what is missing.
         let err = err_of(run(
-            &prepared,
-            &info,
+            &mut without_cameras,
             &recon,
-            None,
-            &[],
             &options("cameras"),
             &NoProgress,
         ));
@@ -1065,11 +936,8 @@ mod tests {
             ..recon.clone()
         };
         let err = err_of(run(
-            &prepared,
-            &info,
+            &mut with_cameras,
             &bare,
-            Some(&gt_cams),
-            &[],
             &options("cameras"),
             &NoProgress,
         ));
@@ -1079,7 +947,8 @@ mod tests {
             &gt_cams,
             recon.model.as_ref().unwrap(),
             None,
-            &options("auto"),
+            0,
+            &PoseOptions::default(),
         )
         .unwrap_err()
         .to_string();

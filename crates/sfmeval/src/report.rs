@@ -1,12 +1,18 @@
-//! The `sfmeval.report/1` JSON report (see `schemas/report.schema.json`). Every front end writes
+//! The `sfmeval.report/2` JSON report (see `schemas/report.schema.json`). Every front end writes
 //! this shape; fields may be added, none renamed without a schema bump.
+//!
+//! `/2` differs from `/1` in three places: `options.align` is the requested mode (what ran is
+//! `alignment.method`), thresholds give `tau_percent_of_diagonal` in percent (was
+//! `tau_relative_to_diagonal`, a fraction), and `cameras` is a typed section whose keys come in
+//! declaration order like every other section.
 
 use serde::{Deserialize, Serialize};
 
+use crate::pose::CamerasReport;
 use crate::stats::Statistics;
 
 /// Schema id of reports.
-pub const REPORT_SCHEMA: &str = "sfmeval.report/1";
+pub const REPORT_SCHEMA: &str = "sfmeval.report/2";
 
 /// The whole report.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -30,7 +36,7 @@ pub struct Report {
     /// Precision / recall / F-score per threshold.
     pub thresholds: Vec<ThresholdReport>,
     /// Camera pose errors (null when no cameras were given).
-    pub cameras: Option<serde_json::Value>,
+    pub cameras: Option<CamerasSection>,
     /// Completeness over the part of the surface the ground-truth images see (only when depth
     /// maps were given).
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -113,9 +119,10 @@ pub struct ReportOptions {
     pub histogram_bins: u64,
     /// Thresholds given in ground-truth units.
     pub tau: Vec<f64>,
-    /// Thresholds given in percent of the ground-truth diagonal.
+    /// Thresholds given in percent of the ground-truth bounding-box diagonal.
     pub tau_percent_of_diagonal: Vec<f64>,
-    /// Requested alignment method.
+    /// The requested alignment mode (`auto`, `cameras+icp`, `given`, ...); what ran is
+    /// `alignment.method`.
     pub align: String,
     /// Images a surface sample must be seen in to count as visible (only with depth maps).
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -222,8 +229,8 @@ pub struct CompletenessReport {
 pub struct ThresholdReport {
     /// Threshold in ground-truth units.
     pub tau: f64,
-    /// Threshold as a fraction of the ground-truth diagonal.
-    pub tau_relative_to_diagonal: f64,
+    /// The same threshold in percent of the ground-truth bounding-box diagonal.
+    pub tau_percent_of_diagonal: f64,
     /// Share of kept reconstructed points closer than tau to the ground truth.
     pub precision: f64,
     /// Share of ground-truth samples closer than tau to the reconstruction.
@@ -320,6 +327,28 @@ pub struct SlidingThresholdReport {
     pub sliding_fraction: f64,
     /// Share of measured points whose true error is below tau (a track-based precision).
     pub true_error_below: f64,
+}
+
+/// The report's `cameras` section: the pose errors and the transform they were measured after.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct CamerasSection {
+    /// The pose errors.
+    #[serde(flatten)]
+    pub errors: CamerasReport,
+    /// The transform the poses were measured after.
+    pub alignment: CamerasAlignment,
+}
+
+/// Which transform the camera poses were measured after.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct CamerasAlignment {
+    /// `cameras` (the camera stage's transform, before any point refinement) or the
+    /// alignment method when no camera stage ran.
+    pub stage: String,
+    /// Row-major 4×4 mapping the reconstruction into the ground-truth frame.
+    pub gt_from_recon: [[f64; 4]; 4],
+    /// Its scale.
+    pub scale: f64,
 }
 
 impl Report {

@@ -23,9 +23,12 @@ use serde::Serialize;
 
 use crate::geometry::{Point3, norm, sub};
 use crate::gt_views::GtView;
+use crate::metrics::share_below;
 use crate::model::Reconstruction;
 use crate::parallel;
 use crate::progress::Progress;
+use crate::report::{SlidingThresholdReport, TrackErrorReport};
+use crate::stats::Statistics;
 use crate::transform::Similarity;
 
 /// Relative part of the depth spread that counts as a discontinuity.
@@ -52,6 +55,15 @@ pub enum ObservationConvention {
 }
 
 impl ObservationConvention {
+    /// The name written in reports.
+    pub fn name(self) -> &'static str {
+        match self {
+            ObservationConvention::ColmapPixels => "colmap_pixels",
+            ObservationConvention::CenteredYDown => "centered_y_down",
+            ObservationConvention::CenteredYUp => "centered_y_up",
+        }
+    }
+
     /// The convention of a model's observations, from its format (and, for NVM, the signs).
     pub fn of(rec: &Reconstruction) -> ObservationConvention {
         match rec.format {
@@ -85,14 +97,27 @@ impl ObservationConvention {
 /// Why an observation gave no back-projection.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Rejection {
-    /// Its image has no ground-truth image of the same name.
-    UnmatchedImage,
     /// Its pixel lies outside the ground-truth image.
     OutsideImage,
     /// A pixel of its neighbourhood is background (a silhouette).
     Background,
     /// Its neighbourhood straddles a depth step.
     Discontinuity,
+}
+
+impl Rejection {
+    /// The slot of [`PointOutcome::rejected`] counting observations whose image has no
+    /// ground-truth image of the same name (they never reach a back-projection).
+    const UNMATCHED_IMAGE: usize = 0;
+
+    /// This reason's slot of [`PointOutcome::rejected`].
+    fn slot(self) -> usize {
+        match self {
+            Rejection::OutsideImage => 1,
+            Rejection::Background => 2,
+            Rejection::Discontinuity => 3,
+        }
+    }
 }
 
 /// The ground-truth surface point seen through pixel position `(u, v)` of `view`, with the
@@ -142,6 +167,75 @@ pub fn robust_mean(points: &[Point3], footprint: f64) -> Option<(Point3, usize)>
         }
     }
     (kept > 0).then(|| (sum.map(|s| s / kept as f64), kept))
+}
+
+/// The report section of the measured points: `outcomes` of every model point (in point order),
+/// with their nearest-surface `distances` and crop `kept` flags in the same order, at the
+/// evaluation's thresholds `taus` (ground-truth units). Returns the section and a warning when
+/// no point could be measured.
+pub fn aggregate(
+    convention: ObservationConvention,
+    outcomes: &[PointOutcome],
+    distances: &[f64],
+    kept: &[bool],
+    taus: &[f64],
+    bins: usize,
+) -> (TrackErrorReport, Option<String>) {
+    let mut errors = Vec::new();
+    let mut surface = Vec::new();
+    let mut sums = [0u64; 7];
+    let mut kept_points = 0u64;
+    for ((o, d), k) in outcomes.iter().zip(distances).zip(kept) {
+        if !*k {
+            continue;
+        }
+        kept_points += 1;
+        sums[0] += u64::from(o.observations);
+        sums[1] += u64::from(o.used);
+        sums[2] += u64::from(o.trimmed);
+        for k in 0..4 {
+            sums[3 + k] += u64::from(o.rejected[k]);
+        }
+        if let Some(e) = o.true_error {
+            errors.push(e);
+            surface.push(*d);
+        }
+    }
+    let n = errors.len().max(1) as f64;
+    let thresholds = taus
+        .iter()
+        .map(|&tau| SlidingThresholdReport {
+            tau,
+            sliding_fraction: errors
+                .iter()
+                .zip(&surface)
+                .filter(|(e, s)| **e - **s > tau)
+                .count() as f64
+                / n,
+            true_error_below: share_below(&errors, tau),
+        })
+        .collect();
+    let warning = errors.is_empty().then(|| {
+        "no reconstructed point could be measured against its track (no image matched by name, or every observation fell on a silhouette)".to_string()
+    });
+    let report = TrackErrorReport {
+        direction: "reconstruction_to_track_truth".into(),
+        observation_convention: convention.name().into(),
+        min_observations: MIN_OBSERVATIONS as u64,
+        points: kept_points,
+        measured: errors.len() as u64,
+        observations: sums[0],
+        observations_used: sums[1],
+        observations_trimmed: sums[2],
+        rejected_unmatched_image: sums[3],
+        rejected_outside_image: sums[4],
+        rejected_background: sums[5],
+        rejected_discontinuity: sums[6],
+        stats: Statistics::of(&errors, bins),
+        surface_distance: Statistics::of(&surface, bins),
+        thresholds,
+    };
+    (report, warning)
 }
 
 /// The outcome for one 3D point.
@@ -198,7 +292,7 @@ pub fn track_errors(
                 .flatten()
                 .and_then(|v| views.get(v))
             else {
-                out.rejected[0] += 1;
+                out.rejected[Rejection::UNMATCHED_IMAGE] += 1;
                 continue;
             };
             let (u, v) = convention.to_pixels(xy, view);
@@ -208,13 +302,7 @@ pub fn track_errors(
                     footprints.push(f);
                 }
                 Err(r) => {
-                    let k = match r {
-                        Rejection::UnmatchedImage => 0,
-                        Rejection::OutsideImage => 1,
-                        Rejection::Background => 2,
-                        Rejection::Discontinuity => 3,
-                    };
-                    out.rejected[k] += 1;
+                    out.rejected[r.slot()] += 1;
                 }
             }
         }

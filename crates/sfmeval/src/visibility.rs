@@ -29,8 +29,11 @@ use serde::Serialize;
 
 use crate::geometry::Point3;
 use crate::gt_views::GtView;
+use crate::metrics::{f_score, share_below};
 use crate::parallel;
 use crate::progress::Progress;
+use crate::report::{ThresholdReport, VisibleCompletenessReport, VisibleThresholdReport};
+use crate::stats::Statistics;
 
 /// Relative part of the depth tolerance (of the sample's depth).
 pub const RELATIVE_TOLERANCE: f64 = 0.0005;
@@ -128,6 +131,66 @@ pub fn labels(
             }
         })
         .collect()
+}
+
+/// Completeness over the visible surface, from each completeness sample's view count and
+/// distance to the reconstruction: the samples seen in `min_views` or more of the `views`
+/// images, their distance statistics, and per threshold (`scores`: the evaluation's resolved
+/// thresholds with their precision and whole-surface recall) the recall and F-score over the
+/// visible samples. `surface_area` is the whole ground-truth area when the samples cover all of
+/// it (a mesh, no crop volume). Returns the report section and a warning when nothing is visible.
+pub fn visible_completeness(
+    view_counts: &[u32],
+    completeness_distances: &[f64],
+    scores: &[ThresholdReport],
+    min_views: u32,
+    views: usize,
+    surface_area: Option<f64>,
+    bins: usize,
+) -> (VisibleCompletenessReport, Option<String>) {
+    let visible: Vec<f64> = view_counts
+        .iter()
+        .zip(completeness_distances)
+        .filter(|(n, _)| **n >= min_views)
+        .map(|(_, d)| *d)
+        .collect();
+    let finite: Vec<f64> = visible.iter().copied().filter(|d| d.is_finite()).collect();
+    let samples = view_counts.len();
+    let fraction = if samples > 0 {
+        visible.len() as f64 / samples as f64
+    } else {
+        0.0
+    };
+    let thresholds = scores
+        .iter()
+        .map(|t| {
+            let recall_visible = share_below(&visible, t.tau);
+            VisibleThresholdReport {
+                tau: t.tau,
+                recall: t.recall,
+                recall_visible,
+                f_score_visible: f_score(t.precision, recall_visible),
+            }
+        })
+        .collect();
+    let warning = visible.is_empty().then(|| {
+        format!(
+            "no ground-truth sample is seen in {min_views} or more images: check that the depth maps belong to these cameras"
+        )
+    });
+    let report = VisibleCompletenessReport {
+        direction: "ground_truth_to_reconstruction".into(),
+        min_views: u64::from(min_views),
+        views: views as u64,
+        samples: samples as u64,
+        visible_samples: visible.len() as u64,
+        visible_fraction: fraction,
+        visible_area: surface_area.map(|a| fraction * a),
+        labels_tau: scores.first().map_or(0.0, |t| t.tau),
+        stats: Statistics::of(&finite, bins),
+        thresholds,
+    };
+    (report, warning)
 }
 
 // Test data only: platform maths is fine here (reports use libm, see clippy.toml).

@@ -2,9 +2,10 @@
 
 use std::collections::BTreeMap;
 
-use sfmeval::evaluate::{AlignmentInput, EvalOptions, InputInfo, PreparedGroundTruth, evaluate};
+use sfmeval::evaluate::{AlignmentInput, EvalOptions, InputInfo, evaluate};
 use sfmeval::geometry::{GroundTruth, PointCloud, TriangleMesh};
 use sfmeval::io;
+use sfmeval::prepared::PreparedGroundTruth;
 use sfmeval::progress::NoProgress;
 
 fn ply_cloud(n_declared: u64, body: &[u8]) -> Vec<u8> {

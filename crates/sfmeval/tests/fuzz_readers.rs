@@ -140,7 +140,7 @@ fn ground_truth_dispatch_survives_mutations() {
         run(name, 3000, |b| {
             if let Ok(gt) = io::read_ground_truth(name, b, &BTreeMap::new()) {
                 // Whatever is accepted must be usable.
-                let _ = sfmeval::evaluate::PreparedGroundTruth::new(
+                let _ = sfmeval::prepared::PreparedGroundTruth::new(
                     &gt.ground_truth,
                     100,
                     0,

@@ -150,7 +150,7 @@ impl Adapter for Colmap {
         let mut dirs: Vec<_> = entries.filter_map(|e| e.ok()).map(|e| e.path()).collect();
         dirs.sort();
         for d in dirs.into_iter().filter(|d| d.is_dir()) {
-            let files = crate::files::read_model_dir(&d)?;
+            let files = sfmeval_fs::read_input_files(&d)?;
             let Ok(rec) = sfmeval::model::read_model_files(&files) else {
                 continue;
             };

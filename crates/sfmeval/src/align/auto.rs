@@ -7,8 +7,8 @@ use super::{
     align_points, refine_icp,
 };
 use crate::error::{Error, Result};
-use crate::evaluate::PreparedGroundTruth;
 use crate::geometry::Point3;
+use crate::prepared::PreparedGroundTruth;
 use crate::report::{AlignmentReport, AlignmentStage};
 use crate::transform::Similarity;
 

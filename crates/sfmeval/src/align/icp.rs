@@ -25,8 +25,8 @@ use nalgebra::Vector3;
 
 use super::{is_finite, make_stage, subsample_indices, to_v};
 use crate::error::{Error, Result};
-use crate::evaluate::PreparedGroundTruth;
 use crate::geometry::{Aabb, Point3};
+use crate::prepared::PreparedGroundTruth;
 use crate::progress::NoProgress;
 use crate::report::AlignmentStage;
 use crate::transform::Similarity;

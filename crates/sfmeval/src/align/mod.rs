@@ -19,6 +19,7 @@ pub mod global;
 pub mod icp;
 pub mod points;
 pub mod ransac;
+pub mod request;
 pub mod umeyama;
 
 #[cfg(test)]
@@ -29,6 +30,7 @@ pub use global::{GlobalOptions, align_global};
 pub use icp::{IcpOptions, refine_icp};
 pub use points::{PointPair, align_points, parse_point_pairs};
 pub use ransac::{CameraPair, CamerasOptions, align_cameras};
+pub use request::{AlignMode, AlignRequest};
 pub use umeyama::{umeyama, umeyama_weighted};
 
 use nalgebra::{Matrix3, Vector3};

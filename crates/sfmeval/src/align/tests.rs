@@ -10,8 +10,8 @@ use rand::{Rng as _, SeedableRng as _};
 use rand_chacha::ChaCha8Rng;
 
 use super::*;
-use crate::evaluate::PreparedGroundTruth;
 use crate::geometry::{GroundTruth, TriangleMesh};
+use crate::prepared::PreparedGroundTruth;
 use crate::progress::NoProgress;
 use crate::sampling::sample_surface;
 

@@ -1,10 +1,9 @@
-//! Readers and writers, all on bytes. Format detection by name and content.
+//! Readers, all on bytes. Format detection by name and content.
 
 pub mod gltf;
 pub mod npy;
 pub mod obj;
 pub mod ply;
-pub mod write;
 
 use std::collections::BTreeMap;
 

@@ -19,6 +19,7 @@
 pub mod bundler;
 pub mod cameras_json;
 pub mod colmap;
+pub mod colmap_write;
 pub mod matching;
 pub mod nvm;
 pub mod openmvg;

@@ -14,7 +14,7 @@
 //! - Intrinsics: focal-length error (%) per estimated camera against the GT camera of its
 //!   images, scaled by the width ratio when the estimate used another resolution.
 
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 use crate::error::{Error, Result};
 use crate::geometry::{Point3, norm, sub};
@@ -48,7 +48,7 @@ impl Default for PoseOptions {
 }
 
 /// Relative accuracy at one threshold.
-#[derive(Debug, Clone, PartialEq, Serialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct RelativeAccuracy {
     /// Threshold in degrees.
     pub threshold_deg: f64,
@@ -61,7 +61,7 @@ pub struct RelativeAccuracy {
 }
 
 /// Relative-pose errors over all ground-truth image pairs.
-#[derive(Debug, Clone, PartialEq, Serialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct RelativePoseReport {
     /// Number of pairs evaluated.
     pub pairs: usize,
@@ -80,7 +80,7 @@ pub struct RelativePoseReport {
 }
 
 /// Focal-length error of one estimated camera.
-#[derive(Debug, Clone, PartialEq, Serialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct FocalError {
     /// Estimated camera id.
     pub camera_id: u64,
@@ -97,7 +97,7 @@ pub struct FocalError {
 }
 
 /// Pose error of one matched image.
-#[derive(Debug, Clone, PartialEq, Serialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct ImagePoseError {
     /// Ground-truth image name.
     pub name: String,
@@ -112,7 +112,7 @@ pub struct ImagePoseError {
 }
 
 /// The report's `cameras` section.
-#[derive(Debug, Clone, PartialEq, Serialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct CamerasReport {
     /// Ground-truth images.
     pub ground_truth: usize,

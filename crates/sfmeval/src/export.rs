@@ -104,3 +104,24 @@ pub fn samples_csv(eval: &Evaluation) -> String {
     }
     s
 }
+/// A binary little-endian PLY of points (float x y z, uchar red green blue; white without
+/// colours), as COLMAP writes its sparse clouds.
+pub fn points_ply(points: &[[f64; 3]], colors: Option<&[[u8; 3]]>) -> Vec<u8> {
+    let mut out = format!(
+        "ply\nformat binary_little_endian 1.0\ncomment written by sfmeval\nelement vertex {}\nproperty float x\nproperty float y\nproperty float z\nproperty uchar red\nproperty uchar green\nproperty uchar blue\nend_header\n",
+        points.len()
+    )
+    .into_bytes();
+    out.reserve(points.len() * 15);
+    for (i, p) in points.iter().enumerate() {
+        for v in p {
+            out.extend_from_slice(&(*v as f32).to_le_bytes());
+        }
+        let c = colors
+            .and_then(|c| c.get(i))
+            .copied()
+            .unwrap_or([255, 255, 255]);
+        out.extend_from_slice(&c);
+    }
+    out
+}

@@ -1,0 +1,117 @@
+//! The filesystem as a [`FileSource`]: paths are the operating system's, given as UTF-8 strings.
+
+use std::collections::BTreeMap;
+use std::path::Path;
+
+use anyhow::{Context as _, Result};
+use sfmeval::dataset::{Dataset, DatasetPaths};
+use sfmeval::files::FileSource;
+
+/// The real filesystem. Paths are read as given (relative to the working directory or
+/// absolute).
+#[derive(Debug, Clone, Copy, Default)]
+pub struct Disk;
+
+impl FileSource for Disk {
+    fn read(&self, path: &str) -> sfmeval::Result<Option<Vec<u8>>> {
+        let p = Path::new(path);
+        if !p.is_file() {
+            return Ok(None);
+        }
+        std::fs::read(p).map(Some).map_err(|e| sfmeval::Error::Io {
+            file: path.to_string(),
+            message: e.to_string(),
+        })
+    }
+
+    fn list(&self, dir: &str) -> sfmeval::Result<Vec<String>> {
+        let mut out = Vec::new();
+        if Path::new(dir).is_dir() {
+            walk(Path::new(dir), &mut out).map_err(|(p, e)| sfmeval::Error::Io {
+                file: p,
+                message: e.to_string(),
+            })?;
+        }
+        out.sort();
+        Ok(out)
+    }
+
+    fn is_dir(&self, path: &str) -> bool {
+        Path::new(path).is_dir()
+    }
+}
+
+fn walk(dir: &Path, out: &mut Vec<String>) -> Result<(), (String, std::io::Error)> {
+    let err = |e| (dir.display().to_string(), e);
+    for entry in std::fs::read_dir(dir).map_err(err)? {
+        let p = entry.map_err(err)?.path();
+        if p.is_dir() {
+            walk(&p, out)?;
+        } else if let Some(s) = p.to_str() {
+            out.push(s.to_string());
+        }
+    }
+    Ok(())
+}
+
+/// `path` as the UTF-8 string the core's sources take.
+pub fn path_str(path: &Path) -> Result<&str> {
+    path.to_str()
+        .with_context(|| format!("'{}' is not a UTF-8 path", path.display()))
+}
+
+/// Reads a whole file, naming it in the error.
+pub fn read(path: &Path) -> Result<Vec<u8>> {
+    std::fs::read(path).with_context(|| format!("cannot read '{}'", path.display()))
+}
+
+/// The file name without folders, for reports.
+pub fn name_of(path: &Path) -> String {
+    path.file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_else(|| path.display().to_string())
+}
+
+/// The files of one input (a model folder, or a file with the neighbours its format refers
+/// to), keyed as the core's readers expect ([`sfmeval::files::read_input_files`]).
+pub fn read_input_files(path: &Path) -> Result<BTreeMap<String, Vec<u8>>> {
+    Ok(sfmeval::files::read_input_files(&Disk, path_str(path)?)?)
+}
+
+/// Reads a ground truth and its optional parts from disk ([`Dataset::read`]).
+pub fn read_dataset(paths: &DatasetPaths) -> Result<Dataset> {
+    Ok(Dataset::read(&Disk, paths)?)
+}
+
+#[cfg(test)]
+#[allow(clippy::unwrap_used)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn lists_files_at_any_depth_and_reads_them() {
+        let dir = std::env::temp_dir().join(format!("sfmeval-fs-disk-{}", std::process::id()));
+        std::fs::create_dir_all(dir.join("sparse/0")).unwrap();
+        std::fs::write(dir.join("sparse/0/cameras.txt"), b"c").unwrap();
+        std::fs::write(dir.join("a.ply"), b"p").unwrap();
+        let root = path_str(&dir).unwrap();
+        let listed = Disk.list(root).unwrap();
+        assert_eq!(
+            listed,
+            [
+                format!("{root}/a.ply"),
+                format!("{root}/sparse/0/cameras.txt")
+            ]
+        );
+        assert!(Disk.is_dir(root));
+        assert_eq!(Disk.read(&listed[0]).unwrap(), Some(b"p".to_vec()));
+        assert_eq!(Disk.read(&format!("{root}/none")).unwrap(), None);
+        assert_eq!(Disk.read(root).unwrap(), None, "a folder is not a file");
+        let files = read_input_files(&dir).unwrap();
+        assert_eq!(
+            files.keys().collect::<Vec<_>>(),
+            ["a.ply", "sparse/0/cameras.txt"]
+        );
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+}

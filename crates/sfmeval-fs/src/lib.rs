@@ -1,0 +1,11 @@
+//! # sfmeval-fs
+//!
+//! The filesystem layer of the native front ends (the `sfmeval` CLI and `sfmeval-runner`): the
+//! core reads named bytes through [`sfmeval::files::FileSource`]; [`Disk`] is that source over
+//! the real filesystem, and [`write_atomic`] is the one way outputs reach the disk.
+
+mod disk;
+mod write;
+
+pub use disk::{Disk, name_of, path_str, read, read_dataset, read_input_files};
+pub use write::write_atomic;
