@@ -257,7 +257,7 @@ $('demo').onclick = async () => {
       $('transform').value = t;
       document.querySelector('input[name=align][value=given]').checked = true;
     } else {
-      document.querySelector(`input[name=align][value=${m.align ?? 'auto'}]`).checked = true;
+      document.querySelector(`input[name=align][value="${m.align ?? 'auto'}"]`).checked = true;
     }
     refreshPoints();
   } catch (e) { showError(e.message); }
@@ -362,7 +362,7 @@ $('pick').onclick = () => {
   state.picking = !state.picking;
   state.nextPick = 'recon';
   $('pick').textContent = state.picking ? 'done picking' : 'pick pairs';
-  if (state.picking) document.querySelector('input[name=align][value=points]').checked = true;
+  if (state.picking) document.querySelector('input[name=align][value="points+icp"]').checked = true;
   viewer.onPick = state.picking ? onPick : null;
   updatePairs();
   refreshPoints();
@@ -477,7 +477,7 @@ function options() {
   const method = alignMethod();
   o.align = method;
   if (method === 'given') o.transform = $('transform').value;
-  if (method === 'points') o.pairs = state.pairs.filter((p) => p.gt && p.recon);
+  if (method.startsWith('points')) o.pairs = state.pairs.filter((p) => p.gt && p.recon);
   return o;
 }
 
@@ -534,7 +534,7 @@ function showResults(r) {
   for (const t of rep.thresholds) {
     const v = vis && vis.get(t.tau);
     const s = sl && sl.get(t.tau);
-    h += `<tr><td>${g(t.tau)}</td><td>${(t.tau_relative_to_diagonal * 100).toFixed(3)}</td><td>${t.precision.toFixed(4)}</td><td>${t.recall.toFixed(4)}</td><td>${t.f_score.toFixed(4)}</td>`
+    h += `<tr><td>${g(t.tau)}</td><td>${t.tau_percent_of_diagonal.toFixed(3)}</td><td>${t.precision.toFixed(4)}</td><td>${t.recall.toFixed(4)}</td><td>${t.f_score.toFixed(4)}</td>`
       + `${vis ? `<td data-k="recall_visible">${v ? v.recall_visible.toFixed(4) : '—'}</td><td>${v ? v.f_score_visible.toFixed(4) : '—'}</td>` : ''}${sl ? `<td data-k="sliding">${s ? s.sliding_fraction.toFixed(4) : '—'}</td>` : ''}</tr>`;
   }
   h += '</table>';

@@ -106,7 +106,7 @@ try {
   };
   check('dom-numbers-equal-cli', JSON.stringify(dom) === JSON.stringify(want), `${JSON.stringify(dom)} vs ${JSON.stringify(want)}`);
   const thr = await page.$$eval('#thresholds tr', (rows) => rows.slice(1).map((r) => Array.from(r.children).map((c) => c.textContent)));
-  const wantThr = rep.thresholds.map((t) => [g(t.tau), (t.tau_relative_to_diagonal * 100).toFixed(3), t.precision.toFixed(4), t.recall.toFixed(4), t.f_score.toFixed(4)]);
+  const wantThr = rep.thresholds.map((t) => [g(t.tau), t.tau_percent_of_diagonal.toFixed(3), t.precision.toFixed(4), t.recall.toFixed(4), t.f_score.toFixed(4)]);
   check('dom-thresholds-equal-cli', JSON.stringify(thr) === JSON.stringify(wantThr), `${JSON.stringify(thr)} vs ${JSON.stringify(wantThr)}`);
   const stages = await page.$$eval('#stages tr', (r) => r.length);
   check('alignment-stages-shown', stages >= 3 && (await page.textContent('#r-align')) === rep.alignment.method, `${stages} rows`);
@@ -148,9 +148,9 @@ try {
     return out;
   }, rep.alignment.gt_from_recon);
   writeFileSync(join(out, 'pairs.json'), JSON.stringify({ pairs }));
-  await page.check('input[name=align][value=points]');
+  await page.check('input[name=align][value="points+icp"]');
   await evaluateAndWait();
-  const expectedPoints = cliReport(['--recon', demo('sparse.ply'), '--align', 'points', '--pairs', join(out, 'pairs.json')], 'cli-points.json');
+  const expectedPoints = cliReport(['--recon', demo('sparse.ply'), '--align', 'points+icp', '--pairs', join(out, 'pairs.json')], 'cli-points.json');
   const pagePoints = await downloadText('#dl-report');
   check('report-point-pairs-equals-cli', noteSame('report-point-pairs-equals-cli', pagePoints.text, expectedPoints), `page ${pagePoints.path} vs cli-points.json: ${firstDiff(pagePoints.text, expectedPoints)}`);
 

@@ -62,6 +62,22 @@ try {
 } catch (e) {
   check('npm-error', e instanceof Error && /ground truth 'broken.glb'/.test(e.message), String(e && e.message));
 }
+// The alignment modes: the core's single list, the package's type declarations, and a mode
+// that needs pairs refusing to run without them.
+const modes = sfmeval.alignModes();
+const dts = readFileSync(join(dir, 'node_modules/sfmeval', pkgJson.types), 'utf8');
+const declared = [...(dts.match(/type AlignModeName =([^;]+);/)?.[1] ?? '').matchAll(/'([^']+)'/g)].map((m) => m[1]);
+check('npm-align-modes-match-types', modes.length === 10 && JSON.stringify(modes.map((m) => m.name)) === JSON.stringify(declared),
+  `${JSON.stringify(modes.map((m) => m.name))} vs .d.ts ${JSON.stringify(declared)}`);
+check('npm-align-modes-needs', modes.filter((m) => m.needsPairs).map((m) => m.name).join() === 'points,points+icp'
+  && modes.filter((m) => m.needsCameras).map((m) => m.name).join() === 'cameras,cameras+icp'
+  && modes.filter((m) => m.needsTransform).map((m) => m.name).join() === 'given', JSON.stringify(modes));
+try {
+  sfmeval.evaluate({ gt: { 'ground_truth.glb': demo('ground_truth.glb') }, recon: { 'sparse.ply': demo('sparse.ply') }, options: { align: 'points+icp' } });
+  check('npm-align-needs-pairs', false, 'no error thrown');
+} catch (e) {
+  check('npm-align-needs-pairs', /'points\+icp' needs point pairs/.test(e.message), String(e && e.message));
+}
 const crop = sfmeval.parseCrop('{"schema":"sfmeval.crop/1","volume":{"kind":"sphere","center":[0,0,0],"radius":1}}');
 check('npm-crop-roundtrip', crop.volume.kind === 'sphere' && sfmeval.cropFile(crop).includes('"sfmeval.crop/1"'));
 console.log(`npm: demo evaluated in ${ms.toFixed(0)} ms in Node`);

@@ -49,20 +49,41 @@ export interface EvalOptions {
   min_views?: number;
   /** The crop, applied in the ground-truth frame after the transform. */
   crop?: Crop;
-  /** Alignment: default `given` with a transform, else `auto`. */
-  align?: 'auto' | 'cameras' | 'points' | 'global' | 'icp' | 'given' | 'none';
+  /** Alignment mode (see {@link alignModes}): default `given` with a transform, else `auto`. */
+  align?: AlignModeName;
   /** `gt_from_recon`: a row-major 4×4, 16 numbers, or the text of a transform file. */
   transform?: number[][] | number[] | string;
-  /** Point pairs for `align: 'points'`. */
+  /** Point pairs for `align: 'points'` and `'points+icp'`. */
   pairs?: PointPair[];
 }
+
+/** The alignment modes, as the CLI's `--align` takes them. */
+export type AlignModeName =
+  | 'auto' | 'cameras' | 'points' | 'global' | 'icp'
+  | 'cameras+icp' | 'points+icp' | 'global+icp' | 'given' | 'none';
+
+/** One alignment mode and what it needs. */
+export interface AlignModeInfo {
+  name: AlignModeName;
+  /** One line on what it does. */
+  description: string;
+  /** `given`: cannot run without `transform`. */
+  needsTransform: boolean;
+  /** `points`, `points+icp`: cannot run without `pairs`. */
+  needsPairs: boolean;
+  /** `cameras`, `cameras+icp`: cannot run without cameras on both sides. */
+  needsCameras: boolean;
+}
+
+/** Every alignment mode, in menu order, from the core's single list. */
+export function alignModes(): AlignModeInfo[];
 
 /** Progress callback: stage label, units done, units total. */
 export type ProgressCallback = (stage: string, done: number, total: number) => void;
 
 /** The result of {@link evaluate}. */
 export interface EvaluationResult {
-  /** The `sfmeval.report/1` JSON text, byte for byte what `sfmeval eval --report` writes. */
+  /** The `sfmeval.report/2` JSON text, byte for byte what `sfmeval eval --report` writes. */
   readonly reportJson: string;
   /** The parsed report. */
   readonly report: any;

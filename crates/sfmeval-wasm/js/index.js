@@ -119,8 +119,8 @@ function wrap(e) {
  * needs `gtCameras`) maps the dataset's `depth/<image stem>.npy` file names to bytes and adds
  * visibility-aware completeness and the track-based error, as `sfmeval eval --depth`.
  * `options` uses the report's option names: `tau`, `tau_percent_of_diagonal`, `samples`, `seed`,
- * `signed`, `histogram_bins`, `crop` (a crop-file object), plus `align` (`auto`, `cameras`,
- * `points`, `global`, `icp`, `given`, `none`), `transform` (4×4 or transform-file text) and
+ * `signed`, `histogram_bins`, `crop` (a crop-file object), plus `align` (a mode name of
+ * `alignModes()`), `transform` (4×4 or transform-file text) and
  * `pairs` (`[{recon: [x,y,z], gt: [x,y,z]}, ...]`).
  * `onProgress(stage, done, total)` is called during the long steps.
  */
@@ -140,6 +140,12 @@ export function evaluate({ gt, recon, gtCameras, depth, options, onProgress } = 
 }
 
 /** Parses and validates the text of a crop file (`sfmeval.crop/1`). */
+/** Every alignment mode with what it needs (`[{name, description, needsTransform, needsPairs,
+ * needsCameras}]`), from the core's single list. */
+export function alignModes() {
+  return wasm.alignModes();
+}
+
 export function parseCrop(text) {
   return wasm.parseCrop(text);
 }
