@@ -9,13 +9,13 @@
 //! new report field is one more line in [`DEFAULT_METRICS`] (or `--metric PATH`).
 
 use std::fmt::Write as _;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::time::Instant;
 
 use anyhow::{Context, Result, bail};
-use clap::Args;
 use serde_json::Value as Json;
 
+use crate::args::SweepArgs;
 use crate::chart::{self, Chart, Series, Value};
 use crate::dataset::Dataset;
 use crate::exec::shell_quote;
@@ -66,53 +66,6 @@ pub const VISIBILITY_METRICS: &[(&str, &str)] = &[
         "sliding points (true error − surface distance > τ)",
     ),
 ];
-
-/// Arguments of `sweep`.
-#[derive(Args)]
-pub struct SweepArgs {
-    /// The condition and its values, NAME=V1,V2,...: views, baseline, focal, texture,
-    /// lighting, noise, blur (see the README for what each changes).
-    #[arg(long, value_name = "NAME=V1,V2,...")]
-    factor: String,
-    /// Generator preset of the base dataset (default `small` when no --dataset-config).
-    #[arg(long)]
-    dataset_preset: Option<String>,
-    /// Generator config file (TOML/JSON) of the base dataset.
-    #[arg(long)]
-    dataset_config: Option<PathBuf>,
-    /// Fixed generator overrides `section.key=value` for every variant (repeatable).
-    #[arg(long = "set")]
-    sets: Vec<String>,
-    /// Pipelines: names or specs KIND[:key=value,...] separated by commas or `;`, or `all`.
-    #[arg(long, num_args = 1.., required = true)]
-    pipelines: Vec<String>,
-    /// Output folder (datasets/, runs/, table/, charts/, sweep.csv, sweep.html, sweep.json).
-    #[arg(long, default_value = "sweep")]
-    out: PathBuf,
-    /// Also render depth maps, so every report gains completeness over the visible surface and
-    /// the track-based error, and plot them (rendering takes longer).
-    #[arg(long)]
-    visibility: bool,
-    /// Extra metric to plot: a JSON path such as `report.completeness.p90` or
-    /// `report.thresholds[*].recall`, optionally `=LABEL` (repeatable).
-    #[arg(long = "metric", value_name = "PATH[=LABEL]")]
-    metrics: Vec<String>,
-    /// The blender_scripts folder (default: found from the binary or the working directory).
-    #[arg(long)]
-    blender_scripts: Option<PathBuf>,
-    /// Redo everything (default: reuse rendered variants and finished runs).
-    #[arg(long)]
-    fresh: bool,
-    /// Redo runs that failed or timed out (finished ones are reused).
-    #[arg(long)]
-    retry_failed: bool,
-    #[command(flatten)]
-    exec: crate::ExecArgs,
-    #[command(flatten)]
-    tools: crate::ToolArgs,
-    #[command(flatten)]
-    eval: crate::EvalArgs,
-}
 
 /// The conditions a sweep can vary.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -762,13 +715,13 @@ pub fn sweep(a: &SweepArgs) -> Result<()> {
     let (factor, values) = parse_factor(&a.factor)?;
     a.exec.check()?;
     // absolute paths: the generator runs in the datasets folder
-    let python = crate::find_python(a.tools.python.as_deref())?;
+    let python = crate::env::find_python(a.tools.python.as_deref())?;
     let scripts = std::path::absolute(crate::table1::find_blender_scripts(
         a.blender_scripts.as_deref(),
     )?)?;
     let customs = crate::pipelines::parse_customs(&a.tools.customs)?;
     let specs = crate::pipelines::parse_list(&a.pipelines, &customs)?;
-    let eval = crate::eval_options(&a.eval)?;
+    let eval = a.eval.eval_options()?;
     // base: preset/config, no masks, depth maps only with --visibility, the user's --set
     let mut base_args: Vec<String> = Vec::new();
     match (&a.dataset_preset, &a.dataset_config) {
@@ -866,7 +819,7 @@ pub fn sweep(a: &SweepArgs) -> Result<()> {
     let table = out.join("table");
     let t_runs = Instant::now();
     if !datasets.is_empty() {
-        let env = crate::make_env(&a.tools, &runs)?;
+        let env = crate::env::make_env(&a.tools, &runs)?;
         let opts = a.exec.batch_options(&runs, !a.fresh, a.retry_failed)?;
         let sum = crate::run::run_batch(&datasets, &specs, &customs, &env, &opts)?;
         eprintln!(

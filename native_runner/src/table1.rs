@@ -9,7 +9,7 @@ use std::time::{Duration, Instant};
 
 use anyhow::{Context, Result, bail};
 
-use crate::Table1Args;
+use crate::args::Table1Args;
 use crate::dataset::Dataset;
 use crate::exec::{Step, run_step};
 use crate::files::{partial_name, replace_dir, write_atomic};
@@ -137,7 +137,7 @@ pub fn render_dataset(
 pub fn table1(a: &Table1Args) -> Result<()> {
     let t0 = Instant::now();
     a.exec.check()?;
-    let python = crate::find_python(a.tools.python.as_deref())?;
+    let python = crate::env::find_python(a.tools.python.as_deref())?;
     let scripts = std::path::absolute(find_blender_scripts(a.blender_scripts.as_deref())?)?;
     let presets: Vec<String> = if a.presets.is_empty() {
         PRESETS.iter().map(|s| s.to_string()).collect()
@@ -175,7 +175,7 @@ pub fn table1(a: &Table1Args) -> Result<()> {
     timing.insert("render_seconds".into(), gen_times.into());
     let customs = crate::pipelines::parse_customs(&a.tools.customs)?;
     let specs = crate::pipelines::parse_list(&a.pipelines, &customs)?;
-    let env = crate::make_env(&a.tools, &runs)?;
+    let env = crate::env::make_env(&a.tools, &runs)?;
     let opts = a.exec.batch_options(&runs, !a.fresh, false)?;
     let t_runs = Instant::now();
     let summary = crate::run::run_batch(&datasets, &specs, &customs, &env, &opts)?;
@@ -185,7 +185,7 @@ pub fn table1(a: &Table1Args) -> Result<()> {
         runs: vec![runs.clone()],
         out: table.clone(),
         datasets: Vec::new(),
-        eval: crate::eval_options(&a.eval)?,
+        eval: a.eval.eval_options()?,
         align: a.eval.align.clone(),
         verbose: false,
     })?;
