@@ -18,6 +18,7 @@ mod dataset;
 mod env;
 mod exec;
 mod files;
+mod generator;
 mod html;
 mod pipelines;
 mod report;

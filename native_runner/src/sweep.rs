@@ -9,7 +9,6 @@
 //! new report field is one more line in [`DEFAULT_METRICS`] (or `--metric PATH`).
 
 use std::fmt::Write as _;
-use std::path::Path;
 use std::time::Instant;
 
 use anyhow::{Context, Result, bail};
@@ -691,24 +690,6 @@ pub fn page(
     h
 }
 
-/// The resolved base config: `generate.py [--preset P] [--config F] --set ... --print-config`.
-fn resolve_base(python: &Path, scripts: &Path, base_args: &[String]) -> Result<Json> {
-    let mut cmd = std::process::Command::new(python);
-    cmd.arg(scripts.join("generate.py"))
-        .args(base_args)
-        .arg("--print-config");
-    let out = cmd
-        .output()
-        .with_context(|| format!("running {}", python.display()))?;
-    if !out.status.success() {
-        bail!(
-            "the generator rejected the base config: {}",
-            String::from_utf8_lossy(&out.stderr).trim()
-        );
-    }
-    serde_json::from_slice(&out.stdout).context("reading the generator's --print-config output")
-}
-
 /// The whole sweep.
 pub fn sweep(a: &SweepArgs) -> Result<()> {
     let t0 = Instant::now();
@@ -716,7 +697,7 @@ pub fn sweep(a: &SweepArgs) -> Result<()> {
     a.exec.check()?;
     // absolute paths: the generator runs in the datasets folder
     let python = crate::env::find_python(a.tools.python.as_deref())?;
-    let scripts = std::path::absolute(crate::table1::find_blender_scripts(
+    let scripts = std::path::absolute(crate::generator::find_blender_scripts(
         a.blender_scripts.as_deref(),
     )?)?;
     let customs = crate::pipelines::parse_customs(&a.tools.customs)?;
@@ -748,7 +729,7 @@ pub fn sweep(a: &SweepArgs) -> Result<()> {
     {
         base_args.extend(["--set".into(), s]);
     }
-    let base = resolve_base(&python, &scripts, &base_args)?;
+    let base = crate::generator::resolved_config(&python, &scripts, &base_args)?;
     // every value's overrides first: a bad value stops the sweep before anything is rendered
     let mut planned: Vec<(String, f64, String, Vec<String>)> = Vec::new();
     for (text, x) in &values {
@@ -786,7 +767,7 @@ pub fn sweep(a: &SweepArgs) -> Result<()> {
             seconds: None,
         };
         if !complete || a.fresh {
-            match crate::table1::render_dataset("sweep", &python, &scripts, &args, &dest) {
+            match crate::generator::render_dataset("sweep", &python, &scripts, &args, &dest) {
                 Ok(secs) => {
                     write_atomic(&stamp, stamp_json.as_bytes())?;
                     v.status = "rendered".into();
