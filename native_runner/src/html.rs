@@ -3,12 +3,11 @@
 
 use std::fmt::Write as _;
 
+use crate::chart::bar::{self, BarChart};
+use crate::chart::cdf::{self, Curve};
+use crate::chart::palette::color;
+use crate::chart::value::Value;
 use crate::report::{Row, table1_cell, wide_for_html};
-
-const COLORS: [&str; 10] = [
-    "#1f77b4", "#ff7f0e", "#2ca02c", "#d62728", "#9467bd", "#8c564b", "#e377c2", "#7f7f7f",
-    "#bcbd22", "#17becf",
-];
 
 /// HTML-escapes text.
 pub fn esc(s: &str) -> String {
@@ -16,10 +15,6 @@ pub fn esc(s: &str) -> String {
         .replace('<', "&lt;")
         .replace('>', "&gt;")
         .replace('"', "&quot;")
-}
-
-fn color(i: usize) -> &'static str {
-    COLORS[i % COLORS.len()]
 }
 
 fn find<'a>(rows: &'a [Row], d: &str, p: &str) -> Option<&'a Row> {
@@ -89,7 +84,7 @@ pub fn page(rows: &[Row], datasets: &[String], pipes: &[String]) -> String {
         }),
     ];
     for (title, f) in metrics {
-        h.push_str(&bar_chart(title, rows, datasets, pipes, f));
+        h.push_str(&bar::svg(&bar_chart(title, rows, datasets, pipes, f)));
     }
     for d in datasets {
         h.push_str(&cdf_chart(d, rows, pipes));
@@ -137,168 +132,51 @@ pub fn page(rows: &[Row], datasets: &[String], pipes: &[String]) -> String {
     h
 }
 
-fn nice_max(v: f64) -> f64 {
-    if !(v > 0.0) {
-        return 1.0;
-    }
-    let e = 10f64.powf(v.log10().floor());
-    for m in [1.0, 2.0, 2.5, 5.0, 10.0] {
-        if v <= m * e {
-            return m * e;
-        }
-    }
-    10.0 * e
-}
-
-fn fmt_tick(v: f64) -> String {
-    if v == 0.0 {
-        "0".into()
-    } else if v.abs() >= 100.0 {
-        format!("{v:.0}")
-    } else if v.abs() >= 1.0 {
-        format!("{v:.1}")
-    } else {
-        format!("{v:.2e}")
-    }
-}
-
+/// The bar chart of one metric: a group per dataset, a bar per pipeline; a run without the
+/// value that did not succeed is marked with its status.
 fn bar_chart(
     title: &str,
     rows: &[Row],
     datasets: &[String],
     pipes: &[String],
     f: fn(&Row) -> Option<f64>,
-) -> String {
-    let (w, hgt, left, bottom, top) = (460.0, 260.0, 60.0, 40.0, 28.0);
-    let plot_w = w - left - 10.0;
-    let plot_h = hgt - bottom - top;
-    let max = rows
+) -> BarChart {
+    let values = datasets
         .iter()
-        .filter_map(f)
-        .filter(|v| v.is_finite())
-        .fold(0.0f64, f64::max);
-    let ymax = nice_max(max);
-    let mut s = format!(
-        "<svg class=\"bar\" width=\"{w}\" height=\"{hgt}\" viewBox=\"0 0 {w} {hgt}\" role=\"img\"><title>{t}</title><text x=\"{x}\" y=\"18\" font-size=\"13\" text-anchor=\"middle\">{t}</text>",
-        t = esc(title),
-        x = w / 2.0
-    );
-    for k in 0..=4 {
-        let v = ymax * k as f64 / 4.0;
-        let y = top + plot_h - plot_h * k as f64 / 4.0;
-        let _ = write!(
-            s,
-            "<line x1=\"{left}\" x2=\"{}\" y1=\"{y:.1}\" y2=\"{y:.1}\" stroke=\"#eee\"/><text x=\"{}\" y=\"{:.1}\" font-size=\"10\" text-anchor=\"end\">{}</text>",
-            left + plot_w,
-            left - 4.0,
-            y + 3.0,
-            fmt_tick(v)
-        );
+        .map(|d| {
+            pipes
+                .iter()
+                .map(|p| match find(rows, d, p) {
+                    None => Value::Missing("no run".into()),
+                    Some(r) => match f(r).filter(|v| v.is_finite()) {
+                        Some(v) => Value::Ok(v),
+                        None if r.status != "ok" => Value::Failed(r.status.clone()),
+                        None => Value::Missing("no value".into()),
+                    },
+                })
+                .collect()
+        })
+        .collect();
+    BarChart {
+        title: title.to_string(),
+        groups: datasets.to_vec(),
+        series: pipes.to_vec(),
+        values,
     }
-    let group = plot_w / datasets.len().max(1) as f64;
-    let bar = (group * 0.8 / pipes.len().max(1) as f64).max(1.0);
-    for (di, d) in datasets.iter().enumerate() {
-        let gx = left + group * di as f64 + group * 0.1;
-        for (pi, p) in pipes.iter().enumerate() {
-            let x = gx + bar * pi as f64;
-            let Some(r) = find(rows, d, p) else { continue };
-            match f(r).filter(|v| v.is_finite()) {
-                Some(v) => {
-                    let bh = plot_h * (v / ymax).clamp(0.0, 1.0);
-                    let _ = write!(
-                        s,
-                        "<rect x=\"{x:.1}\" y=\"{:.1}\" width=\"{:.1}\" height=\"{bh:.1}\" fill=\"{}\"><title>{}: {} = {v}</title></rect>",
-                        top + plot_h - bh,
-                        (bar - 1.0).max(0.5),
-                        color(pi),
-                        esc(d),
-                        esc(p)
-                    );
-                }
-                None if r.status != "ok" => {
-                    let _ = write!(
-                        s,
-                        "<text x=\"{:.1}\" y=\"{:.1}\" font-size=\"11\" fill=\"#a00\" text-anchor=\"middle\">×<title>{}: {} {}</title></text>",
-                        x + bar / 2.0,
-                        top + plot_h - 3.0,
-                        esc(d),
-                        esc(p),
-                        esc(&r.status)
-                    );
-                }
-                None => {}
-            }
-        }
-        let _ = write!(
-            s,
-            "<text x=\"{:.1}\" y=\"{:.1}\" font-size=\"11\" text-anchor=\"middle\">{}</text>",
-            gx + group * 0.4,
-            top + plot_h + 16.0,
-            esc(d)
-        );
-    }
-    s.push_str("</svg>\n");
-    s
 }
 
+/// The cumulative error curves of one dataset, a curve per pipeline with an evaluation.
 fn cdf_chart(dataset: &str, rows: &[Row], pipes: &[String]) -> String {
-    let (w, hgt, left, bottom, top) = (460.0, 260.0, 50.0, 40.0, 28.0);
-    let plot_w = w - left - 30.0;
-    let plot_h = hgt - bottom - top;
-    let series: Vec<(usize, &Row)> = pipes
+    let curves: Vec<Curve> = pipes
         .iter()
         .enumerate()
         .filter_map(|(i, p)| {
-            find(rows, dataset, p)
-                .filter(|r| !r.cdf.is_empty())
-                .map(|r| (i, r))
+            find(rows, dataset, p).map(|r| Curve {
+                name: &r.pipeline,
+                color: i,
+                points: &r.cdf,
+            })
         })
         .collect();
-    // The x range covers the 95th percentile of the worst run, so the curves are readable.
-    let xmax = series
-        .iter()
-        .filter_map(|(_, r)| r.cdf.iter().find(|(_, y)| *y >= 0.95).map(|(x, _)| *x))
-        .fold(0.0f64, f64::max);
-    let xmax = nice_max(xmax);
-    let mut s = format!(
-        "<svg class=\"cdf\" width=\"{w}\" height=\"{hgt}\" viewBox=\"0 0 {w} {hgt}\" role=\"img\"><title>cumulative error {d}</title><text x=\"{x}\" y=\"18\" font-size=\"13\" text-anchor=\"middle\">{d}: share of points within distance (m)</text>",
-        d = esc(dataset),
-        x = w / 2.0
-    );
-    for k in 0..=4 {
-        let y = top + plot_h - plot_h * k as f64 / 4.0;
-        let xv = left + plot_w * k as f64 / 4.0;
-        let _ = write!(
-            s,
-            "<line x1=\"{left}\" x2=\"{}\" y1=\"{y:.1}\" y2=\"{y:.1}\" stroke=\"#eee\"/><text x=\"{}\" y=\"{:.1}\" font-size=\"10\" text-anchor=\"end\">{}%</text><text x=\"{xv:.1}\" y=\"{:.1}\" font-size=\"10\" text-anchor=\"middle\">{}</text>",
-            left + plot_w,
-            left - 4.0,
-            y + 3.0,
-            25 * k,
-            top + plot_h + 14.0,
-            fmt_tick(xmax * k as f64 / 4.0)
-        );
-    }
-    for (i, r) in series {
-        let pts: Vec<String> = r
-            .cdf
-            .iter()
-            .map(|(x, y)| {
-                format!(
-                    "{:.1},{:.1}",
-                    left + plot_w * (x / xmax).clamp(0.0, 1.0),
-                    top + plot_h - plot_h * y.clamp(0.0, 1.0)
-                )
-            })
-            .collect();
-        let _ = write!(
-            s,
-            "<polyline fill=\"none\" stroke=\"{}\" stroke-width=\"1.6\" points=\"{}\"><title>{}</title></polyline>",
-            color(i),
-            pts.join(" "),
-            esc(&r.pipeline)
-        );
-    }
-    s.push_str("</svg>\n");
-    s
+    cdf::svg(dataset, &curves)
 }

@@ -15,7 +15,8 @@ use anyhow::{Context, Result, bail};
 use serde_json::Value as Json;
 
 use crate::args::SweepArgs;
-use crate::chart::{self, Chart, Series, Value};
+use crate::chart::line::{self, Chart, Series};
+use crate::chart::value::Value;
 use crate::dataset::Dataset;
 use crate::exec::shell_quote;
 use crate::files::write_atomic;
@@ -683,7 +684,7 @@ pub fn page(
             h,
             "<figure id=\"{}\">{}</figure>",
             esc(f),
-            chart::svg_inline(c)
+            line::svg_inline(c)
         );
     }
     h.push_str("</div>\n</body></html>\n");
@@ -871,7 +872,7 @@ pub fn sweep(a: &SweepArgs) -> Result<()> {
     let mut files = Vec::new();
     for (c, m) in charts.iter().zip(&metrics) {
         let f = format!("charts/{}.svg", metric_file(&m.path));
-        write_atomic(&out.join(&f), chart::svg(c).as_bytes())?;
+        write_atomic(&out.join(&f), line::svg(c).as_bytes())?;
         files.push(f);
     }
     let command = std::env::args()
