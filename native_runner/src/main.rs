@@ -22,9 +22,11 @@ mod generator;
 mod html;
 mod pipelines;
 mod report;
+mod row;
 mod run;
 mod setup;
 mod sweep;
+mod table;
 mod table1;
 
 use std::process::ExitCode;

@@ -21,7 +21,7 @@ use crate::dataset::Dataset;
 use crate::exec::shell_quote;
 use crate::files::write_atomic;
 use crate::html::esc;
-use crate::report::Row;
+use crate::row::Row;
 
 /// Metrics plotted by default: `(path, label)`. `[*]` expands to one metric per element
 /// (the report's thresholds). Paths start at `report.` (the run's `sfmeval.report/1`) or `run.`
