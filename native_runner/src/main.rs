@@ -14,6 +14,7 @@ mod adapters;
 mod args;
 mod chart;
 mod commands;
+mod csv;
 mod dataset;
 mod env;
 mod exec;
@@ -28,6 +29,7 @@ mod setup;
 mod sweep;
 mod table;
 mod table1;
+mod text;
 
 use std::process::ExitCode;
 

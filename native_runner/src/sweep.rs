@@ -17,11 +17,13 @@ use serde_json::Value as Json;
 use crate::args::SweepArgs;
 use crate::chart::line::{self, Chart, Series};
 use crate::chart::value::Value;
+use crate::csv::CsvWriter;
 use crate::dataset::Dataset;
 use crate::exec::shell_quote;
 use crate::files::write_atomic;
-use crate::html::esc;
+use crate::html::{self, esc};
 use crate::row::Row;
+use crate::text::one_line;
 
 /// Metrics plotted by default: `(path, label)`. `[*]` expands to one metric per element
 /// (the report's thresholds). Paths start at `report.` (the run's `sfmeval.report/1`) or `run.`
@@ -514,43 +516,33 @@ fn run_doc(row: &Row) -> Json {
     v
 }
 
-fn csv_field(s: &str) -> String {
-    if s.contains([',', '"', '\n']) {
-        format!("\"{}\"", s.replace('"', "\"\""))
-    } else {
-        s.to_string()
-    }
-}
-
 /// `sweep.csv`: one row per (value, pipeline): factor, value, dataset, pipeline, status,
 /// reason, then every metric (empty where there is none).
 pub fn csv(factor: Factor, cells: &[Cell], metrics: &[Metric]) -> String {
-    let mut s = String::from("factor,value,dataset,pipeline,status,reason");
-    for m in metrics {
-        s.push(',');
-        s.push_str(&csv_field(&m.path));
-    }
-    s.push('\n');
+    let mut w = CsvWriter::new();
+    let mut header: Vec<String> = ["factor", "value", "dataset", "pipeline", "status", "reason"]
+        .iter()
+        .map(|s| s.to_string())
+        .collect();
+    header.extend(metrics.iter().map(|m| m.path.clone()));
+    w.record(&header);
     for c in cells {
-        let _ = write!(
-            s,
-            "{},{},{},{},{},{}",
-            factor.name(),
-            csv_field(&c.value.0),
-            csv_field(&c.dataset),
-            csv_field(&c.pipeline),
-            csv_field(&c.status),
-            csv_field(&c.reason.clone().unwrap_or_default().replace('\n', " "))
-        );
-        for m in metrics {
-            s.push(',');
-            if let Some(x) = lookup(&c.doc, &m.path) {
-                let _ = write!(s, "{x}");
-            }
-        }
-        s.push('\n');
+        let mut record = vec![
+            factor.name().to_string(),
+            c.value.0.clone(),
+            c.dataset.clone(),
+            c.pipeline.clone(),
+            c.status.clone(),
+            c.reason.clone().unwrap_or_default().replace('\n', " "),
+        ];
+        record.extend(metrics.iter().map(|m| {
+            lookup(&c.doc, &m.path)
+                .map(|x| format!("{x}"))
+                .unwrap_or_default()
+        }));
+        w.record(&record);
     }
-    s
+    w.finish()
 }
 
 /// One chart per metric, one series per pipeline (in `pipes` order).
@@ -583,7 +575,7 @@ pub fn charts(
                                     c.status,
                                     c.reason
                                         .as_deref()
-                                        .map(|r| format!(": {}", short(r)))
+                                        .map(|r| format!(": {}", one_line(r, 160)))
                                         .unwrap_or_default()
                                 )),
                                 Some(c) => {
@@ -597,15 +589,6 @@ pub fn charts(
                 .collect(),
         })
         .collect()
-}
-
-fn short(s: &str) -> String {
-    let one = s.replace('\n', " ");
-    if one.chars().count() > 160 {
-        format!("{}…", one.chars().take(160).collect::<String>())
-    } else {
-        one
-    }
 }
 
 /// A file-name-safe stem for a metric path.
@@ -640,7 +623,11 @@ pub struct Variant {
     pub seconds: Option<f64>,
 }
 
-/// The HTML page (self-contained: inline SVG, no scripts, nothing loaded).
+/// The page's own style, after the shell's.
+const STYLE: &str = "th,td{border:1px solid #ccc;padding:3px 7px;text-align:left}th{background:#f3f3f3}td.failed{color:#a00;background:#fff3f3}\n.charts{display:flex;flex-wrap:wrap;gap:1em}.charts figure{margin:0}svg{border:1px solid #ddd}code{background:#f5f5f5;padding:1px 3px}";
+
+/// `sweep.html` (self-contained: inline SVG, no scripts, nothing loaded): the factor, the
+/// command, the variants table and every chart (`files`: their ids, the chart files' names).
 pub fn page(
     factor: Factor,
     command: &str,
@@ -649,9 +636,7 @@ pub fn page(
     charts: &[Chart],
     files: &[String],
 ) -> String {
-    let mut h = String::from(
-        "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\"><title>sfmeval sweep</title>\n<style>\nbody{font-family:system-ui,sans-serif;margin:1.5em;color:#222}table{border-collapse:collapse;margin:1em 0;font-size:13px}\nth,td{border:1px solid #ccc;padding:3px 7px;text-align:left}th{background:#f3f3f3}td.failed{color:#a00;background:#fff3f3}\n.charts{display:flex;flex-wrap:wrap;gap:1em}.charts figure{margin:0}svg{border:1px solid #ddd}code{background:#f5f5f5;padding:1px 3px}\n</style></head><body>\n",
-    );
+    let mut h = String::new();
     let _ = writeln!(
         h,
         "<h1>Where does each pipeline break? Sweep over <code>{}</code></h1>\n<p><b>{}</b>: {}.</p>\n<p>Command: <code>{}</code></p>\n<p>Pipelines: {}. Each chart plots one metric against the factor, one line per pipeline; a red × in the band under the axis is a run that failed or was not run (hover for the reason), a grey ○ a successful run without that metric. Metrics are read from each run's <code>sfmeval.report/1</code> (<code>report.…</code>) or its row in <code>table/runs.csv</code> (<code>run.…</code>); every value is in <code>sweep.csv</code>.</p>",
@@ -672,7 +657,7 @@ pub fn page(
             esc(&v.overrides.join(" ")),
             if failed { " class=\"failed\"" } else { "" },
             esc(&match (&v.status[..], v.seconds, &v.reason) {
-                ("failed", _, Some(r)) => format!("failed: {}", short(r)),
+                ("failed", _, Some(r)) => format!("failed: {}", one_line(r, 160)),
                 (s, Some(t), _) => format!("{s} in {t:.0} s"),
                 (s, _, _) => s.to_string(),
             })
@@ -687,8 +672,8 @@ pub fn page(
             line::svg_inline(c)
         );
     }
-    h.push_str("</div>\n</body></html>\n");
-    h
+    h.push_str("</div>\n");
+    html::page("sfmeval sweep", STYLE, &h)
 }
 
 /// The whole sweep.

@@ -3,6 +3,7 @@
 
 use crate::row::Row;
 use crate::table::order::find;
+use crate::text::one_line;
 
 /// Table I cell text: `mean m (points)` or the failure.
 pub fn table1_cell(r: Option<&Row>) -> String {
@@ -24,12 +25,7 @@ pub fn table1_cell(r: Option<&Row>) -> String {
 
 /// A reason on one line for a Markdown cell: no line breaks or `|`, at most 120 characters.
 fn short(s: &str) -> String {
-    let one = s.replace(['\n', '|'], " ");
-    if one.chars().count() > 120 {
-        format!("{}…", one.chars().take(120).collect::<String>())
-    } else {
-        one
-    }
+    one_line(&s.replace('|', " "), 120)
 }
 
 /// A number with `digits` decimals, empty for none.

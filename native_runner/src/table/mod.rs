@@ -9,6 +9,7 @@ use std::path::Path;
 
 use anyhow::Result;
 
+use crate::csv::CsvWriter;
 use crate::files::write_atomic;
 use crate::row::Row;
 use crate::table::cells::{csv_num, n_tau, table1_cell, wide_columns, wide_values};
@@ -38,31 +39,35 @@ pub fn write_tables(out: &Path, rows: &[Row]) -> Result<()> {
         "# Table I: mean distance to the ground truth (m) and number of points\n\nEach cell: mean reconstruction → ground-truth distance in metres (after `auto` alignment), and in parentheses the number of points; failed runs show why.\n\n{t1}"
     );
     write_atomic(&out.join("table1.md"), t1_md.as_bytes())?;
-    let mut csv = String::from("dataset");
+    let mut csv = CsvWriter::new();
+    let mut header = vec!["dataset".to_string()];
     for p in &pipes {
-        csv.push_str(&format!(",{p}.mean_m,{p}.points,{p}.status"));
+        header.extend([
+            format!("{p}.mean_m"),
+            format!("{p}.points"),
+            format!("{p}.status"),
+        ]);
     }
-    csv.push('\n');
+    csv.record(&header);
     for d in &datasets {
-        csv.push_str(&csv_field(d));
+        let mut record = vec![d.clone()];
         for p in &pipes {
             match find(rows, d, p) {
-                Some(r) => csv.push_str(&format!(
-                    ",{},{},{}",
+                Some(r) => record.extend([
                     csv_num(r.mean),
                     if r.mean.is_some() {
                         r.points.to_string()
                     } else {
                         String::new()
                     },
-                    csv_field(&r.status)
-                )),
-                None => csv.push_str(",,,"),
+                    r.status.clone(),
+                ]),
+                None => record.extend([String::new(), String::new(), String::new()]),
             }
         }
-        csv.push('\n');
+        csv.record(&record);
     }
-    write_atomic(&out.join("table1.csv"), csv.as_bytes())?;
+    write_atomic(&out.join("table1.csv"), csv.finish().as_bytes())?;
     // Wide table.
     let cols = wide_columns(rows);
     let nt = n_tau(rows);
@@ -78,23 +83,12 @@ pub fn write_tables(out: &Path, rows: &[Row]) -> Result<()> {
     for r in &ordered {
         wide.push_str(&format!("| {} |\n", wide_values(r, nt, false).join(" | ")));
     }
-    let mut wcsv = cols
-        .iter()
-        .map(|c| csv_field(c))
-        .collect::<Vec<_>>()
-        .join(",");
-    wcsv.push('\n');
+    let mut wcsv = CsvWriter::new();
+    wcsv.record(&cols);
     for r in &ordered {
-        wcsv.push_str(
-            &wide_values(r, nt, true)
-                .iter()
-                .map(|v| csv_field(v))
-                .collect::<Vec<_>>()
-                .join(","),
-        );
-        wcsv.push('\n');
+        wcsv.record(wide_values(r, nt, true));
     }
-    write_atomic(&out.join("runs.csv"), wcsv.as_bytes())?;
+    write_atomic(&out.join("runs.csv"), wcsv.finish().as_bytes())?;
     let md = format!(
         "{t1_md}\n# All runs\n\nP/R/F at thresholds in % of the ground-truth bounding-box diagonal; camera errors after the same alignment, centre errors also in % of the scene radius (mean distance of the ground-truth cameras from their centroid).\n\n{wide}"
     );
@@ -112,13 +106,4 @@ pub fn write_tables(out: &Path, rows: &[Row]) -> Result<()> {
     json.push('\n');
     write_atomic(&out.join("summary.json"), json.as_bytes())?;
     Ok(())
-}
-
-/// One CSV field, quoted when it holds `,`, `"` or `\n`.
-fn csv_field(s: &str) -> String {
-    if s.contains([',', '"', '\n']) {
-        format!("\"{}\"", s.replace('"', "\"\""))
-    } else {
-        s.to_string()
-    }
 }

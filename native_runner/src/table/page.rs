@@ -7,16 +7,17 @@ use crate::chart::bar::{self, BarChart};
 use crate::chart::cdf::{self, Curve};
 use crate::chart::palette::color;
 use crate::chart::value::Value;
-use crate::html::esc;
+use crate::html::{self, esc};
 use crate::row::Row;
 use crate::table::cells::{table1_cell, wide_for_html};
 use crate::table::order::find;
 
+/// The page's own style, after the shell's.
+const STYLE: &str = "th,td{border:1px solid #ccc;padding:3px 7px;text-align:right}th{background:#f3f3f3}td.l,th.l{text-align:left}\ntr.failed td,td.failed{color:#a00;background:#fff3f3}.charts{display:flex;flex-wrap:wrap;gap:1em}\nsvg{background:#fff;border:1px solid #ddd}.legend span{display:inline-block;margin-right:1em}.sw{display:inline-block;width:12px;height:12px;margin-right:4px;vertical-align:middle}";
+
 /// The whole page (`index.html`).
 pub fn page(rows: &[Row], datasets: &[String], pipes: &[String]) -> String {
-    let mut h = String::from(
-        "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\"><title>sfmeval-runner comparison</title>\n<style>\nbody{font-family:system-ui,sans-serif;margin:1.5em;color:#222}table{border-collapse:collapse;margin:1em 0;font-size:13px}\nth,td{border:1px solid #ccc;padding:3px 7px;text-align:right}th{background:#f3f3f3}td.l,th.l{text-align:left}\ntr.failed td,td.failed{color:#a00;background:#fff3f3}.charts{display:flex;flex-wrap:wrap;gap:1em}\nsvg{background:#fff;border:1px solid #ddd}.legend span{display:inline-block;margin-right:1em}.sw{display:inline-block;width:12px;height:12px;margin-right:4px;vertical-align:middle}\n</style></head><body>\n<h1>SfM pipelines compared with sfmeval</h1>\n",
-    );
+    let mut h = String::from("<h1>SfM pipelines compared with sfmeval</h1>\n");
     let _ = writeln!(
         h,
         "<p>{} datasets × {} pipelines. Distances in metres, after <code>auto</code> alignment to the ground truth; one <code>sfmeval.report/1</code> per run under <code>reports/</code>.</p>",
@@ -101,8 +102,8 @@ pub fn page(rows: &[Row], datasets: &[String], pipes: &[String]) -> String {
         }
         h.push_str("</tr>\n");
     }
-    h.push_str("</table>\n<p>Written by sfmeval-runner.</p>\n</body></html>\n");
-    h
+    h.push_str("</table>\n<p>Written by sfmeval-runner.</p>\n");
+    html::page("sfmeval-runner comparison", STYLE, &h)
 }
 
 /// The class of column `i` of `n` in the wide table: the first three (dataset, pipeline,
