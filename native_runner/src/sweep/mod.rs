@@ -66,7 +66,7 @@ pub fn sweep(a: &SweepArgs) -> Result<()> {
     let render_seconds = t0.elapsed().as_secs_f64();
     // runs
     let runs = out.join("runs");
-    let table = out.join("table");
+    let table_dir = out.join("table");
     let t_runs = Instant::now();
     if !datasets.is_empty() {
         let env = make_env(&a.tools, &runs)?;
@@ -86,7 +86,7 @@ pub fn sweep(a: &SweepArgs) -> Result<()> {
     } else {
         report(&ReportArgs {
             runs: vec![runs.clone()],
-            out: table.clone(),
+            out: table_dir.clone(),
             datasets: Vec::new(),
             eval,
             align: a.eval.align.clone(),
@@ -96,7 +96,7 @@ pub fn sweep(a: &SweepArgs) -> Result<()> {
     let report_seconds = t_rep.elapsed().as_secs_f64();
     // cells
     let pipes: Vec<String> = specs.iter().map(|s| s.name.clone()).collect();
-    let cells = cells::collect(&planned, &variants, &pipes, &rows, &table);
+    let cells = cells::collect(&planned, &variants, &pipes, &rows, &table_dir);
     let metrics = metrics::metrics(&a.metrics, &cells);
     write_atomic(
         &out.join("sweep.csv"),
