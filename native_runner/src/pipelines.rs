@@ -6,10 +6,7 @@ use std::collections::BTreeMap;
 
 use anyhow::{Result, bail};
 
-use crate::adapters::{self, Adapter, BUILTIN};
-
-/// Options handled by the runner itself, valid for every pipeline.
-pub const RUNNER_OPTIONS: [&str; 3] = ["timeout", "name", "intrinsics"];
+use crate::adapters::{self, Adapter, BUILTIN, RUNNER_OPTIONS};
 
 /// One pipeline of a batch.
 #[derive(Debug, Clone, PartialEq)]

@@ -4,17 +4,16 @@
 //! small preset's settings (36 views, 640×360, 16 spp). Rendered datasets and finished runs
 //! are reused unless `--fresh`.
 
-use std::path::{Path, PathBuf};
-use std::time::{Duration, Instant};
+use std::path::Path;
+use std::time::Instant;
 
-use anyhow::{Context, Result, bail};
+use anyhow::{Context, Result};
 
-use crate::Table1Args;
-use crate::dataset::Dataset;
-use crate::exec::{Step, run_step};
 use sfmeval_fs::write_atomic;
 
-use crate::files::{partial_name, replace_dir};
+use crate::args::Table1Args;
+use crate::dataset::Dataset;
+use crate::generator::{find_blender_scripts, render_dataset};
 
 /// The seed paper's five datasets, as generator presets.
 pub const PRESETS: [&str; 5] = ["statue", "vase", "bicycle", "hydrant", "vehicle"];
@@ -28,30 +27,6 @@ pub const QUICK: [&str; 6] = [
     "views.orbits=[{elevation_deg=20.0, count=18}, {elevation_deg=45.0, count=18, azimuth_offset_deg=10.0}]",
     "views.sphere.count=0",
 ];
-
-/// The `blender_scripts` folder: given, `$SFMEVAL_BLENDER_SCRIPTS`, beside an ancestor of the
-/// binary, or under the working directory.
-pub fn find_blender_scripts(given: Option<&Path>) -> Result<PathBuf> {
-    let ok = |p: &Path| p.join("generate.py").is_file();
-    if let Some(p) = given {
-        if ok(p) {
-            return Ok(p.to_path_buf());
-        }
-        bail!("{} has no generate.py", p.display());
-    }
-    let mut candidates: Vec<PathBuf> = Vec::new();
-    if let Some(p) = std::env::var_os("SFMEVAL_BLENDER_SCRIPTS") {
-        candidates.push(PathBuf::from(p));
-    }
-    if let Ok(exe) = std::env::current_exe() {
-        candidates.extend(exe.ancestors().skip(1).map(|d| d.join("blender_scripts")));
-    }
-    candidates.push(PathBuf::from("blender_scripts"));
-    candidates
-        .into_iter()
-        .find(|p| ok(p))
-        .context("blender_scripts/generate.py not found: pass --blender-scripts DIR")
-}
 
 /// Renders one preset into `dest` (through a temporary folder), returning the seconds spent.
 fn generate(
@@ -83,63 +58,11 @@ fn generate(
     render_dataset("table1", python, scripts, &args, dest)
 }
 
-/// Runs the Blender generator (`generate.py ARGS --out TMP`) into a temporary folder beside
-/// `dest`, logging to `dest.log`, and moves the dataset into `dest` when it succeeded; returns
-/// the seconds spent. A failure names the generator's last error line. `who` prefixes the
-/// progress line (`table1`, `sweep`).
-pub fn render_dataset(
-    who: &str,
-    python: &Path,
-    scripts: &Path,
-    args: &[String],
-    dest: &Path,
-) -> Result<f64> {
-    let tmp = partial_name(dest);
-    if tmp.exists() {
-        std::fs::remove_dir_all(&tmp)?;
-    }
-    let mut argv = vec![
-        python.to_string_lossy().to_string(),
-        scripts.join("generate.py").to_string_lossy().to_string(),
-    ];
-    argv.extend(args.iter().cloned());
-    argv.push("--out".into());
-    argv.push(tmp.to_string_lossy().to_string());
-    let parent = dest.parent().unwrap_or(Path::new("."));
-    let name = dest
-        .file_name()
-        .map(|n| n.to_string_lossy().to_string())
-        .unwrap_or_default();
-    let log = parent.join(format!("{name}.log"));
-    eprintln!(
-        "{who}: rendering {name} → {} (log {})",
-        dest.display(),
-        log.display()
-    );
-    let step = Step::new(&format!("generate {name}"), argv, parent);
-    let r = run_step(&step, &log, Instant::now() + Duration::from_secs(48 * 3600));
-    if !r.success() {
-        let _ = std::fs::remove_dir_all(&tmp);
-        let tail = std::fs::read_to_string(&log)
-            .ok()
-            .and_then(|t| {
-                t.lines()
-                    .rev()
-                    .find(|l| l.contains("error"))
-                    .map(str::to_string)
-            })
-            .unwrap_or_default();
-        bail!("{} {tail} (see {})", r.failure_reason(), log.display());
-    }
-    replace_dir(&tmp, dest)?;
-    Ok(r.wall_seconds)
-}
-
 /// The whole experiment.
 pub fn table1(a: &Table1Args) -> Result<()> {
     let t0 = Instant::now();
     a.exec.check()?;
-    let python = crate::find_python(a.tools.python.as_deref())?;
+    let python = crate::env::find_python(a.tools.python.as_deref())?;
     let scripts = std::path::absolute(find_blender_scripts(a.blender_scripts.as_deref())?)?;
     let presets: Vec<String> = if a.presets.is_empty() {
         PRESETS.iter().map(|s| s.to_string()).collect()
@@ -177,7 +100,7 @@ pub fn table1(a: &Table1Args) -> Result<()> {
     timing.insert("render_seconds".into(), gen_times.into());
     let customs = crate::pipelines::parse_customs(&a.tools.customs)?;
     let specs = crate::pipelines::parse_list(&a.pipelines, &customs)?;
-    let env = crate::make_env(&a.tools, &runs)?;
+    let env = crate::env::make_env(&a.tools, &runs)?;
     let opts = a.exec.batch_options(&runs, !a.fresh, false)?;
     let t_runs = Instant::now();
     let summary = crate::run::run_batch(&datasets, &specs, &customs, &env, &opts)?;
@@ -187,7 +110,7 @@ pub fn table1(a: &Table1Args) -> Result<()> {
         runs: vec![runs.clone()],
         out: table.clone(),
         datasets: Vec::new(),
-        eval: crate::eval_options(&a.eval)?,
+        eval: a.eval.eval_options()?,
         align: a.eval.align_request()?,
         verbose: false,
     })?;

@@ -169,7 +169,7 @@ impl Job<'_> {
             v.push(k.map(|x| format!("{x}")).join(","));
         }
         for (k, val) in self.options {
-            if !crate::pipelines::RUNNER_OPTIONS.contains(&k.as_str()) {
+            if !RUNNER_OPTIONS.contains(&k.as_str()) {
                 v.push("--option".into());
                 v.push(format!("{k}={val}"));
             }
@@ -182,6 +182,10 @@ impl Job<'_> {
 pub fn path_str(p: &Path) -> String {
     p.to_string_lossy().to_string()
 }
+
+/// Pipeline options handled by the runner itself, valid for every pipeline (and not passed
+/// to the tool).
+pub const RUNNER_OPTIONS: [&str; 3] = ["timeout", "name", "intrinsics"];
 
 /// What every SfM tool adapter provides.
 pub trait Adapter: Send + Sync {

@@ -1,0 +1,357 @@
+//! The command line: every subcommand's arguments (clap), and their translation into the
+//! options of the batch ([`BatchOptions`]) and of the evaluation ([`EvalOptions`]).
+
+use std::path::{Path, PathBuf};
+use std::time::Duration;
+
+use anyhow::{Context, Result};
+use clap::builder::PossibleValuesParser;
+use clap::{Args, Parser, Subcommand};
+use sfmeval::align::{AlignMode, AlignRequest};
+use sfmeval::evaluate::EvalOptions;
+
+use crate::adapters::Intrinsics;
+use crate::run::{BatchOptions, parse_shard};
+
+/// The whole command line.
+#[derive(Parser)]
+#[command(
+    name = "sfmeval-runner",
+    version,
+    about = "Run SfM pipelines on sfmeval datasets, evaluate them with the sfmeval core and write the comparison table."
+)]
+pub struct Cli {
+    /// The subcommand.
+    #[command(subcommand)]
+    pub command: Command,
+}
+
+/// The subcommands.
+#[derive(Subcommand)]
+pub enum Command {
+    /// Create the Python venv with the pinned SfM tools (requirements/runner.txt).
+    Setup(SetupArgs),
+    /// Run pipelines on datasets: writes `OUT/<dataset>/<pipeline>/` (sparse.ply, cameras.json, run.json, log.txt, model/).
+    Run(RunArgs),
+    /// Join the run folders of several shards into one.
+    Merge(MergeArgs),
+    /// Evaluate every run and write the comparison tables (Markdown, CSV, HTML).
+    Report(ReportCmd),
+    /// The whole seed experiment: render the five built-in datasets, run every pipeline, write the table.
+    Table1(Table1Args),
+    /// Vary one dataset condition (views, baseline, focal, texture, lighting, noise, blur):
+    /// render a variant per value, run the pipelines, plot every metric against it.
+    Sweep(SweepArgs),
+    /// List the pipelines and whether each is installed here.
+    Pipelines(ToolArgs),
+}
+
+/// Where the tools are, and the custom pipelines.
+#[derive(Args, Clone)]
+pub struct ToolArgs {
+    /// Python interpreter of the venv with pycolmap, pytheia, openmvg-rs (default:
+    /// $SFMEVAL_PYTHON, ./.venv/bin/python, the repository's .venv, python3).
+    #[arg(long)]
+    pub python: Option<PathBuf>,
+    /// COLMAP executable.
+    #[arg(long, default_value = "colmap")]
+    pub colmap: String,
+    /// VisualSfM executable.
+    #[arg(long, default_value = "VisualSFM")]
+    pub visualsfm: String,
+    /// A custom pipeline: NAME='COMMAND with {images} and {out}' (repeatable; see README).
+    #[arg(long = "custom", value_name = "NAME=COMMAND")]
+    pub customs: Vec<String>,
+}
+
+/// How the runs of a batch execute: shared by `run`, `table1` and `sweep`.
+#[derive(Args, Clone)]
+pub struct ExecArgs {
+    /// Timeout per run, seconds (a pipeline's `timeout=` option overrides it).
+    #[arg(long, default_value_t = 3600.0)]
+    pub timeout: f64,
+    /// Runs at once.
+    #[arg(long, default_value_t = 1)]
+    pub jobs: usize,
+    /// Intrinsics given to the tools: `exif` (the images' EXIF, default) or `known`
+    /// (the dataset's cameras.json).
+    #[arg(long, default_value = "exif", value_parser = ["exif", "known"])]
+    pub intrinsics: String,
+    /// Seed passed to the tools that take one.
+    #[arg(long, default_value_t = 0)]
+    pub seed: u64,
+}
+
+impl ExecArgs {
+    /// Fails on a timeout that is not positive. Commands that render first call it before
+    /// rendering, so a bad flag does not cost the renders.
+    pub fn check(&self) -> Result<()> {
+        if !(self.timeout > 0.0) {
+            anyhow::bail!("--timeout must be > 0");
+        }
+        Ok(())
+    }
+
+    /// The batch options writing into `out`; `resume`/`retry_failed` say which finished runs
+    /// are reused. Fails as [`Self::check`] does.
+    pub fn batch_options(
+        &self,
+        out: &Path,
+        resume: bool,
+        retry_failed: bool,
+    ) -> Result<BatchOptions> {
+        self.check()?;
+        Ok(BatchOptions {
+            out: out.to_path_buf(),
+            timeout: Duration::from_secs_f64(self.timeout),
+            jobs: self.jobs.max(1),
+            resume,
+            retry_failed,
+            shard: None,
+            intrinsics: if self.intrinsics == "known" {
+                Intrinsics::Known
+            } else {
+                Intrinsics::Exif
+            },
+            seed: self.seed,
+            keep_scratch: false,
+            verbose: true,
+        })
+    }
+}
+
+/// The pipelines of a batch and how it runs (`run`).
+#[derive(Args, Clone)]
+pub struct BatchArgs {
+    /// Pipelines: names or specs KIND[:key=value,...] separated by commas or `;`, or `all`.
+    #[arg(long, num_args = 1.., required = true)]
+    pub pipelines: Vec<String>,
+    /// How the runs execute.
+    #[command(flatten)]
+    pub exec: ExecArgs,
+    /// Skip runs already finished in the output folder.
+    #[arg(long)]
+    pub resume: bool,
+    /// With --resume, redo runs that failed or timed out.
+    #[arg(long)]
+    pub retry_failed: bool,
+    /// Only the grid cells k with k % n == i (0 <= i < n), for cluster job arrays.
+    #[arg(long, value_name = "i/n")]
+    pub shard: Option<String>,
+    /// Keep the tools' scratch files (databases, features) in the run folders.
+    #[arg(long)]
+    pub keep_scratch: bool,
+    /// Where the tools are.
+    #[command(flatten)]
+    pub tools: ToolArgs,
+}
+
+impl BatchArgs {
+    /// The batch options writing into `out`, with the shard and `--keep-scratch`.
+    pub fn batch_options(&self, out: &Path) -> Result<BatchOptions> {
+        Ok(BatchOptions {
+            shard: self.shard.as_deref().map(parse_shard).transpose()?,
+            keep_scratch: self.keep_scratch,
+            ..self
+                .exec
+                .batch_options(out, self.resume, self.retry_failed)?
+        })
+    }
+}
+
+/// Arguments of `setup`.
+#[derive(Args)]
+pub struct SetupArgs {
+    /// The venv to create or update.
+    #[arg(long, default_value = ".venv")]
+    pub venv: PathBuf,
+    /// The Python used to create it (bpy 5.0 needs CPython 3.11).
+    #[arg(long, default_value = "python3.11")]
+    pub python: String,
+}
+
+/// Arguments of `run`.
+#[derive(Args)]
+pub struct RunArgs {
+    /// Dataset folders (sfmeval.dataset/1).
+    #[arg(long, num_args = 1.., required = true)]
+    pub datasets: Vec<PathBuf>,
+    /// Output folder.
+    #[arg(long, default_value = "runs")]
+    pub out: PathBuf,
+    /// The pipelines and how they run.
+    #[command(flatten)]
+    pub batch: BatchArgs,
+}
+
+/// Arguments of `merge`.
+#[derive(Args)]
+pub struct MergeArgs {
+    /// Shard output folders.
+    #[arg(required = true)]
+    pub shards: Vec<PathBuf>,
+    /// Merged output folder.
+    #[arg(long)]
+    pub out: PathBuf,
+    /// When a run differs between shards, keep the last instead of failing.
+    #[arg(long)]
+    pub force: bool,
+}
+
+/// How every run is measured: shared by `report`, `table1` and `sweep`.
+#[derive(Args, Clone)]
+pub struct EvalArgs {
+    /// Crop file (sfmeval.crop/1) applied in the ground-truth frame.
+    #[arg(long)]
+    pub crop: Option<PathBuf>,
+    /// Completeness samples on the ground-truth mesh.
+    #[arg(long, default_value_t = sfmeval::evaluate::DEFAULT_SAMPLES)]
+    pub samples: usize,
+    /// Thresholds in ground-truth units (metres for Blender datasets), comma-separated.
+    #[arg(long, value_delimiter = ',')]
+    pub tau: Vec<f64>,
+    /// Thresholds in percent of the ground-truth bounding-box diagonal (default 0.5,1,2).
+    #[arg(long, value_delimiter = ',', alias = "tau-relative")]
+    pub tau_percent: Vec<f64>,
+    /// Alignment: auto (cameras, else global; then ICP), cameras, global, cameras+icp,
+    /// global+icp, icp or none (given and points need inputs a batch does not have).
+    #[arg(long, default_value = "auto", value_parser = PossibleValuesParser::new(AlignMode::names()))]
+    pub align: String,
+    /// Seed of the surface sampler.
+    #[arg(long = "eval-seed", default_value_t = 0)]
+    pub eval_seed: u64,
+}
+
+impl EvalArgs {
+    /// The core's evaluation options: thresholds, samples, seed and the crop file's volume
+    /// (read here: a missing or malformed crop file is an error naming it).
+    pub fn eval_options(&self) -> Result<EvalOptions> {
+        let crop = match &self.crop {
+            Some(p) => {
+                let bytes = std::fs::read(p).with_context(|| format!("reading {}", p.display()))?;
+                sfmeval::crop::Crop::parse(&bytes)
+                    .with_context(|| format!("crop file {}", p.display()))?
+            }
+            None => sfmeval::crop::Crop::default(),
+        };
+        Ok(EvalOptions {
+            tau: self.tau.clone(),
+            tau_percent_of_diagonal: self.tau_percent.clone(),
+            samples: self.samples,
+            seed: self.eval_seed,
+            crop,
+            ..EvalOptions::default()
+        })
+    }
+}
+
+impl EvalArgs {
+    /// The alignment request of `--align` (validated: modes that need a transform or point
+    /// pairs are refused, a batch has neither).
+    pub fn align_request(&self) -> Result<AlignRequest> {
+        let mode = AlignMode::parse(&self.align)?;
+        Ok(AlignRequest::new(Some(mode), None, Vec::new())?)
+    }
+}
+
+/// Arguments of `report`.
+#[derive(Args)]
+pub struct ReportCmd {
+    /// Runs folders.
+    #[arg(required = true)]
+    pub runs: Vec<PathBuf>,
+    /// Table folder.
+    #[arg(long, default_value = "table")]
+    pub out: PathBuf,
+    /// Dataset folders, when they moved since the runs (matched by folder name).
+    #[arg(long, num_args = 1..)]
+    pub datasets: Vec<PathBuf>,
+    /// How every run is measured.
+    #[command(flatten)]
+    pub eval: EvalArgs,
+}
+
+/// Arguments of `table1`.
+#[derive(Args)]
+pub struct Table1Args {
+    /// The small preset (36 views, 640×360, 16 spp) instead of the seed's full datasets.
+    #[arg(long)]
+    pub quick: bool,
+    /// Output folder (datasets/, runs/, table/).
+    #[arg(long, default_value = "table1")]
+    pub out: PathBuf,
+    /// Pipelines (default: all built-in ones; those not installed are recorded as such).
+    #[arg(long, num_args = 1.., default_value = "all")]
+    pub pipelines: Vec<String>,
+    /// Only these presets (default: statue vase bicycle hydrant vehicle).
+    #[arg(long, num_args = 1..)]
+    pub presets: Vec<String>,
+    /// Extra generator overrides `section.key=value` for every dataset (repeatable).
+    #[arg(long = "set")]
+    pub sets: Vec<String>,
+    /// The blender_scripts folder (default: found from the binary or the working directory).
+    #[arg(long)]
+    pub blender_scripts: Option<PathBuf>,
+    /// Redo everything (default: reuse rendered datasets and finished runs).
+    #[arg(long)]
+    pub fresh: bool,
+    /// How the runs execute.
+    #[command(flatten)]
+    pub exec: ExecArgs,
+    /// Where the tools are.
+    #[command(flatten)]
+    pub tools: ToolArgs,
+    /// How every run is measured.
+    #[command(flatten)]
+    pub eval: EvalArgs,
+}
+
+/// Arguments of `sweep`.
+#[derive(Args)]
+pub struct SweepArgs {
+    /// The condition and its values, NAME=V1,V2,...: views, baseline, focal, texture,
+    /// lighting, noise, blur (see the README for what each changes).
+    #[arg(long, value_name = "NAME=V1,V2,...")]
+    pub factor: String,
+    /// Generator preset of the base dataset (default `small` when no --dataset-config).
+    #[arg(long)]
+    pub dataset_preset: Option<String>,
+    /// Generator config file (TOML/JSON) of the base dataset.
+    #[arg(long)]
+    pub dataset_config: Option<PathBuf>,
+    /// Fixed generator overrides `section.key=value` for every variant (repeatable).
+    #[arg(long = "set")]
+    pub sets: Vec<String>,
+    /// Pipelines: names or specs KIND[:key=value,...] separated by commas or `;`, or `all`.
+    #[arg(long, num_args = 1.., required = true)]
+    pub pipelines: Vec<String>,
+    /// Output folder (datasets/, runs/, table/, charts/, sweep.csv, sweep.html, sweep.json).
+    #[arg(long, default_value = "sweep")]
+    pub out: PathBuf,
+    /// Also render depth maps, so every report gains completeness over the visible surface and
+    /// the track-based error, and plot them (rendering takes longer).
+    #[arg(long)]
+    pub visibility: bool,
+    /// Extra metric to plot: a JSON path such as `report.completeness.p90` or
+    /// `report.thresholds[*].recall`, optionally `=LABEL` (repeatable).
+    #[arg(long = "metric", value_name = "PATH[=LABEL]")]
+    pub metrics: Vec<String>,
+    /// The blender_scripts folder (default: found from the binary or the working directory).
+    #[arg(long)]
+    pub blender_scripts: Option<PathBuf>,
+    /// Redo everything (default: reuse rendered variants and finished runs).
+    #[arg(long)]
+    pub fresh: bool,
+    /// Redo runs that failed or timed out (finished ones are reused).
+    #[arg(long)]
+    pub retry_failed: bool,
+    /// How the runs execute.
+    #[command(flatten)]
+    pub exec: ExecArgs,
+    /// Where the tools are.
+    #[command(flatten)]
+    pub tools: ToolArgs,
+    /// How every run is measured.
+    #[command(flatten)]
+    pub eval: EvalArgs,
+}

@@ -1,0 +1,70 @@
+//! One run's row of the comparison tables: its record, its evaluation's numbers (written by
+//! `report`, read by the tables, the page and the sweep).
+
+use serde::{Deserialize, Serialize};
+
+/// One threshold's precision / recall / F.
+#[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
+pub struct Prf {
+    /// Threshold in ground-truth units (metres for Blender datasets).
+    pub tau: f64,
+    /// The same threshold in percent of the ground-truth bounding-box diagonal.
+    pub tau_percent_of_diagonal: f64,
+    /// Precision.
+    pub precision: f64,
+    /// Recall.
+    pub recall: f64,
+    /// F-score.
+    pub f_score: f64,
+}
+
+/// One run in the comparison.
+#[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
+pub struct Row {
+    /// Dataset.
+    pub dataset: String,
+    /// Pipeline.
+    pub pipeline: String,
+    /// Tool and version.
+    pub tool: String,
+    /// Tool version.
+    pub version: Option<String>,
+    /// `ok`, `failed`, `timeout`, `not installed`, `evaluation failed`.
+    pub status: String,
+    /// Why not ok.
+    pub reason: Option<String>,
+    /// Images in the dataset.
+    pub images_total: usize,
+    /// Images registered.
+    pub images_registered: usize,
+    /// Points of the reconstruction.
+    pub points: u64,
+    /// Wall seconds.
+    pub wall_seconds: f64,
+    /// CPU seconds.
+    pub cpu_seconds: f64,
+    /// Peak memory, MB.
+    pub peak_memory_mb: f64,
+    /// Accuracy: mean distance reconstruction → GT (m).
+    pub mean: Option<f64>,
+    /// Median distance.
+    pub median: Option<f64>,
+    /// RMS distance.
+    pub rms: Option<f64>,
+    /// Mean completeness distance GT → reconstruction.
+    pub completeness_mean: Option<f64>,
+    /// P/R/F per threshold.
+    pub thresholds: Vec<Prf>,
+    /// Median rotation error (degrees).
+    pub rotation_median_deg: Option<f64>,
+    /// Median camera-centre error (m).
+    pub center_median: Option<f64>,
+    /// Median camera-centre error, % of the scene radius.
+    pub center_median_percent: Option<f64>,
+    /// Largest camera-centre error, % of the scene radius.
+    pub center_max_percent: Option<f64>,
+    /// Cumulative share of points within a distance: `(distance, share)`.
+    pub cdf: Vec<(f64, f64)>,
+    /// The report file, relative to the table folder.
+    pub report: Option<String>,
+}

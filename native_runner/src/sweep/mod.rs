@@ -1,0 +1,204 @@
+//! `sfmeval-runner sweep`: where does each pipeline break? Varies one condition of a
+//! generated dataset (number of views, baseline, focal length, texture strength, lighting,
+//! image noise or blur), renders one variant per value with the Blender generator, runs the
+//! pipelines on every variant (the `run` machinery: resumable, failures recorded), evaluates
+//! them (the `report` machinery) and plots each metric against the factor, one line per
+//! pipeline: `sweep.csv`, `sweep.html` and `charts/<metric>.svg`.
+//!
+//! The steps, one module each: [`factor`] (`--factor` parsing), [`overrides`] (a value as
+//! generator overrides), [`variants`] (planning and rendering), [`cells`] (a cell per value
+//! and pipeline), [`metrics`] (what is plotted), [`table`] (`sweep.csv`), [`charts`] and
+//! [`page`] (`sweep.html`).
+
+pub mod cells;
+pub mod charts;
+pub mod factor;
+pub mod metrics;
+pub mod overrides;
+pub mod page;
+pub mod table;
+pub mod variants;
+
+use std::time::Instant;
+
+use anyhow::{Context, Result};
+
+use sfmeval_fs::write_atomic;
+
+use crate::args::SweepArgs;
+use crate::chart::line;
+use crate::env::{find_python, make_env};
+use crate::exec::shell_quote;
+use crate::generator::{find_blender_scripts, resolved_config};
+use crate::pipelines::{parse_customs, parse_list};
+use crate::report::{ReportArgs, report};
+use crate::row::Row;
+use crate::run::run_batch;
+use crate::sweep::factor::parse_factor;
+use crate::sweep::metrics::metric_file;
+
+/// The whole sweep: plan and render the variants, run the pipelines, evaluate, write
+/// `sweep.csv`, `charts/`, `sweep.html` and `sweep.json`.
+pub fn sweep(a: &SweepArgs) -> Result<()> {
+    let t0 = Instant::now();
+    let (factor, values) = parse_factor(&a.factor)?;
+    a.exec.check()?;
+    // absolute paths: the generator runs in the datasets folder
+    let python = find_python(a.tools.python.as_deref())?;
+    let scripts = std::path::absolute(find_blender_scripts(a.blender_scripts.as_deref())?)?;
+    let customs = parse_customs(&a.tools.customs)?;
+    let specs = parse_list(&a.pipelines, &customs)?;
+    let eval = a.eval.eval_options()?;
+    // base: preset/config, no masks, depth maps only with --visibility, the user's --set
+    let base_args = variants::base_args(
+        a.dataset_preset.as_deref(),
+        a.dataset_config.as_deref(),
+        a.visibility,
+        &a.sets,
+    )?;
+    let base = resolved_config(&python, &scripts, &base_args)?;
+    // every value's overrides first: a bad value stops the sweep before anything is rendered
+    let planned = variants::plan(factor, &values, &base)?;
+    let out = std::path::absolute(&a.out)
+        .with_context(|| format!("output folder {}", a.out.display()))?;
+    let ds_root = out.join("datasets");
+    let (variants, datasets) =
+        variants::render(&planned, &base_args, &ds_root, a.fresh, &python, &scripts)?;
+    let render_seconds = t0.elapsed().as_secs_f64();
+    // runs
+    let runs = out.join("runs");
+    let table_dir = out.join("table");
+    let t_runs = Instant::now();
+    if !datasets.is_empty() {
+        let env = make_env(&a.tools, &runs)?;
+        let opts = a.exec.batch_options(&runs, !a.fresh, a.retry_failed)?;
+        let sum = run_batch(&datasets, &specs, &customs, &env, &opts)?;
+        eprintln!(
+            "sweep: runs: {} executed, {} reused",
+            sum.ran.values().sum::<usize>(),
+            sum.skipped
+        );
+    }
+    let runs_seconds = t_runs.elapsed().as_secs_f64();
+    // report
+    let t_rep = Instant::now();
+    let rows: Vec<Row> = if datasets.is_empty() {
+        Vec::new()
+    } else {
+        report(&ReportArgs {
+            runs: vec![runs.clone()],
+            out: table_dir.clone(),
+            datasets: Vec::new(),
+            eval,
+            align: a.eval.align_request()?,
+            verbose: true,
+        })?
+    };
+    let report_seconds = t_rep.elapsed().as_secs_f64();
+    // cells
+    let pipes: Vec<String> = specs.iter().map(|s| s.name.clone()).collect();
+    let cells = cells::collect(&planned, &variants, &pipes, &rows, &table_dir);
+    let metrics = metrics::metrics(&a.metrics, &cells);
+    write_atomic(
+        &out.join("sweep.csv"),
+        table::csv(factor, &cells, &metrics).as_bytes(),
+    )?;
+    let charts = charts::charts(factor, &values, &pipes, &cells, &metrics);
+    let mut files = Vec::new();
+    for (c, m) in charts.iter().zip(&metrics) {
+        let f = format!("charts/{}.svg", metric_file(&m.path));
+        write_atomic(&out.join(&f), line::svg(c).as_bytes())?;
+        files.push(f);
+    }
+    let command = std::env::args()
+        .map(|s| shell_quote(&s))
+        .collect::<Vec<_>>()
+        .join(" ");
+    write_atomic(
+        &out.join("sweep.html"),
+        page::page(factor, &command, &variants, &pipes, &charts, &files).as_bytes(),
+    )?;
+    let total = t0.elapsed().as_secs_f64();
+    let doc = serde_json::json!({
+        "schema": "sfmeval.sweep/1",
+        "factor": factor.name(),
+        "definition": factor.description(),
+        "values": values.iter().map(|v| v.0.clone()).collect::<Vec<_>>(),
+        "base_generator_args": base_args,
+        "variants": variants,
+        "pipelines": pipes,
+        "metrics": metrics.iter().map(|m| serde_json::json!({"path": m.path, "label": m.label, "chart": metric_file(&m.path) + ".svg"})).collect::<Vec<_>>(),
+        "command": command,
+        "timing": {"datasets_seconds": render_seconds, "runs_seconds": runs_seconds,
+                   "report_seconds": report_seconds, "total_seconds": total},
+    });
+    let mut json = serde_json::to_string_pretty(&doc)?;
+    json.push('\n');
+    write_atomic(&out.join("sweep.json"), json.as_bytes())?;
+    let ok = cells.iter().filter(|c| c.status == "ok").count();
+    eprintln!(
+        "sweep: {} value(s) × {} pipeline(s), {ok} ok; datasets {render_seconds:.0} s, runs {runs_seconds:.0} s, report {report_seconds:.0} s, total {total:.0} s → {}/{{sweep.csv,sweep.html,sweep.json,charts/}}",
+        values.len(),
+        pipes.len(),
+        a.out.display()
+    );
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use serde_json::{Value as Json, json};
+
+    use crate::chart::value::Value;
+    use crate::sweep::cells::Cell;
+    use crate::sweep::charts::charts;
+    use crate::sweep::factor::Factor;
+    use crate::sweep::metrics::Metric;
+    use crate::sweep::table::csv;
+
+    #[test]
+    fn csv_and_charts_keep_failures() {
+        let doc = json!({"report": {"accuracy": {"mean": 0.5}}, "run": {"wall_seconds": 3.0}});
+        let mk = |v: &str, x: f64, p: &str, st: &str, d: Json| Cell {
+            value: (v.into(), x),
+            dataset: format!("noise-{v}"),
+            pipeline: p.into(),
+            status: st.into(),
+            reason: (st != "ok").then(|| "exit 1, \"boom\"".to_string()),
+            doc: d,
+        };
+        let cells = vec![
+            mk("0", 0.0, "a", "ok", doc.clone()),
+            mk("0", 0.0, "b", "failed", Json::Null),
+            mk("4", 4.0, "a", "ok", doc),
+        ];
+        let metrics = vec![Metric {
+            path: "report.accuracy.mean".into(),
+            label: "mean".into(),
+        }];
+        let s = csv(Factor::Noise, &cells, &metrics);
+        let lines: Vec<&str> = s.lines().collect();
+        assert_eq!(
+            lines[0],
+            "factor,value,dataset,pipeline,status,reason,report.accuracy.mean"
+        );
+        assert_eq!(lines[1], "noise,0,noise-0,a,ok,,0.5");
+        assert_eq!(
+            lines[2],
+            "noise,0,noise-0,b,failed,\"exit 1, \"\"boom\"\"\","
+        );
+        let values = vec![("0".to_string(), 0.0), ("4".to_string(), 4.0)];
+        let ch = charts(
+            Factor::Noise,
+            &values,
+            &["a".into(), "b".into()],
+            &cells,
+            &metrics,
+        );
+        assert_eq!(ch.len(), 1);
+        let b = &ch[0].series[1].points;
+        assert!(matches!(&b[0].1, Value::Failed(r) if r.starts_with("failed: exit 1")));
+        assert!(matches!(&b[1].1, Value::Failed(r) if r == "not run"));
+        assert_eq!(ch[0].series[0].points[1].1, Value::Ok(0.5));
+    }
+}
