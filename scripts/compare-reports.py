@@ -42,9 +42,15 @@ def cases(depth):
                                        "--seed", "3", "--samples", "20000"]),
     ]
     for name in ["colmap_text", "colmap_bin", "colmap38.nvm", "colmap38.bundle.out", "theia_colmap",
-                 "theia.nvm", "theia.ply", "openmvg_colmap", "openmvg.ply", "openmvg_sfm_data.json"]:
+                 "theia.nvm", "openmvg_colmap", "openmvg_sfm_data.json"]:
         out.append((f"model-{name}", ["--gt", CORE / "trimesh_mesh.glb", "--gt-cameras", MODELS / "gt_cameras.json",
                                      "--recon", MODELS / name, "--align", "cameras", "--samples", "5000"]))
+    for name in ["theia.ply", "openmvg.ply"]:
+        out.append((f"model-{name}-with-cameras", ["--gt", CORE / "trimesh_mesh.glb", "--gt-cameras",
+                                                  MODELS / "gt_cameras.json", "--recon", MODELS / name,
+                                                  "--recon-cameras", MODELS / "theia.nvm", "--samples", "5000"]))
+        out.append((f"model-{name}-global", ["--gt", CORE / "trimesh_mesh.glb", "--recon", MODELS / name,
+                                            "--align", "global+icp", "--samples", "5000"]))
     for name in ["open3d_cloud_ascii.ply", "open3d_cloud_binary.ply", "colmap_points.ply"]:
         for gt_name in ["trimesh_mesh.glb", "meshlab_mesh_binary.ply", "trimesh_mesh.obj", "open3d_cloud_binary.ply"]:
             out.append((f"core-{name}-vs-{gt_name}", ["--gt", CORE / gt_name, "--recon", CORE / name,

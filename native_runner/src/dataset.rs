@@ -1,4 +1,5 @@
-//! A dataset folder (`sfmeval.dataset/1`, docs/dataset.md) as the runner sees it.
+//! A dataset folder (`sfmeval.dataset/1`, docs/dataset.md) as the runner sees it: the images
+//! the tools run on and the intrinsics of its cameras.
 
 use std::path::{Path, PathBuf};
 
@@ -50,16 +51,18 @@ impl Dataset {
             .map(|n| n.to_string_lossy().to_string())
             .filter(|n| !n.is_empty() && !n.starts_with('.'))
             .with_context(|| format!("dataset folder {} has no usable name", dir.display()))?;
-        let known = match std::fs::read(dir.join("cameras.json")) {
-            Ok(bytes) => {
-                let rec = sfmeval::model::cameras_json::read_cameras_json(&bytes)
-                    .with_context(|| format!("{}/cameras.json", dir.display()))?;
-                match rec.cameras.as_slice() {
-                    [c] => Some([c.fx, c.fy, c.cx, c.cy]),
-                    _ => None,
-                }
+        // The ground-truth side (geometry, depth maps) is the core's `Dataset`, read by `report`;
+        // running the tools needs only the intrinsics of the dataset's cameras.
+        let cameras = dir.join(sfmeval::dataset::CAMERAS_FILE);
+        let known = if cameras.is_file() {
+            let rec = sfmeval::model::read_model_files(&sfmeval_fs::read_input_files(&cameras)?)
+                .with_context(|| format!("{}", cameras.display()))?;
+            match rec.cameras.as_slice() {
+                [c] => Some([c.fx, c.fy, c.cx, c.cy]),
+                _ => None,
             }
-            Err(_) => None,
+        } else {
+            None
         };
         Ok(Dataset {
             name,

@@ -198,7 +198,7 @@ def test_cloud_ground_truth_nn_and_tnt_prf(tmp_path, run_eval):
         assert entry["precision"] == pytest.approx(p, abs=1e-12)
         assert entry["recall"] == pytest.approx(r, abs=1e-12)
         assert entry["f_score"] == pytest.approx(f, abs=1e-12)
-        assert entry["tau_relative_to_diagonal"] == pytest.approx(t / diag, rel=1e-9)
+        assert entry["tau_percent_of_diagonal"] == pytest.approx(100 * t / diag, rel=1e-9)
 
 
 def test_completeness_samples_agree_with_trimesh_sampling(tmp_path, run_eval):
