@@ -72,6 +72,11 @@ DEFAULTS = {
         "walls": False,
         "wall_color": [0.6, 0.6, 0.6],
         "room_size": 8.0,                # metres, edge of the floor / walls box
+        # Objects in the Blender scene that sfmeval did not make (the add-on's scene: the
+        # default Cube, the user's objects; the headless generator starts empty): hidden from
+        # every render unless kept as context (in the images; never in masks, depth or GT).
+        "keep_other_objects": False,
+        "keep_other_lights": False,
     },
     "render": {
         "samples": 32,

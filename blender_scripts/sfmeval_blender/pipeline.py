@@ -62,6 +62,11 @@ def generate(cfg, out_dir, render=True, overwrite=False):
         info = steps.step_render(cfg, out_dir, progress)
         mean = sum(info["seconds_per_frame"]) / max(1, len(info["seconds_per_frame"]))
         log("rendered %d images, %.2f s per frame" % (info["frames"], mean))
+        for _, line in steps.other_objects_summary(info["other_objects"]):
+            log(line)
+        if info["views_without_object"]:
+            log("warning: the object is seen in no pixel of %s"
+                % ", ".join(info["views_without_object"]))
     log("export ground truth")
     ds = steps.step_export(cfg, out_dir)
     log("done in %.1f s: %s" % (time.perf_counter() - t0, os.path.abspath(out_dir)))

@@ -5,6 +5,7 @@ Objects the steps create carry a custom property ``sfmeval_role`` so a later ste
 of a step) finds them again; the configuration used by each step is stored on the scene.
 """
 
+import contextlib
 import hashlib
 import json
 import math
@@ -96,6 +97,131 @@ def bbox(verts):
 def reset_scene():
     """Empty scene for the headless generator (never used by the add-on)."""
     bpy.ops.wm.read_factory_settings(use_empty=True)
+
+
+# -- objects sfmeval did not make ------------------------------------------------------------
+# Types that never put a pixel in a Cycles render (an empty only when it instances nothing).
+_NOT_RENDERED_TYPES = {"CAMERA", "ARMATURE", "LATTICE", "SPEAKER", "LIGHT_PROBE", "EMPTY"}
+
+
+def _rendered_collections(view_layer):
+    """Collections whose objects a render of `view_layer` includes (not excluded from the view
+    layer, not disabled for rendering, nor any of their parents)."""
+    out = set()
+
+    def walk(lc):
+        if lc.exclude or lc.collection.hide_render:
+            return
+        out.add(lc.collection)
+        for child in lc.children:
+            walk(child)
+
+    walk(view_layer.layer_collection)
+    return out
+
+
+def other_objects(scene, cfg, view_layer=None):
+    """Every object of `scene` that sfmeval did not make (no ``sfmeval_role``: the default Cube,
+    Light and Camera, the user's own objects), sorted by name, as (object, treatment):
+
+    - ``"hidden"``: it would render, so it is hidden from rendering while sfmeval renders
+      (images, depth, masks) — the default;
+    - ``"context"``: kept in the images (``background.keep_other_objects``, or
+      ``background.keep_other_lights`` for lights); never in masks, depth or the ground truth;
+    - ``"not rendered"``: cameras, armatures, plain empties…, and objects the user already left
+      out of renders (``hide_render``, a collection disabled or excluded): left alone.
+    """
+    vl = view_layer or bpy.context.view_layer
+    rendered = _rendered_collections(vl)
+    bg = cfg["background"]
+    out = []
+    for o in sorted(scene.objects, key=lambda o: o.name):
+        if o.get(ROLE):
+            continue
+        inert = o.type in _NOT_RENDERED_TYPES and not (
+            o.type == "EMPTY" and o.instance_type != "NONE")
+        if inert or o.hide_render or not any(c in rendered for c in o.users_collection):
+            treatment = "not rendered"
+        elif o.type == "LIGHT":
+            treatment = "context" if bg["keep_other_lights"] else "hidden"
+        else:
+            treatment = "context" if bg["keep_other_objects"] else "hidden"
+        out.append((o, treatment))
+    return out
+
+
+def other_objects_record(scene, cfg):
+    """The dataset.json field ``other_objects`` (docs/dataset.md)."""
+    return {"keep_other_objects": cfg["background"]["keep_other_objects"],
+            "keep_other_lights": cfg["background"]["keep_other_lights"],
+            "objects": [{"name": o.name, "type": o.type, "treatment": t}
+                        for o, t in other_objects(scene, cfg)]}
+
+
+def _names(names, limit=8):
+    names = list(names)
+    more = len(names) - limit
+    return ", ".join(names[:limit]) + (" and %d more" % more if more > 0 else "")
+
+
+def other_objects_summary(record):
+    """One line per treatment for the panel and the reports: ``("hidden", "Hidden while
+    rendering: Cube, Light")``, ``("context", "Kept as context: Table")``."""
+    lines = []
+    for treatment, head in (("hidden", "Hidden while rendering"), ("context", "Kept as context")):
+        names = [o["name"] for o in record["objects"] if o["treatment"] == treatment]
+        if names:
+            lines.append((treatment, "%s: %s" % (head, _names(names))))
+    return lines
+
+
+def render_report(info):
+    """(level, message) for the render step: "WARNING" when objects were hidden (the images do
+    not show the scene as the viewport does) or some views show no object at all."""
+    times = info["seconds_per_frame"]
+    parts = ["rendered %d images (%.2f s per frame)" % (len(times), sum(times) / max(1, len(times)))]
+    level = "INFO"
+    record = info["other_objects"]
+    for treatment, line in other_objects_summary(record):
+        if treatment == "hidden":
+            level = "WARNING"
+            types = {o["type"] == "LIGHT" for o in record["objects"] if o["treatment"] == "hidden"}
+            toggles = " or ".join(name for is_light, name in (
+                (False, "'Keep other objects as context'"), (True, "'Keep other lights'"))
+                if is_light in types)
+            line += " (not made by sfmeval; %s renders them)" % toggles
+        else:
+            line += " (in the images; not in masks, depth or ground truth)"
+        parts.append(line)
+    missing = info.get("views_without_object") or []
+    if missing:
+        level = "WARNING"
+        parts.append("the object is seen in no pixel of %d of %d views (hidden behind context "
+                     "objects or out of frame): %s" % (len(missing), info["frames"], _names(missing, 4)))
+    return level, "; ".join(parts)
+
+
+@contextlib.contextmanager
+def other_objects_hidden(scene, cfg):
+    """Hide the objects sfmeval did not make from rendering (``hide_render``) for the duration
+    of the block, unless they are kept as context; every object's own ``hide_render`` is
+    restored afterwards, also when rendering fails. Yields the ``other_objects`` record."""
+    record = other_objects_record(scene, cfg)
+    hidden = [o for o, t in other_objects(scene, cfg) if t == "hidden"]
+    done = []
+    try:
+        for o in hidden:
+            try:
+                o.hide_render = True
+            except (AttributeError, TypeError, RuntimeError):
+                raise GenerationError(
+                    "cannot hide %r from rendering (linked from a library?): make it local, "
+                    "delete it or keep other objects as context" % o.name) from None
+            done.append(o)
+        yield record
+    finally:
+        for o in done:
+            o.hide_render = False
 
 
 # -- step 1: import object --------------------------------------------------------------------
@@ -555,7 +681,11 @@ def _set_output(scene, fmt, cfg):
 
 def _render_to(scene, path):
     scene.render.filepath = path
-    bpy.ops.render.render(write_still=True)
+    try:
+        bpy.ops.render.render(write_still=True)
+    except RuntimeError as exc:
+        raise GenerationError("rendering %s failed: %s" % (
+            path, str(exc).strip().replace("Error: ", "", 1))) from None
     if not os.path.isfile(path):
         raise GenerationError("Blender did not write %s" % path)
 
@@ -584,37 +714,41 @@ def step_render(cfg, out_dir, progress=None, frames=None):
     c = cfg["camera"]
     w, h = scene.render.resolution_x, scene.render.resolution_y
     times = []
-    for k, m in enumerate(meta):
-        scene.frame_set(m["frame"])
-        path = os.path.join(img_dir, m["name"])
-        t0 = time.perf_counter()
-        if pp_on:  # render losslessly, then blur/noise into the configured format
-            tmp = path + ".render.png"
-            _render_to(scene, tmp)
-            postprocess.process_file(tmp, path, cfg, m["frame"] - 1)
-            os.remove(tmp)
-        else:
-            _render_to(scene, path)
-        times.append(time.perf_counter() - t0)
-        if c["exif"]:
-            exif.write_exif(path, width=w, height=h, focal_mm=cam.data.lens,
-                            sensor_mm=[cam.data.sensor_width, cam.data.sensor_height],
-                            make=c["make"], model=c["model"],
-                            software="sfmeval_blender %s / Blender %s" % (__version__, bpy.app.version_string),
-                            unit=c["exif_focal_plane_unit"], write_35mm=c["exif_35mm_equivalent"])
-        if progress:
-            progress("render", k + 1, len(meta), times[-1])
     aux_time = 0.0
-    if cfg["outputs"]["depth"] or cfg["outputs"]["masks"]:
-        t0 = time.perf_counter()
-        render_aux(cfg, out_dir, meta, progress)
-        aux_time = time.perf_counter() - t0
+    without_object = None                     # unknown without a depth/mask pass
+    # Objects sfmeval did not make stay out of every render unless kept as context.
+    with other_objects_hidden(scene, cfg) as others:
+        for k, m in enumerate(meta):
+            scene.frame_set(m["frame"])
+            path = os.path.join(img_dir, m["name"])
+            t0 = time.perf_counter()
+            if pp_on:  # render losslessly, then blur/noise into the configured format
+                tmp = path + ".render.png"
+                _render_to(scene, tmp)
+                postprocess.process_file(tmp, path, cfg, m["frame"] - 1)
+                os.remove(tmp)
+            else:
+                _render_to(scene, path)
+            times.append(time.perf_counter() - t0)
+            if c["exif"]:
+                exif.write_exif(path, width=w, height=h, focal_mm=cam.data.lens,
+                                sensor_mm=[cam.data.sensor_width, cam.data.sensor_height],
+                                make=c["make"], model=c["model"],
+                                software="sfmeval_blender %s / Blender %s" % (__version__, bpy.app.version_string),
+                                unit=c["exif_focal_plane_unit"], write_35mm=c["exif_35mm_equivalent"])
+            if progress:
+                progress("render", k + 1, len(meta), times[-1])
+        if cfg["outputs"]["depth"] or cfg["outputs"]["masks"]:
+            t0 = time.perf_counter()
+            without_object = render_aux(cfg, out_dir, meta, progress)
+            aux_time = time.perf_counter() - t0
     info = {"postprocess": {"applied": pp_on, "blur_sigma": cfg["postprocess"]["blur_sigma"],
                             "noise_sigma": cfg["postprocess"]["noise_sigma"],
                             "seed": postprocess.seed_of(cfg),
                             "order": "blur, then noise, on the 8-bit render, before EXIF"},
             "seconds_per_frame": times, "aux_seconds_total": aux_time, "denoise_used": denoise_used,
-            "denoise_available": compat.oidn_available(), "frames": len(meta)}
+            "denoise_available": compat.oidn_available(), "frames": len(meta),
+            "other_objects": others, "views_without_object": without_object}
     store(scene, "render_info", info)
     return info
 
@@ -639,7 +773,11 @@ def render_aux(cfg, out_dir, meta, progress=None):
 
     One extra Cycles pass per view: every surface replaced by an emission of its camera-space Z
     depth, 1 sample through a 0.01-pixel box filter (so each pixel sees exactly the ray through
-    its centre), transparent film (alpha = object coverage), walls and floor hidden."""
+    its centre), transparent film (alpha = object coverage), walls, floor and lights hidden.
+    Other objects kept as context are holdouts: they hide the object behind them (depth 0,
+    mask 0, as in the images) but are never object themselves.
+
+    Returns the names of the views in which no pixel shows the object."""
     import numpy as np
     scene = bpy.context.scene
     vl = bpy.context.view_layer
@@ -651,7 +789,11 @@ def render_aux(cfg, out_dir, meta, progress=None):
         "override": vl.material_override, "vt": scene.view_settings.view_transform,
         "adaptive": scene.cycles.use_adaptive_sampling,
     }
-    hidden = [o for o in objects_with_role("room") if not o.hide_render]
+    hidden = [o for o in scene.objects if not o.hide_render
+              and (o.get(ROLE) == "room" or o.type == "LIGHT")]
+    holdouts = [o for o, t in other_objects(scene, cfg) if t == "context"
+                and o.type != "LIGHT" and not o.is_holdout]
+    without_object = []
     try:
         scene.cycles.samples = 1
         scene.cycles.use_adaptive_sampling = False
@@ -665,6 +807,8 @@ def render_aux(cfg, out_dir, meta, progress=None):
             scene.view_settings.view_transform = "Raw"
         for o in hidden:
             o.hide_render = True
+        for o in holdouts:
+            o.is_holdout = True
         _set_output(scene, "EXR", cfg)
         tmp = os.path.join(out_dir, ".aux.exr")
         depth_dir = os.path.join(out_dir, "depth")
@@ -686,6 +830,8 @@ def render_aux(cfg, out_dir, meta, progress=None):
                 bpy.data.images.remove(img)
             rgba = buf.reshape(h, w, 4)[::-1]             # Blender stores rows bottom-up
             cover = rgba[:, :, 3] > 0.5
+            if not cover.any():
+                without_object.append(m["name"])
             stem = os.path.splitext(m["name"])[0]
             if cfg["outputs"]["depth"]:
                 depth = np.where(cover, rgba[:, :, 0], 0.0).astype(np.float32)
@@ -709,7 +855,10 @@ def render_aux(cfg, out_dir, meta, progress=None):
         scene.view_settings.view_transform = saved["vt"]
         for o in hidden:
             o.hide_render = False
+        for o in holdouts:
+            o.is_holdout = False
         _set_output(scene, cfg["render"]["format"], cfg)
+    return without_object
 
 
 # -- step 6: ground truth ---------------------------------------------------------------------
@@ -781,10 +930,25 @@ def write_colmap_text(cams, folder):
 
 
 def export_glb(obj, path):
-    for o in bpy.context.scene.objects:
+    """The object alone (selection-only export); the user's selection and active object are
+    restored afterwards."""
+    vl = bpy.context.view_layer
+    selected = [o for o in vl.objects if o.select_get()]
+    active = vl.objects.active
+    try:
+        _export_selected_glb(obj, path)
+    finally:
+        for o in vl.objects:
+            o.select_set(o in selected)
+        vl.objects.active = active
+
+
+def _export_selected_glb(obj, path):
+    vl = bpy.context.view_layer
+    for o in vl.objects:
         o.select_set(False)
     obj.select_set(True)
-    bpy.context.view_layer.objects.active = obj
+    vl.objects.active = obj
     op = bpy.ops.export_scene.gltf
     kwargs = compat.op_kwargs(op, filepath=path, export_format="GLB", use_selection=True,
                               export_apply=True, export_yup=True, export_materials="NONE",
@@ -835,7 +999,9 @@ def step_export(cfg, out_dir):
         "render": {"engine": "CYCLES", "device": "CPU", "samples": scene.cycles.samples,
                    "denoise_used": info.get("denoise_used"), "denoise_available": compat.oidn_available(),
                    "threads": scene.render.threads, "view_transform": scene.view_settings.view_transform,
-                   "postprocess": info.get("postprocess")},
+                   "postprocess": info.get("postprocess"),
+                   "views_without_object": info.get("views_without_object")},
+        "other_objects": info.get("other_objects") or other_objects_record(scene, cfg),
         "timing": {"render_seconds_per_frame": [round(t, 3) for t in times],
                    "render_seconds_mean": round(sum(times) / len(times), 3) if times else None,
                    "render_seconds_total": round(sum(times), 3),

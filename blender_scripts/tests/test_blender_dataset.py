@@ -47,6 +47,10 @@ def test_files_and_schemas(small_dataset):
     assert meta["settings"]["render"]["samples"] == 16
     assert len(meta["timing"]["render_seconds_per_frame"]) == 36
     assert meta["render"]["denoise_used"] is False
+    # The headless generator starts from an empty scene: nothing of the user's to hide.
+    assert meta["other_objects"] == {"keep_other_objects": False, "keep_other_lights": False,
+                                     "objects": []}
+    assert meta["render"]["views_without_object"] == []
     for im in cams["images"]:
         R = np.array(im["cam_from_world"]["rotation"])
         assert np.allclose(R @ R.T, np.eye(3), atol=1e-6) and np.linalg.det(R) > 0
