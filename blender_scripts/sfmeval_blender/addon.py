@@ -54,6 +54,15 @@ class SFMEVAL_PG_settings(bpy.types.PropertyGroup):
     world_strength: FloatProperty(name="Strength", default=1.0, min=0.0)
     floor: BoolProperty(name="Floor", default=False)
     walls: BoolProperty(name="Walls", default=False)
+    keep_other_objects: BoolProperty(
+        name="Keep other objects as context", default=False,
+        description="Render the scene's objects that sfmeval did not make (e.g. the default Cube) "
+                    "in the images. They never enter the masks, depth maps or ground truth (they "
+                    "only hide the object behind them). Off: hidden while rendering")
+    keep_other_lights: BoolProperty(
+        name="Keep other lights", default=False,
+        description="Let the scene's own lights (e.g. the default Light) light the images too. "
+                    "Off: only sfmeval's lights")
     light_type: EnumProperty(name="Lights", items=[("area", "Area", ""), ("sun", "Sun", ""),
                                                    ("point", "Point", "")])
     key_energy: FloatProperty(name="Key", default=250.0, min=0.0)
@@ -105,7 +114,9 @@ def props_to_config(p):
                    "texture_scale": p.texture_scale},
         "lights": lights,
         "background": {"world_color": list(p.world_color), "world_strength": p.world_strength,
-                       "floor": p.floor, "walls": p.walls},
+                       "floor": p.floor, "walls": p.walls,
+                       "keep_other_objects": p.keep_other_objects,
+                       "keep_other_lights": p.keep_other_lights},
         "render": {"samples": p.samples, "max_bounces": p.max_bounces,
                    "denoise": {"auto": "auto", "on": True, "off": False}[p.denoise],
                    "format": p.format, "jpeg_quality": p.jpeg_quality},
@@ -130,6 +141,7 @@ def config_to_props(cfg, p):
     p.subdivision, p.texture_scale = o["subdivision"], o["texture_scale"]
     p.world_color, p.world_strength = b["world_color"], b["world_strength"]
     p.floor, p.walls = b["floor"], b["walls"]
+    p.keep_other_objects, p.keep_other_lights = b["keep_other_objects"], b["keep_other_lights"]
     if cfg["lights"]:
         p.light_type = cfg["lights"][0]["type"]
         p.key_energy = cfg["lights"][0]["energy"]
@@ -152,6 +164,15 @@ def config_to_props(cfg, p):
     p.depth, p.masks, p.colmap_gt = out["depth"], out["masks"], out["colmap_gt"]
 
 
+def other_objects_lines(scene):
+    """What the panel says about the objects sfmeval did not make, as the render step will
+    treat them now: [(treatment, "Hidden while rendering: Cube, Light"), …]."""
+    p = scene.sfmeval
+    cfg = {"background": {"keep_other_objects": p.keep_other_objects,
+                          "keep_other_lights": p.keep_other_lights}}
+    return steps.other_objects_summary(steps.other_objects_record(scene, cfg))
+
+
 class _Step(bpy.types.Operator):
     bl_options = {"REGISTER", "UNDO"}
 
@@ -166,8 +187,9 @@ class _Step(bpy.types.Operator):
         except (cfgmod.ConfigError, steps.GenerationError) as exc:
             self.report({"ERROR"}, str(exc))
             return {"CANCELLED"}
+        level, msg = msg if isinstance(msg, tuple) else ("INFO", msg)
         if msg:
-            self.report({"INFO"}, msg)
+            self.report({level}, msg)
         return {"FINISHED"}
 
 
@@ -229,8 +251,7 @@ class SFMEVAL_OT_render(_Step):
                                      progress=lambda what, k, total, s: wm.progress_update(k))
         finally:
             wm.progress_end()
-        times = info["seconds_per_frame"]
-        return "rendered %d images (%.2f s per frame)" % (len(times), sum(times) / max(1, len(times)))
+        return steps.render_report(info)
 
 
 class SFMEVAL_OT_export_gt(_Step):
@@ -254,9 +275,9 @@ class SFMEVAL_OT_generate_all(_Step):
         steps.step_setup_scene(cfg)
         steps.step_setup_camera(cfg)
         steps.step_animate(cfg)
-        steps.step_render(cfg, out)
+        level, msg = steps.render_report(steps.step_render(cfg, out))
         steps.step_export(cfg, out)
-        return "dataset written to %s" % out
+        return level, "dataset written to %s; %s" % (out, msg)
 
 
 class SFMEVAL_OT_load_preset(bpy.types.Operator):
@@ -405,6 +426,12 @@ class SFMEVAL_PT_panel(bpy.types.Panel):
         row.prop(p, "depth")
         row.prop(p, "masks")
         box.prop(p, "colmap_gt")
+        sub = box.box()
+        sub.label(text="Objects sfmeval did not make", icon="OUTLINER_COLLECTION")
+        sub.prop(p, "keep_other_objects")
+        sub.prop(p, "keep_other_lights")
+        for treatment, line in other_objects_lines(context.scene):
+            sub.label(text=line, icon="HIDE_ON" if treatment == "hidden" else "HIDE_OFF")
         box.operator("sfmeval.render", icon="RENDER_ANIMATION")
         box.operator("sfmeval.export_gt", icon="EXPORT")
         lay.separator()
