@@ -201,26 +201,44 @@ def render_report(info):
     return level, "; ".join(parts)
 
 
+class _Hiding:
+    """What :func:`other_objects_hidden` yields: the ``other_objects`` record, and ``check()``
+    to call after every frame change."""
+
+    def __init__(self, record, hidden):
+        self.record, self.hidden = record, hidden
+
+    def check(self):
+        """A keyframe or driver on an object's render visibility overrides the hiding at each
+        frame change (and in the render itself): fail then rather than render it."""
+        for o in self.hidden:
+            if not o.hide_render:
+                raise GenerationError(
+                    "the render visibility of %r is animated (keyframes or a driver on 'Disable "
+                    "in Renders'), so sfmeval cannot hide it: remove them, delete the object or "
+                    "keep other objects as context" % o.name)
+
+
 @contextlib.contextmanager
 def other_objects_hidden(scene, cfg):
     """Hide the objects sfmeval did not make from rendering (``hide_render``) for the duration
     of the block, unless they are kept as context; every object's own ``hide_render`` is
-    restored afterwards, also when rendering fails. Yields the ``other_objects`` record."""
-    record = other_objects_record(scene, cfg)
-    hidden = [o for o, t in other_objects(scene, cfg) if t == "hidden"]
-    done = []
+    restored afterwards, also when rendering fails. Yields a :class:`_Hiding`."""
+    hiding = _Hiding(other_objects_record(scene, cfg), [])
     try:
-        for o in hidden:
+        for o, t in other_objects(scene, cfg):
+            if t != "hidden":
+                continue
             try:
                 o.hide_render = True
             except (AttributeError, TypeError, RuntimeError):
                 raise GenerationError(
                     "cannot hide %r from rendering (linked from a library?): make it local, "
                     "delete it or keep other objects as context" % o.name) from None
-            done.append(o)
-        yield record
+            hiding.hidden.append(o)
+        yield hiding
     finally:
-        for o in done:
+        for o in hiding.hidden:
             o.hide_render = False
 
 
@@ -717,9 +735,10 @@ def step_render(cfg, out_dir, progress=None, frames=None):
     aux_time = 0.0
     without_object = None                     # unknown without a depth/mask pass
     # Objects sfmeval did not make stay out of every render unless kept as context.
-    with other_objects_hidden(scene, cfg) as others:
+    with other_objects_hidden(scene, cfg) as hiding:
         for k, m in enumerate(meta):
             scene.frame_set(m["frame"])
+            hiding.check()
             path = os.path.join(img_dir, m["name"])
             t0 = time.perf_counter()
             if pp_on:  # render losslessly, then blur/noise into the configured format
@@ -740,7 +759,7 @@ def step_render(cfg, out_dir, progress=None, frames=None):
                 progress("render", k + 1, len(meta), times[-1])
         if cfg["outputs"]["depth"] or cfg["outputs"]["masks"]:
             t0 = time.perf_counter()
-            without_object = render_aux(cfg, out_dir, meta, progress)
+            without_object = render_aux(cfg, out_dir, meta, progress, hiding.check)
             aux_time = time.perf_counter() - t0
     info = {"postprocess": {"applied": pp_on, "blur_sigma": cfg["postprocess"]["blur_sigma"],
                             "noise_sigma": cfg["postprocess"]["noise_sigma"],
@@ -748,7 +767,7 @@ def step_render(cfg, out_dir, progress=None, frames=None):
                             "order": "blur, then noise, on the 8-bit render, before EXIF"},
             "seconds_per_frame": times, "aux_seconds_total": aux_time, "denoise_used": denoise_used,
             "denoise_available": compat.oidn_available(), "frames": len(meta),
-            "other_objects": others, "views_without_object": without_object}
+            "other_objects": hiding.record, "views_without_object": without_object}
     store(scene, "render_info", info)
     return info
 
@@ -768,7 +787,7 @@ def _aux_material():
     return mat
 
 
-def render_aux(cfg, out_dir, meta, progress=None):
+def render_aux(cfg, out_dir, meta, progress=None, after_frame=None):
     """Depth (float32 .npy, metres along the optical axis, 0 = no object) and masks (PNG).
 
     One extra Cycles pass per view: every surface replaced by an emission of its camera-space Z
@@ -777,7 +796,8 @@ def render_aux(cfg, out_dir, meta, progress=None):
     Other objects kept as context are holdouts: they hide the object behind them (depth 0,
     mask 0, as in the images) but are never object themselves.
 
-    Returns the names of the views in which no pixel shows the object."""
+    `after_frame()` runs after every frame change. Returns the names of the views in which no
+    pixel shows the object."""
     import numpy as np
     scene = bpy.context.scene
     vl = bpy.context.view_layer
@@ -820,6 +840,8 @@ def render_aux(cfg, out_dir, meta, progress=None):
         w, h = r.resolution_x, r.resolution_y
         for k, m in enumerate(meta):
             scene.frame_set(m["frame"])
+            if after_frame:
+                after_frame()
             _render_to(scene, tmp)
             img = bpy.data.images.load(tmp, check_existing=False)
             try:

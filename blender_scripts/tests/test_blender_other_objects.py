@@ -4,8 +4,8 @@ on a tiny config (2 views at 160×90, 4 spp, PNG), several times in one Blender 
 
 - default: the Cube and the Light are hidden while rendering, so images, masks, depth and
   ground_truth.glb equal those rendered after deleting them (the reference); their hide_render
-  is restored, even when the render fails; dataset.json lists them; the panel and the operator
-  say what was hidden;
+  is restored, even when the render fails; a keyframed hide_render (which would override the
+  hiding) is refused; dataset.json lists them; the panel and the operator say what was hidden;
 - keep as context, the Cube flattened into a slab under the object: the slab is in the images
   (they differ from the reference), masks and depth are still the object's alone;
 - keep as context, the default 2 m Cube around the object: it hides the object in every view,
@@ -106,6 +106,16 @@ except RuntimeError as exc:
     out["fail_result"] = str(exc)
 out["state"]["fail"] = state()
 
+# keyframed render visibility would override the hiding: refused before the first image
+cube.keyframe_insert("hide_render", frame=1)
+p.out_dir = os.path.join(base, "animated")
+try:
+    out["animated_result"] = sorted(bpy.ops.sfmeval.render())
+except RuntimeError as exc:
+    out["animated_result"] = str(exc)
+cube.animation_data_clear()
+out["state"]["animated"] = state()
+
 p.keep_other_objects = True
 dataset("context_around")                   # the 2 m default Cube encloses the 1 m object
 lo, hi = steps.bbox(steps.evaluated_world_vertices(steps.get_object())[0])
@@ -167,7 +177,7 @@ def test_addon_hides_objects_it_did_not_make(tmp_path, blender):
     sys.stderr.write("\n[other objects, %s] %.1f s\n" % (blender, time.perf_counter() - t0))
 
     # The user's scene is left as it was: hide_render, membership, selection, holdout.
-    for name in ("default", "fail", "context_around", "context_slab", "lights"):
+    for name in ("default", "fail", "animated", "context_around", "context_slab", "lights"):
         st = res["state"][name]
         assert st["cube_hide_render"] is False and st["light_hide_render"] is False, (name, st)
         assert st["cube_in_scene"] and st["light_in_scene"] and st["holdout"] is False, (name, st)
@@ -176,6 +186,8 @@ def test_addon_hides_objects_it_did_not_make(tmp_path, blender):
     failed = str(base / "fail" / "images" / "0001.png")
     assert res["fail_result"].startswith("Error: rendering %s failed: " % failed), res["fail_result"]
     assert os.path.isfile(base / "fail" / "images" / "0000.png")  # the first view was rendered
+    assert res["animated_result"].startswith("Error: the render visibility of 'Cube' is animated")
+    assert os.listdir(base / "animated" / "images") == []
 
     rgb_ref, mask_ref, depth_ref = _images(base / "reference")
     v_ref, _ = glb_vertices(str(base / "reference" / "ground_truth.glb"))
