@@ -1,24 +1,40 @@
 //! # sfmeval core
 //!
 //! Measures a Structure-from-Motion reconstruction against ground truth: read (PLY, glTF/GLB,
-//! OBJ) from bytes, align (a given similarity, more in [`align`] later), crop, compute exact
+//! OBJ, SfM models) from bytes, align ([`align`]), crop, compute exact
 //! point-to-triangle (or nearest-neighbour) accuracy and sampled completeness, statistics,
-//! precision/recall/F-score, and the `sfmeval.report/1` report.
+//! precision/recall/F-score, and the `sfmeval.report/2` report.
 //!
 //! No filesystem, no printing, no threads unless the `parallel` feature is on; compiles to
 //! `wasm32-unknown-unknown`. Errors are typed ([`Error`]); input never causes a panic.
 //!
+//! Every front end makes the same request: a [`dataset::Dataset`] (the ground truth, read
+//! through a [`files::FileSource`]: a folder on disk, dropped files, or a map of named bytes), a
+//! reconstruction, and a [`pipeline::EvalRequest`] (alignment, measurement and pose options).
+//!
 //! ```
-//! use sfmeval::{evaluate::*, geometry::*, progress::NoProgress};
-//! let gt = GroundTruth::Mesh(TriangleMesh {
-//!     vertices: vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]],
-//!     triangles: vec![[0, 1, 2]],
-//! });
-//! let recon = PointCloud { points: vec![[0.2, 0.2, 0.1], [0.1, 0.1, -0.3]], colors: None };
-//! let options = EvalOptions { samples: 1000, ..Default::default() };
-//! let prepared = PreparedGroundTruth::new(&gt, options.samples, options.seed, &NoProgress).unwrap();
-//! let eval = evaluate(&prepared, &recon, &AlignmentInput::none(), &options, &InputInfo::default(), &NoProgress).unwrap();
-//! assert!((eval.report.accuracy.stats.mean - 0.2).abs() < 1e-12);
+//! use std::collections::BTreeMap;
+//! use sfmeval::align::AlignRequest;
+//! use sfmeval::dataset::{Dataset, DatasetPaths};
+//! use sfmeval::evaluate::EvalOptions;
+//! use sfmeval::pipeline::{self, EvalRequest};
+//! use sfmeval::progress::NoProgress;
+//!
+//! let files = BTreeMap::from([
+//!     ("gt.obj".to_string(), b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n".to_vec()),
+//!     ("cloud.ply".to_string(),
+//!      b"ply\nformat ascii 1.0\nelement vertex 2\nproperty float x\nproperty float y\nproperty float z\nend_header\n0.2 0.2 0.1\n0.1 0.1 -0.3\n".to_vec()),
+//! ]);
+//! let mut dataset = Dataset::read(&files, &DatasetPaths::ground_truth("gt.obj")).unwrap();
+//! let cloud = BTreeMap::from([("cloud.ply".to_string(), files["cloud.ply"].clone())]);
+//! let recon = pipeline::read_reconstruction("cloud.ply", &cloud).unwrap();
+//! let request = EvalRequest {
+//!     align: AlignRequest::none(),
+//!     eval: EvalOptions { samples: 1000, ..Default::default() },
+//!     ..Default::default()
+//! };
+//! let eval = pipeline::run(&mut dataset, &recon, &request, &NoProgress).unwrap();
+//! assert!((eval.report.accuracy.stats.mean - 0.2).abs() < 1e-7);
 //! ```
 
 pub mod align;
