@@ -3,7 +3,8 @@
 # then runs the wasm-bindgen tests (Node and headless Chromium), the packed npm tarball in Node
 # and in a bundler-free page in Chromium (report byte for byte the CLI's), every alignment path
 # through the npm package in Node against the CLI (byte for byte), and the page end to end in
-# Chromium via playwright-core.
+# Chromium via playwright-core (tests/browser/e2e.mjs: results equal the CLI's; tests/browser/ux.mjs:
+# layout at 1366×768 and 1920×1080, errors in view, keyboard, axe-core, cancel).
 # SFMEVAL_BENCH=1 also runs the speed benchmarks (bench/data; not tests): whole eval in the page,
 # and per operation in Node (tests/browser/bench-ops.mjs).
 # Ends with "N passed, N failed".
@@ -31,7 +32,7 @@ fi
 tail -1 "$log/build.log"
 cargo build --release --locked -p sfmeval-cli >"$log/cli.log" 2>&1 || fail "cli build" "$log/cli.log"
 echo "build: $((SECONDS - t)) s"
-(cd tests/browser && [ -d node_modules ] || npm ci --no-audit --no-fund --silent)
+(cd tests/browser && [ -f node_modules/axe-core/axe.min.js ] || npm ci --no-audit --no-fund --silent)
 
 # wasm-bindgen-test: one build (cargo runs it in Node), then the same test module in headless
 # Chromium through the runner directly.
@@ -89,6 +90,13 @@ rc=$?
 count "$log/e2e.log"
 [ $rc -ne 0 ] && ! grep -q '^FAILED' "$log/e2e.log" && fail "e2e" "$log/e2e.log"
 echo "e2e: $((SECONDS - t)) s (screenshots in $out)"
+# the page as a person uses it: layout at two window sizes, errors, keyboard, axe-core, cancel
+t=$SECONDS
+node tests/browser/ux.mjs --url "http://127.0.0.1:$port/" --out "$out" >"$log/ux.log" 2>&1
+rc=$?
+count "$log/ux.log"
+[ $rc -ne 0 ] && ! grep -q '^FAILED' "$log/ux.log" && fail "ux" "$log/ux.log"
+echo "ux: $((SECONDS - t)) s (screenshots ux-*.png in $out)"
 
 if [ "${SFMEVAL_BENCH:-0}" = 1 ]; then
   node tests/browser/bench.mjs --url "http://127.0.0.1:$port/" --cli target/release/sfmeval 2>&1 | tee "$log/bench.log"

@@ -12,22 +12,57 @@ const state = {
   pendingRecon: null,
   picking: false,
   transformText: '',
+  running: false, // an evaluation is under way
+  restoring: false, // a fresh worker is reloading the inputs after a cancel
+  loading: 0, // loads under way
+  shownResult: false, // results are on screen (current or stale)
 };
+/** The files behind each loaded input, to reload them into a fresh worker after a cancel. */
+const sources = { gt: null, recon: null, cams: null, depth: null };
 
 // ---- worker ----------------------------------------------------------------------------
-const worker = new Worker(new URL('./worker.js', import.meta.url), { type: 'module' });
+/** The rejection of calls that were under way when the worker was stopped (Cancel). */
+class Cancelled extends Error {
+  constructor() { super('cancelled'); this.name = 'Cancelled'; }
+}
+let worker = null;
 let nextId = 1;
 const pending = new Map();
-worker.onmessage = (ev) => {
-  const m = ev.data;
-  if (m.type === 'progress') { showProgress(m.stage, m.done, m.total); return; }
-  const p = pending.get(m.id);
-  if (!p) return;
-  pending.delete(m.id);
-  if (m.ok) p.resolve(m); else p.reject(new Error(m.error));
-  if (m.fatal) document.body.dataset.fatal = '1';
-};
-worker.onerror = (e) => { showError(`worker failed: ${e.message || 'unknown error'}`); };
+function startWorker() {
+  worker = new Worker(new URL('./worker.js', import.meta.url), { type: 'module' });
+  worker.onmessage = (ev) => {
+    const m = ev.data;
+    if (m.type === 'progress') { if (state.running) showProgress(m.stage, m.done, m.total); return; }
+    const p = pending.get(m.id);
+    if (!p) return;
+    pending.delete(m.id);
+    if (m.ok) p.resolve(m); else p.reject(new Error(m.error));
+    if (m.fatal) document.body.dataset.fatal = '1';
+  };
+  worker.onerror = (e) => { showError(`worker failed: ${e.message || 'unknown error'}`); };
+}
+startWorker();
+/**
+ * Stops the worker (and whatever it computes), rejects its pending calls with `Cancelled`,
+ * starts a fresh one and reloads the inputs into it from their files.
+ */
+async function restartWorker() {
+  worker.terminate();
+  const stopped = [...pending.values()];
+  pending.clear();
+  for (const p of stopped) p.reject(new Cancelled());
+  startWorker();
+  await call('init');
+  const reload = async (type, src, extra = {}) => {
+    if (!src) return;
+    const { files, transfer } = await readFiles(src.files);
+    await call(type, { files, ...extra }, transfer);
+  };
+  await reload('loadGt', sources.gt);
+  await reload('loadRecon', sources.recon, { name: sources.recon && sources.recon.name });
+  await reload('loadCameras', sources.cams);
+  await reload('loadDepth', sources.depth);
+}
 function call(type, payload = {}, transfer = []) {
   const id = nextId++;
   return new Promise((resolve, reject) => {
@@ -37,9 +72,44 @@ function call(type, payload = {}, transfer = []) {
 }
 
 // ---- UI helpers ------------------------------------------------------------------------
-function showError(msg) {
+/**
+ * Shows `msg` in the banner under the header (always in view; empty hides it). `target` is
+ * the id of the control the error belongs to: the banner offers to show it.
+ */
+let errorTarget = null;
+function showError(msg, target = null) {
   $('error').textContent = msg;
-  $('error').style.display = msg ? 'block' : 'none';
+  $('banner').hidden = !msg;
+  errorTarget = msg ? target : null;
+  $('banner-goto').hidden = !errorTarget;
+}
+$('banner-close').onclick = () => {
+  const t = errorTarget && $(errorTarget);
+  showError('');
+  if (t) t.focus(); else $('run').focus();
+};
+$('banner-goto').onclick = () => {
+  const t = errorTarget && $(errorTarget);
+  if (!t) return;
+  (t.closest('.drop') || t).scrollIntoView({ block: 'nearest' });
+  t.focus();
+};
+/** The line under the run button: the last run's outcome, or what is missing to run. */
+let runNote = { text: '', error: false };
+function setRunNote(text, error = false) { runNote = { text, error }; updateRunButton(); }
+function updateRunButton() {
+  const ready = !!(state.gt && state.recon);
+  $('run').disabled = state.running || state.restoring || state.loading > 0 || !ready;
+  $('cancel').hidden = !state.running;
+  $('cancel').disabled = state.restoring;
+  document.body.classList.toggle('busy', state.running || state.loading > 0);
+  let text = runNote.text;
+  if (!text && !ready && !state.loading) {
+    const missing = [!state.recon && 'a reconstruction', !state.gt && 'a ground truth'].filter(Boolean);
+    text = `To evaluate, load ${missing.join(' and ')} (or try the demo).`;
+  }
+  $('run-status').textContent = text;
+  $('run-status').classList.toggle('error', runNote.error);
 }
 function showProgress(stage, done, total) {
   const frac = total > 0 ? done / total : 0;
@@ -48,9 +118,10 @@ function showProgress(stage, done, total) {
   $('progress-text').textContent = stage ? `${stage} ${total > 1 ? `${done}/${total}` : ''}` : '';
 }
 function hideProgress() { $('progress').style.display = 'none'; }
+/** Counts a load under way (true) or finished (false). */
 function setBusy(b) {
-  document.body.classList.toggle('busy', b);
-  $('run').disabled = b || !(state.gt && state.recon);
+  state.loading = Math.max(0, state.loading + (b ? 1 : -1));
+  updateRunButton();
 }
 function download(name, data, type) {
   const blob = data instanceof Blob ? data : new Blob([data], { type });
@@ -101,87 +172,166 @@ async function readFiles(fileList) {
   return { files, transfer, folder };
 }
 
+const INPUT_LABEL = { gt: 'ground truth', recon: 'reconstruction', cams: 'ground-truth cameras', depth: 'depth maps' };
+const INPUT_CONTROLS = { gt: ['file-gt'], recon: ['file-recon', 'dir-recon'], cams: ['file-cams'], depth: ['file-depth', 'dir-depth'] };
+/**
+ * The info line beside an input: what is loaded, or why nothing is (`error`: marked in red,
+ * the drop zone outlined, the file inputs `aria-invalid`). `notes` are the loader's warnings.
+ */
+function setInputInfo(kind, text, { error = false, notes } = {}) {
+  const info = $(`info-${kind}`);
+  info.textContent = text;
+  info.classList.toggle('error', error);
+  $(`drop-${kind}`).classList.toggle('failed', error);
+  for (const id of INPUT_CONTROLS[kind]) {
+    if (error) $(id).setAttribute('aria-invalid', 'true'); else $(id).removeAttribute('aria-invalid');
+  }
+  const box = $(`notes-${kind}`);
+  if (box && notes !== undefined) box.innerHTML = (notes || []).map((w) => `<div class="warn">warning: ${esc(w)}</div>`).join('');
+}
+/** A failed load: said beside the input and in the banner (which offers to show the input). */
+function inputFailed(kind, e) {
+  const label = INPUT_LABEL[kind];
+  const msg = e.message.startsWith(label) ? e.message : `${label}: ${e.message}`;
+  setInputInfo(kind, `✗ not loaded — ${e.message}`, { error: true, notes: [] });
+  showError(msg, INPUT_CONTROLS[kind][0]);
+}
+
+/**
+ * Marks the results on screen as no longer current (dimmed under a note saying `why`),
+ * disables their downloads and hides the colour bar. A new evaluation clears it.
+ */
+function markStale(why) {
+  if (!state.shownResult) return;
+  $('results').classList.add('stale');
+  $('align-result').classList.add('stale');
+  $('stale-note').hidden = false;
+  $('stale-note').textContent = `Out of date: ${why}. These are the previous run's results; press Evaluate for new ones.`;
+  for (const b of ['dl-report', 'dl-ply', 'dl-csv']) $(b).disabled = true;
+  $('clip').disabled = true;
+  $('colorbar').style.display = 'none';
+  document.body.dataset.stale = '1';
+  setRunNote('');
+  if (state.result && state.recon) refreshPoints(); // without the error colours
+}
+function clearStale() {
+  $('results').classList.remove('stale');
+  $('align-result').classList.remove('stale');
+  $('stale-note').hidden = true;
+  $('stale-note').textContent = '';
+  $('clip').disabled = false;
+  delete document.body.dataset.stale;
+}
+
 async function loadGt(fileList) {
   showError('');
-  const { files, transfer } = await readFiles(fileList);
   setBusy(true);
-  $('info-gt').textContent = 'reading…';
+  setInputInfo('gt', 'reading…');
   try {
+    const { files, transfer } = await readFiles(fileList);
     const gt = await call('loadGt', { files }, transfer);
     state.gt = gt;
+    sources.gt = { files: Array.from(fileList) };
     state.beside = null;
     state.result = null;
     viewer.setCoverage(null);
     viewer.setGroundTruth(gt.vertices, gt.triangles, gt.bounds);
-    $('info-gt').textContent = `${gt.name} (${gt.format}): ${gt.vertexCount} vertices, ${gt.triangleCount} triangles`;
-    showWarnings(gt.warnings);
+    setInputInfo('gt', `${gt.name} (${gt.format}): ${gt.vertexCount} vertices, ${gt.triangleCount} triangles`, { notes: gt.warnings });
+    markStale(`the ground truth is now '${gt.name}'`);
     refreshPoints();
+    return true;
   } catch (e) {
     state.gt = null;
-    $('info-gt').textContent = '—';
-    showError(e.message);
+    sources.gt = null;
+    state.result = null;
+    viewer.setCoverage(null);
+    viewer.clearGroundTruth();
+    inputFailed('gt', e);
+    markStale('the ground truth failed to load');
+    refreshPoints();
+    return false;
   } finally { setBusy(false); }
 }
 
 async function loadRecon(fileList, name) {
   showError('');
-  const { files, transfer, folder } = await readFiles(fileList);
-  const names = Object.keys(files);
-  // The report names a reconstruction as the CLI does: the file, or the model's folder.
-  if (!name) name = folder ?? (names.length === 1 ? names[0] : 'model');
   setBusy(true);
-  $('info-recon').textContent = 'reading…';
+  setInputInfo('recon', 'reading…');
   try {
+    const { files, transfer, folder } = await readFiles(fileList);
+    const names = Object.keys(files);
+    // The report names a reconstruction as the CLI does: the file, or the model's folder.
+    if (!name) name = folder ?? (names.length === 1 ? names[0] : 'model');
     const r = await call('loadRecon', { files, name }, transfer);
     state.recon = r;
+    sources.recon = { files: Array.from(fileList), name };
     state.beside = null;
     state.result = null;
     viewer.setCoverage(null);
     state.pairs = [];
     updatePairs();
-    $('info-recon').textContent = `${r.name} (${r.format}): ${r.count} points${r.images ? `, ${r.images} images` : ''}`;
-    showWarnings(r.warnings);
+    setInputInfo('recon', `${r.name} (${r.format}): ${r.count} points${r.images ? `, ${r.images} images` : ''}`, { notes: r.warnings });
+    markStale(`the reconstruction is now '${r.name}'`);
     refreshPoints();
+    return true;
   } catch (e) {
     state.recon = null;
-    $('info-recon').textContent = '—';
-    showError(e.message);
+    sources.recon = null;
+    state.result = null;
+    state.shown = null;
+    viewer.setCoverage(null);
+    viewer.clearPoints();
+    state.pairs = [];
+    updatePairs();
+    inputFailed('recon', e);
+    markStale('the reconstruction failed to load');
+    scheduleKept();
+    return false;
   } finally { setBusy(false); }
 }
 
 async function loadCams(fileList) {
   showError('');
-  const { files, transfer } = await readFiles(fileList);
+  setBusy(true);
   try {
+    const { files, transfer } = await readFiles(fileList);
     const c = await call('loadCameras', { files }, transfer);
     state.camerasName = Object.keys(files)[0];
-    $('info-cams').textContent = `${state.camerasName}: ${c.images} images`;
+    sources.cams = { files: Array.from(fileList) };
+    setInputInfo('cams', `${state.camerasName}: ${c.images} images`);
+    markStale(`the ground-truth cameras are now '${state.camerasName}'`);
+    return true;
   } catch (e) {
-    $('info-cams').textContent = '—';
-    showError(e.message);
-  }
+    // nothing half-loaded: the page and the worker both have no cameras now
+    state.camerasName = null;
+    sources.cams = null;
+    await call('clearCameras').catch(() => {});
+    inputFailed('cams', e);
+    markStale('the ground-truth cameras failed to load');
+    return false;
+  } finally { setBusy(false); }
 }
 
 async function loadDepth(fileList) {
   showError('');
   const npy = Array.from(fileList).filter((f) => /\.npy$/i.test(f.name));
-  if (!npy.length) { showError('depth maps: no .npy file among the dropped files'); return; }
-  const { files, transfer } = await readFiles(npy);
-  $('info-depth').textContent = 'reading…';
+  if (!npy.length) { inputFailed('depth', new Error('no .npy file among the dropped files')); return; }
+  setBusy(true);
+  setInputInfo('depth', 'reading…');
   try {
+    const { files, transfer } = await readFiles(npy);
     const d = await call('loadDepth', { files }, transfer);
     state.depthCount = d.count;
-    $('info-depth').textContent = `${d.count} depth maps${d.checked ? '' : ' (checked against cameras.json when evaluating)'}`;
+    sources.depth = { files: npy };
+    setInputInfo('depth', `${d.count} depth maps${d.checked ? '' : ' (checked against cameras.json when evaluating)'}`);
+    markStale(`${d.count} depth maps were loaded`);
   } catch (e) {
     state.depthCount = 0;
-    await call('clearDepth');
-    $('info-depth').textContent = '—';
-    showError(e.message);
-  }
-}
-
-function showWarnings(list) {
-  $('warnings').innerHTML = (list || []).map((w) => `<div class="warn">warning: ${esc(w)}</div>`).join('');
+    sources.depth = null;
+    await call('clearDepth').catch(() => {});
+    inputFailed('depth', e);
+    markStale('the depth maps failed to load');
+  } finally { setBusy(false); }
 }
 
 $('dir-recon').addEventListener('change', (e) => handleFiles('recon', e.target.files));
@@ -196,7 +346,7 @@ for (const [kind, input] of [['recon', 'file-recon'], ['gt', 'file-gt'], ['cams'
     zone.classList.remove('over');
     const entries = Array.from(e.dataTransfer.items || []).map((i) => i.webkitGetAsEntry && i.webkitGetAsEntry()).filter(Boolean);
     if ((kind === 'recon' || kind === 'depth') && entries.length === 1 && entries[0].isDirectory) {
-      try { handleFiles(kind, await folderFiles(entries[0])); } catch (err) { showError(err.message); }
+      try { handleFiles(kind, await folderFiles(entries[0])); } catch (err) { inputFailed(kind, err); }
     } else {
       handleFiles(kind, e.dataTransfer.files);
     }
@@ -231,10 +381,24 @@ async function folderFiles(dir) {
 function handleFiles(kind, files) {
   if (!files || !files.length) return;
   const p = kind === 'gt' ? loadGt(files) : kind === 'recon' ? loadRecon(files) : kind === 'depth' ? loadDepth(files) : loadCams(files);
-  p.catch((e) => showError(e.message));
+  p.catch((e) => inputFailed(kind, e));
 }
-$('clear-cams').onclick = async () => { await call('clearCameras'); state.camerasName = null; $('info-cams').textContent = '—'; };
-$('clear-depth').onclick = async () => { await call('clearDepth'); state.depthCount = 0; $('info-depth').textContent = '—'; };
+$('clear-cams').onclick = async () => {
+  await call('clearCameras');
+  const had = !!sources.cams;
+  state.camerasName = null;
+  sources.cams = null;
+  setInputInfo('cams', '—');
+  if (had) markStale('the ground-truth cameras were cleared');
+};
+$('clear-depth').onclick = async () => {
+  await call('clearDepth');
+  const had = !!sources.depth;
+  state.depthCount = 0;
+  sources.depth = null;
+  setInputInfo('depth', '—');
+  if (had) markStale('the depth maps were cleared');
+};
 
 // ---- demo -------------------------------------------------------------------------------
 async function fetchFile(name) {
@@ -248,19 +412,22 @@ $('demo').onclick = async () => {
     const m = await (await fetch('demo/manifest.json')).json();
     const gtFiles = await Promise.all([].concat(m.ground_truth).map(fetchFile));
     const reconFiles = await Promise.all([].concat(m.reconstruction).map(fetchFile));
-    await loadGt(gtFiles);
-    await loadRecon(reconFiles, m.reconstruction_name);
-    if (m.gt_cameras) await loadCams([await fetchFile(m.gt_cameras)]);
-    else await $('clear-cams').onclick();
+    // stop at the first failure, so that its message stays in the banner
+    if (!await loadGt(gtFiles) || !await loadRecon(reconFiles, m.reconstruction_name)) return;
+    if (m.gt_cameras) {
+      if (!await loadCams([await fetchFile(m.gt_cameras)])) return;
+    } else {
+      await $('clear-cams').onclick();
+    }
     if (m.transform) {
       const t = await (await fetchFile(m.transform)).text();
-      $('transform').value = t;
+      $('transform').value = alignedTransform(t);
       document.querySelector('input[name=align][value=given]').checked = true;
     } else {
       document.querySelector(`input[name=align][value="${m.align ?? 'auto'}"]`).checked = true;
     }
     refreshPoints();
-  } catch (e) { showError(e.message); }
+  } catch (e) { showError(`demo: ${e.message}`, 'demo'); }
 };
 
 // ---- alignment --------------------------------------------------------------------------
@@ -268,8 +435,20 @@ const alignMethod = () => document.querySelector('input[name=align]:checked').va
 const viewMode = () => document.querySelector('input[name=view]:checked').value;
 $('file-transform').addEventListener('change', async (e) => {
   const f = e.target.files[0];
-  if (f) { $('transform').value = await f.text(); document.querySelector('input[name=align][value=given]').checked = true; refreshPoints(); }
+  if (f) { $('transform').value = alignedTransform(await f.text()); document.querySelector('input[name=align][value=given]').checked = true; refreshPoints(); }
 });
+/**
+ * A loaded transform's text as 4 rows of 4 right-aligned numbers, each printed exactly
+ * (JavaScript's shortest round-trip form: the same doubles as the file); text that is not
+ * 16 numbers stays as it is.
+ */
+export function alignedTransform(text) {
+  const m = parseMatrixLoose(text);
+  if (!m) return text;
+  const cells = m.map((v) => (Object.is(v, -0) ? '-0' : String(v)));
+  const w = Math.max(...cells.map((c) => c.length));
+  return [0, 1, 2, 3].map((r) => cells.slice(4 * r, 4 * r + 4).map((c) => c.padStart(w)).join('  ')).join('\n');
+}
 $('transform').addEventListener('input', () => refreshPoints());
 for (const r of document.querySelectorAll('input[name=align], input[name=view]')) r.addEventListener('change', () => refreshPoints());
 for (const r of document.querySelectorAll('input[name=view]')) r.addEventListener('change', () => viewer.fit(viewMode() === 'before'));
@@ -333,7 +512,7 @@ function refreshPoints() {
   if (!pos) return;
   const f32 = new Float32Array(pos);
   let colors = null;
-  const useHeat = state.result && $('heat').checked && viewMode() === 'after' && !state.picking;
+  const useHeat = state.result && !document.body.dataset.stale && $('heat').checked && viewMode() === 'after' && !state.picking;
   if (useHeat) colors = state.result.colors;
   else if (state.recon.colors) colors = state.recon.colors;
   viewer.setPoints(f32, colors);
@@ -385,9 +564,115 @@ function onPick(hit) {
 function showStages(report) {
   const a = report.alignment;
   const rows = (a.stages || []).map((s) => `<tr><td>${esc(s.method)}</td><td>${g(s.scale)}</td><td>${s.rmse == null ? '—' : g(s.rmse)}</td><td>${s.inlier_ratio == null ? '—' : s.inlier_ratio.toFixed(4)}</td><td>${s.iterations}</td><td>${s.converged ? 'yes' : 'no'}</td></tr>`).join('');
-  const m = a.gt_from_recon.map((r) => r.map((v) => g(v)).join(' ')).join('\n');
-  $('stages').innerHTML = `<tr><th>stage</th><th>scale</th><th>rmse</th><th>inliers</th><th>iter</th><th>conv.</th></tr>${rows}
-    <tr><td colspan="6"><pre id="matrix" title="gt_from_recon">${esc(m)}</pre></td></tr>`;
+  $('stages').innerHTML = `<tr><th>stage</th><th>scale</th><th>rmse</th><th>inliers</th><th>iter</th><th>conv.</th></tr>${rows}`;
+  $('matrix').textContent = matrixText(a.gt_from_recon);
+  $('matrix').title = `gt_from_recon, full precision:\n${a.gt_from_recon.map((r) => r.join(' ')).join('\n')}`;
+  $('matrix-wrap').hidden = false;
+}
+
+/**
+ * A 4×4 matrix as an aligned monospace grid: 4 right-aligned columns, the same number of
+ * decimals everywhere (6, fewer when the largest entry needs more integer digits).
+ */
+export function matrixText(m) {
+  const flat = m.flat();
+  const big = Math.max(...flat.map((v) => Math.abs(v)).filter(Number.isFinite), 0);
+  const intDigits = big >= 1 ? Math.floor(Math.log10(big)) + 1 : 1;
+  const decimals = Math.max(2, Math.min(6, 9 - intDigits));
+  const cells = flat.map((v) => (v === 0 ? 0 : v).toFixed(decimals));
+  const w = Math.max(...cells.map((c) => c.length));
+  const rows = [];
+  for (let r = 0; r < 4; r++) rows.push(cells.slice(4 * r, 4 * r + 4).map((c) => c.padStart(w)).join('  '));
+  return rows.join('\n');
+}
+
+/**
+ * The report's warnings for the page: alignment stage notes (written by the core as
+ * "alignment (STAGE): NOTE; NOTE...") worded for users and split into routine information
+ * and doubtful results (warnings, with the reason); every other warning stays a warning.
+ * Also notes the final stage's fit: a warning when it did not settle with a loose fit
+ * (rmse > 0.5 % of the GT diagonal or < 50 % of the points within its gate) or fitted few
+ * points; information when it did not settle but fits tightly. Returns [{level, html}].
+ */
+export function reportNotes(rep) {
+  const out = [];
+  const diag = rep.inputs && rep.inputs.ground_truth ? rep.inputs.ground_truth.diagonal : 0;
+  for (const w of rep.warnings || []) {
+    const m = /^alignment \(([^)]*)\): (.*)$/s.exec(w);
+    if (!m) { out.push({ level: 'warn', html: `warning: ${esc(w)}` }); continue; }
+    const refined = !!(rep.alignment && rep.alignment.stages && rep.alignment.stages.some((s) => s.method === 'icp'));
+    for (const n of alignmentNotes(m[1], m[2], diag, refined)) out.push(n);
+  }
+  const a = rep.alignment;
+  const last = a && a.stages && a.stages[a.stages.length - 1];
+  const rejected = (rep.warnings || []).some((w) => /^alignment \(icp\): .*rejected, kept the start transform/.test(w));
+  if (last && !rejected && ['icp', 'global'].includes(last.method)) {
+    // The final stage's fit: rmse of the points inside its distance gate, share of them.
+    const ratio = last.inlier_ratio;
+    const rel = last.rmse != null && diag > 0 ? last.rmse / diag : null;
+    const name = { icp: 'ICP', global: 'global search' }[last.method];
+    const fit = `rmse ${last.rmse != null ? g(last.rmse) : '—'}${rel != null ? ` = ${(100 * rel).toPrecision(2)} % of the diagonal` : ''}${ratio != null ? `, ${(100 * ratio).toFixed(0)} % of the points within its distance gate` : ''}`;
+    if (ratio != null && ratio < FEW_INLIERS) {
+      out.push({ level: 'warn', html: `warning: ${name} fitted only ${(100 * ratio).toFixed(0)} % of the reconstruction's points <span class="why">— the others lie outside its distance gate of the ground truth (background, outliers, or part of the cloud misaligned); check the view</span>` });
+    }
+    if (!last.converged) {
+      // not settled but a tight fit on most points: the last steps are jitter, not a search
+      const tight = rel != null && rel <= TIGHT_RMSE && ratio != null && ratio >= FEW_INLIERS;
+      out.push(tight
+        ? { level: 'info', html: `alignment: ${name} stopped after ${last.iterations} iterations before its steps fell below the stopping tolerance <span class="why">— its fit is tight (${fit}), so this is unlikely to matter</span>` }
+        : { level: 'warn', html: `warning: ${name} stopped after ${last.iterations} iterations without settling, and its fit is loose (${fit}) <span class="why">— the transform may be imprecise; check the points against the ground truth in the viewer</span>` });
+    }
+  }
+  return out;
+}
+
+/** Below this share of points inside the last stage's gate, the fit is doubtful. */
+const FEW_INLIERS = 0.5;
+/** An rmse at most this fraction of the GT diagonal is a tight fit. */
+const TIGHT_RMSE = 0.005;
+
+/** The notes of one stage (see `reportNotes`), matched against what the core writes. */
+function alignmentNotes(stage, text, diag, refined) {
+  const stageName = { global: 'global shape search', icp: 'ICP refinement', cameras: 'camera-based alignment', points: 'point pairs' }[stage] || stage;
+  const pct = (v) => (diag > 0 ? ` (${(100 * v / diag).toPrecision(2)} % of the ground-truth diagonal)` : '');
+  const rules = [
+    // crates/sfmeval/src/align/global.rs
+    [/^best of (\d+) starts \(start #(\d+)\), score (\S+?)(?=; |$)/, 'info', (x) => {
+      const score = Number(x[3]);
+      return `alignment: a global shape search tried ${x[1]} starting poses; the best (#${x[2]}) scores ${esc(x[3])}${pct(score)}${refined ? ', then ICP refined it' : ''} <span class="why">— score: the mean of the smallest 80 % of distances from a subsample of the reconstruction to ground-truth surface samples, plus the same from those samples to the subsample, in ground-truth units; lower is better</span>`;
+    }],
+    [/^ambiguous: a pose (\d+)° away scores within 5 % \((\S+)\); the object may be symmetric(?=; |$)/, 'warn', (x) =>
+      `warning: the automatic alignment may have picked the wrong pose: another pose ${x[1]}° away fits almost as well (score ${esc(x[2])}, within 5 %) <span class="why">— the object may be symmetric; check the view, or give a transform or point pairs</span>`],
+    [/^(\d+) non-finite reconstruction point\(s\) ignored(?=; |$)/, 'warn', (x) =>
+      `warning: ${stageName}: ${x[1]} reconstruction point(s) with non-finite coordinates were ignored`],
+    // crates/sfmeval/src/align/icp.rs: the scale-collapse guard and the overlap check
+    [/^rejected, kept the start transform: (.*)$/s, 'warn', (x) =>
+      `warning: the ICP refinement was rejected, the previous stage's transform is used <span class="why">— ${esc(x[1])}</span>`],
+    // crates/sfmeval/src/align/auto.rs: fallbacks
+    [/^(cameras|points) stage failed \((.*?)\)(?=; |$)/s, 'warn', (x) =>
+      `warning: ${x[1] === 'cameras' ? 'the camera-based alignment' : 'the point-pair alignment'} failed <span class="why">— ${esc(x[2])}</span>`],
+    [/^fell back to (\w+)(?=; |$)/, 'warn', (x) =>
+      `warning: the alignment fell back to the ${x[1] === 'global' ? 'global shape search (no correspondences)' : esc(x[1])}`],
+    [/^ICP started from the identity \(no start transform given\)(?=; |$)/, 'warn', () =>
+      'warning: ICP started from the identity (no start transform was given) <span class="why">— it converges only when the reconstruction is already close to the ground truth</span>'],
+    // crates/sfmeval/src/align/ransac.rs
+    [/^(\d+) of (\d+) cameras are outliers \(farther than (\S+) from their ground-truth centre\)(?=; |$)/, 'warn', (x) =>
+      `warning: the camera-based alignment left out ${x[1]} of ${x[2]} cameras as outliers <span class="why">— their centres end farther than ${esc(x[3])} from the ground-truth ones</span>`],
+    [/^(\d+) camera pair\(s\) with non-finite poses skipped(?=; |$)/, 'warn', (x) =>
+      `warning: the camera-based alignment skipped ${x[1]} camera(s) with non-finite poses`],
+    [/^camera centres (fewer than 3|nearly collinear): rotation from the camera orientations, scale and translation from the centres(?=; |$)/, 'info', (x) =>
+      `alignment: the camera centres are ${esc(x[1])}, so the rotation comes from the camera orientations and the scale and translation from the centres`],
+  ];
+  const out = [];
+  let rest = text;
+  while (rest) {
+    const hit = rules.map(([re, level, f]) => [re.exec(rest), level, f]).find(([x]) => x);
+    if (!hit) { out.push({ level: 'warn', html: `warning: alignment (${esc(stage)}): ${esc(rest)}` }); break; }
+    const [x, level, f] = hit;
+    out.push({ level, html: f(x) });
+    rest = rest.slice(x[0].length).replace(/^; /, '');
+  }
+  return out;
 }
 
 // ---- crop -------------------------------------------------------------------------------
@@ -458,7 +743,7 @@ $('crop-import').addEventListener('change', async (e) => {
     $('crop-kind').value = viewer.setCropVolume(crop.volume);
     $('max-distance').value = crop.max_distance ?? '';
     scheduleKept();
-  } catch (err) { showError(`crop file '${f.name}': ${err.message}`); }
+  } catch (err) { showError(`crop file '${f.name}': ${err.message}`, 'crop-import'); }
   e.target.value = '';
 });
 
@@ -484,7 +769,8 @@ function options() {
 async function runEvaluation() {
   showError('');
   if (state.picking) $('pick').click();
-  setBusy(true);
+  state.running = true;
+  setRunNote('');
   showProgress('starting', 0, 1);
   try {
     const r = await call('evaluate', { options: options() });
@@ -499,14 +785,40 @@ async function runEvaluation() {
     $('show-coverage').checked = !!r.sampleLabels;
     viewer.setVisible('coverage', $('show-coverage').checked);
     document.body.dataset.evaluated = String(Number(document.body.dataset.evaluated || 0) + 1);
+    setRunNote(`Done in ${(r.ms / 1000).toFixed(1)} s: results on the right.`);
   } catch (e) {
-    showError(e.message);
+    if (e instanceof Cancelled) {
+      // the worker that held the previous evaluation is gone: its downloads with it
+      markStale('the last evaluation was cancelled (downloads need a new run)');
+    } else {
+      showError(`evaluation failed: ${e.message}`, 'run');
+      setRunNote('✗ The evaluation failed: see the message at the top.', true);
+    }
   } finally {
+    state.running = false;
     hideProgress();
-    setBusy(false);
+    updateRunButton();
   }
 }
 $('run').onclick = runEvaluation;
+/** Cancel: stops the worker mid-run, then reloads the inputs into a fresh one. */
+$('cancel').onclick = async () => {
+  if (!state.running || state.restoring) return;
+  state.restoring = true;
+  setRunNote('Cancelling: restarting the core and reloading the inputs…');
+  try {
+    await restartWorker();
+    setRunNote('Evaluation cancelled.');
+  } catch (e) {
+    showError(`could not reload the inputs after cancelling: ${e.message}; load them again`);
+    setRunNote('✗ Cancelled, but the inputs could not be reloaded.', true);
+  } finally {
+    state.restoring = false;
+    updateRunButton();
+    document.body.dataset.cancelled = String(Number(document.body.dataset.cancelled || 0) + 1);
+    if (!$('run').disabled) $('run').focus();
+  }
+};
 
 function statRow(label, st, extra) {
   const cells = [st.count, g(st.mean), g(st.median), g(st.rms), g(st.std), g(st.percentiles.p90), g(st.percentiles.p99), g(st.max)];
@@ -514,13 +826,15 @@ function statRow(label, st, extra) {
 }
 function showResults(r) {
   const rep = r.report;
+  state.shownResult = true;
+  clearStale();
   const i = rep.inputs;
   const c = rep.crop;
   const a = rep.alignment;
   let h = `<div class="line">${esc(i.reconstruction.name)} (${esc(i.reconstruction.format)}, ${i.reconstruction.points} points) vs ${esc(i.ground_truth.name)} (${esc(i.ground_truth.format)}, ${i.ground_truth.vertices} vertices, ${i.ground_truth.triangles} triangles, bbox diagonal <span id="diag">${g(i.ground_truth.diagonal)}</span>) — ${r.ms.toFixed(0)} ms</div>`;
   h += `<div class="line">crop <b>${esc(c.kind)}</b>: kept <b id="r-kept">${c.kept}</b>, discarded <span id="r-discarded">${c.discarded}</span> (outside volume ${c.discarded_outside_volume}, farther than max distance ${c.discarded_farther_than_max_distance})</div>`;
   h += `<div class="line">alignment <b id="r-align">${esc(a.method)}</b> (scale <span id="r-scale">${g(a.scale)}</span>${a.rmse != null ? `, rmse ${g(a.rmse)}` : ''})</div>`;
-  h += '<table id="stats"><tr><th></th><th>count</th><th>mean</th><th>median</th><th>rms</th><th>std</th><th>p90</th><th>p99</th><th>max</th><th></th></tr>';
+  h += '<table id="stats"><tr><td></td><th>count</th><th>mean</th><th>median</th><th>rms</th><th>std</th><th>p90</th><th>p99</th><th>max</th><th class="muted">notes</th></tr>';
   h += statRow('accuracy', rep.accuracy, `recon → GT, ${rep.accuracy.metric}`);
   h += statRow('completeness', rep.completeness, `GT → recon, ${rep.completeness.samples} samples`);
   if (rep.accuracy.signed) h += statRow('signed', rep.accuracy.signed, 'signed accuracy');
@@ -543,7 +857,7 @@ function showResults(r) {
     const cams = Object.entries(rep.cameras).filter(([, v]) => typeof v === 'number').map(([k, v]) => `${esc(k)} ${Number.isInteger(v) ? v : g(v)}`);
     h += `<div class="line" id="r-cameras">cameras: ${cams.join(', ')}</div>`;
   }
-  for (const w of rep.warnings) h += `<div class="warn">warning: ${esc(w)}</div>`;
+  for (const n of reportNotes(rep)) h += `<div class="${n.level}">${n.level === 'info' ? 'note: ' : ''}${n.html}</div>`;
   $('summary').innerHTML = h;
   showStages(rep);
   for (const b of ['dl-report', 'dl-ply', 'dl-csv']) $(b).disabled = false;
@@ -599,12 +913,13 @@ function drawColorbar(clip) {
   VIRIDIS.forEach((c, i) => grad.addColorStop(i / (VIRIDIS.length - 1), `rgb(${c[0]},${c[1]},${c[2]})`));
   ctx.fillStyle = grad;
   ctx.fillRect(0, 0, cv.width, cv.height);
-  $('cb-hi').textContent = `≥ ${g(clip)}`;
+  $('cb-hi').textContent = `≥ ${Number(clip.toPrecision(3))}`;
+  $('cb-hi').title = `clip ${g(clip)}: this distance and larger are yellow`;
   $('colorbar').style.display = 'flex';
 }
 $('clip').addEventListener('change', async () => {
   const clip = Number($('clip').value);
-  if (!state.result || !(clip > 0)) return;
+  if (!state.result || !(clip > 0) || document.body.dataset.stale) return;
   const { colors } = await call('colors', { clip });
   state.result.colors = colors;
   state.result.clip = clip;
@@ -638,5 +953,6 @@ call('init').then((m) => {
 }).catch((e) => showError(`could not load the WebAssembly core: ${e.message}`));
 hideProgress();
 showError('');
+updateRunButton();
 // for tests and scripting
-window.sfmeval = { state, call, currentCrop, cropText, prAt };
+window.sfmeval = { state, call, currentCrop, cropText, prAt, reportNotes, matrixText, alignedTransform };

@@ -66,6 +66,8 @@ export function curvesPlot(el, r) {
   let marked = null;
   const opts = {
     width: width(el), height: 200,
+    // a key of the three curves only: the values at τ are the slider's readout under the plot
+    legend: { live: false },
     scales: { x: { time: false }, y: { range: [0, 1] } },
     axes: [{ label: 'τ' }, {}],
     series: [{ label: 'τ' },

@@ -85,6 +85,17 @@ export class Viewer {
     this.fit();
   }
 
+  /** Removes the ground truth (after a failed load: nothing stale stays on screen). */
+  clearGroundTruth() {
+    if (this.gtMesh) { this.world.remove(this.gtMesh); this.gtMesh.geometry.dispose(); this.gtMesh = null; }
+  }
+
+  /** Removes the reconstruction's points and the pair markers. */
+  clearPoints() {
+    if (this.points) { this.world.remove(this.points); this.points.geometry.dispose(); this.points = null; }
+    this.pairMarkers.clear();
+  }
+
   /** Frames the ground truth; `wide` also frames the space beside it (the "before" view). */
   fit(wide = false) {
     const d = this.diag;

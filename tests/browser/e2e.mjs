@@ -181,6 +181,11 @@ try {
   check('dom-kept-equals-cli', (await page.textContent('#r-kept')) === String(repAuto.crop.kept));
   check('live-kept-equals-report', (await page.textContent('#kept')) === `${repAuto.crop.kept} / ${repAuto.inputs.reconstruction.points}`, await page.textContent('#kept'));
   check('dom-align-method', (await page.textContent('#r-align')) === repAuto.alignment.method);
+  // the global search's routine note reads as information (worded for users), not a warning
+  const notes = await page.$$eval('#summary .info, #summary .warn', (els) => els.map((e) => [e.className, e.textContent]));
+  check('alignment-notes-worded-for-users', repAuto.alignment.method !== 'global+icp'
+    || (notes.some(([c, t]) => c === 'info' && /global shape search tried \d+ starting poses/.test(t))
+      && !notes.some(([c, t]) => c === 'warn' && /best of|starting poses/.test(t))), JSON.stringify(notes));
   // import the crop file back
   await page.selectOption('#crop-kind', 'none');
   await page.setInputFiles('#crop-import', cropFile.path);
