@@ -24,6 +24,9 @@ check clippy cargo clippy --workspace --all-targets --locked -- -D warnings
 check doc env RUSTDOCFLAGS="-D warnings" cargo doc --workspace --no-deps --locked
 check wasm32-core cargo build -p sfmeval --target wasm32-unknown-unknown --release --locked
 check bench-compiles cargo bench --workspace --no-run --locked
+# Module import graphs without cycles (core and runner): every arrow points down.
+check import-graph-core python3 scripts/import-graph.py crates/sfmeval/src
+check import-graph-runner python3 scripts/import-graph.py native_runner/src
 
 # Rust tests: count each test.
 t=$SECONDS
