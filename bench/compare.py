@@ -278,13 +278,22 @@ def prepare(data, mesh_name, size, work, ctx):
 
 
 def installed_anchors(wanted):
+    """The wanted anchors that are installed; each one that is not is named on stderr as
+    "skipped: ..." (scripts/test.sh counts those lines as skipped tests)."""
     out = []
     for name, script in PY_ANCHORS.items():
         mod = {"Open3D": "open3d", "trimesh+scipy": "trimesh", "point-cloud-utils": "point_cloud_utils"}[name]
-        if name in wanted and subprocess.run([sys.executable, "-c", f"import {mod}"], capture_output=True).returncode == 0:
+        if name not in wanted:
+            continue
+        if subprocess.run([sys.executable, "-c", f"import {mod}"], capture_output=True).returncode == 0:
             out.append(name)
-    if "CloudCompare" in wanted and cloudcompare.available():
-        out.append("CloudCompare")
+        else:
+            print(f"skipped: anchor {name}: Python module {mod} not importable", file=sys.stderr)
+    if "CloudCompare" in wanted:
+        if cloudcompare.available():
+            out.append("CloudCompare")
+        else:
+            print(f"skipped: anchor CloudCompare: {cloudcompare.BINARY} not on PATH", file=sys.stderr)
     return out
 
 

@@ -59,7 +59,7 @@ cp "$three/examples/jsm/controls/OrbitControls.js" "$three/examples/jsm/controls
   "$SITE/vendor/three/addons/controls/"
 cp www/node_modules/uplot/dist/uPlot.esm.js www/node_modules/uplot/dist/uPlot.min.css www/node_modules/uplot/LICENSE \
   "$SITE/vendor/uplot/"
-# The demo: data/demo as it is (the lead may replace it), described by data/demo/manifest.json;
+# The demo: data/demo as it is, described by data/demo/manifest.json;
 # without one, the manifest lists the usual file names that are present.
 (cd data/demo && find . -type f ! -name '*.py' -printf '%P\n') | while read -r f; do
   mkdir -p "$SITE/demo/$(dirname "$f")" && cp "data/demo/$f" "$SITE/demo/$f"

@@ -3,11 +3,21 @@
 # and integration tests, and the Python tests that compare sfmeval with independent tools (Open3D,
 # trimesh, scipy, pycolmap, Blender), and the benchmark in quick mode. Prints a final "N passed, N failed" line.
 # Needs scripts/setup.sh first.
+#
+# Skipped tests (a pytest skip, an ignored Rust test, a "skipped: ..." line of a suite, an anchor
+# of the benchmark that is not installed) are listed with their reasons and counted. Under
+# CI=true or CI=1 (.ci/run sets it) every skip counts as a failure: a test skipped because a
+# tool is missing has tested nothing, and a broken install must not pass.
 set -uo pipefail
 cd "$(dirname "$0")/.."
 export CARGO_TERM_COLOR=never
-passed=0; failed=0; failures=()
+passed=0; failed=0; skipped=0; failures=(); skips=()
 log=$(mktemp -d)
+ci=false; case "${CI:-}" in true | 1) ci=true ;; esac
+
+skip() { # what, why: one skipped test or suite
+  skipped=$((skipped + 1)); skips+=("$1: $2"); echo "SKIPPED $1: $2"
+}
 
 check() { # name, command...
   local name=$1; shift
@@ -40,11 +50,18 @@ if [ $rc -ne 0 ]; then
   [ "$f" -eq 0 ] && { failed=$((failed + 1)); }
   failures+=("cargo test"); grep -E "^(test .* FAILED|---- |error)" -A 15 "$log/cargo-test.log" | head -80
 fi
+# #[ignore]d tests: "test NAME ... ignored[, reason]"
+while read -r name why; do skip "cargo test $name" "${why:-ignored}"; done < <(
+  sed -nE 's/^test (.+) \.\.\. ignored(, (.*))?$/\1 \3/p' "$log/cargo-test.log")
+[ "$p" -gt 0 ] || { failed=$((failed + 1)); failures+=("cargo test ran no test"); }
 echo "cargo test: $p passed, $f failed ($((SECONDS - t)) s)"
 
 # The side-by-side benchmark in its quick mode (tiny data, one round): every installed anchor
 # must run and agree with sfmeval, so bench/compare.py cannot rot.
 check bench-compare-quick .venv/bin/python bench/compare.py --quick
+# an anchor that is not installed is left out of the comparison: a skip
+while read -r line; do skip "bench-compare-quick" "$line"; done < <(
+  sed -nE 's/^skipped: (.*)$/\1/p' "$log/bench-compare-quick.log")
 
 # Python tests (reference tools, real files).
 export SFMEVAL_BIN="$PWD/target/release/sfmeval"
@@ -52,32 +69,84 @@ pytest_dirs=()
 for d in tests/python blender_scripts/tests native_runner/tests; do [ -d "$d" ] && pytest_dirs+=("$d"); done
 if [ ${#pytest_dirs[@]} -gt 0 ]; then
   t=$SECONDS
-  .venv/bin/python -m pytest -q -p no:cacheprovider "${pytest_dirs[@]}" >"$log/pytest.log" 2>&1
+  # -rfEs: failures, errors and skip reasons in the log; the JUnit file gives every test's
+  # outcome, skips with their reasons.
+  .venv/bin/python -m pytest -q -rfEs -p no:cacheprovider -o junit_family=xunit1 \
+    --junitxml="$log/pytest.xml" "${pytest_dirs[@]}" >"$log/pytest.log" 2>&1
   rc=$?
-  last=$(grep -E '^(=+ )?[0-9]+ (passed|failed)|(passed|failed|error)' "$log/pytest.log" | tail -1)
-  p=$(echo "$last" | grep -Eo '[0-9]+ passed' | grep -Eo '[0-9]+' || echo 0)
-  f=$(echo "$last" | grep -Eo '[0-9]+ (failed|error)' | grep -Eo '[0-9]+' | awk '{s+=$1} END {print s+0}')
-  passed=$((passed + ${p:-0})); failed=$((failed + ${f:-0}))
-  if [ $rc -ne 0 ] && [ $rc -ne 5 ]; then
-    [ "${f:-0}" -eq 0 ] && failed=$((failed + 1))
-    failures+=("pytest"); grep -E "^(FAILED|ERROR)|Error|assert" "$log/pytest.log" | head -60
+  # "passed failed skipped", then one "test<TAB>reason" line per skipped test
+  python3 - "$log/pytest.xml" >"$log/pytest.sum" 2>&1 <<'PY'
+import sys
+import xml.etree.ElementTree as ET
+
+p = f = 0
+skips = []
+for case in ET.parse(sys.argv[1]).getroot().iter("testcase"):
+    name = f"{case.get('file') or case.get('classname')}::{case.get('name')}"
+    if case.find("failure") is not None or case.find("error") is not None:
+        f += 1
+    elif (s := case.find("skipped")) is not None:
+        skips.append(f"{name}\t{' '.join((s.get('message') or s.get('type') or '').split())}")
+    else:
+        p += 1
+print(p, f, len(skips))
+for line in skips:
+    print(line)
+PY
+  if read -r p f s <"$log/pytest.sum" 2>/dev/null && [[ "$p $f $s" =~ ^[0-9]+\ [0-9]+\ [0-9]+$ ]]; then
+    passed=$((passed + p)); failed=$((failed + f))
+    while IFS=$'\t' read -r name why; do skip "$name" "$why"; done < <(tail -n +2 "$log/pytest.sum")
+    # pytest's own summary line ("... 3 skipped ... in 12.3s") must say the same (JUnit
+    # reports an xfail as a skip too)
+    said=$(grep -E '^=* ?[0-9]+ [a-z]+.* in [0-9.]+s' "$log/pytest.log" | tail -1 |
+      grep -Eo '[0-9]+ (skipped|xfailed)' | awk '{s+=$1} END {print s+0}')
+    if [ "$said" -ne "$s" ]; then
+      echo "pytest: its summary says $said skipped, the JUnit file $s"
+      failed=$((failed + 1)); failures+=("pytest skip count")
+    fi
+  else
+    p=0 f=0 s=0; cat "$log/pytest.sum"
   fi
-  echo "pytest: ${p:-0} passed, ${f:-0} failed ($((SECONDS - t)) s)"
+  # rc 0 = all passed (skips allowed), 1 = failures, anything else (5: no test collected, an
+  # internal or usage error, a crash) is a failure of the run itself
+  if [ $rc -ne 0 ] || [ "$p" -eq 0 ]; then
+    [ "$f" -eq 0 ] && failed=$((failed + 1))
+    failures+=("pytest"); grep -E "^(FAILED|ERROR)|Error|assert" "$log/pytest.log" | head -60
+    [ "$f" -eq 0 ] && tail -20 "$log/pytest.log"
+  fi
+  echo "pytest: $p passed, $f failed, $s skipped ($((SECONDS - t)) s)"
 fi
 
-# Extra suites (browser, runner) register themselves as scripts/test-*.sh printing "N passed, N failed".
+# Extra suites (browser, runner) register themselves as scripts/test-*.sh printing "N passed, N failed"
+# (and "skipped: WHAT: WHY" per skipped test, if any). A suite that is not executable, ends
+# without that line or runs nothing has not tested anything.
 for s in scripts/test-*.sh; do
-  [ -x "$s" ] || continue
+  [ -e "$s" ] || continue
+  [ -x "$s" ] || { skip "$s" "not executable"; continue; }
   t=$SECONDS
   out=$("$s" 2>&1); rc=$?
   echo "$out" | tail -30
   line=$(echo "$out" | grep -E '^[0-9]+ passed, [0-9]+ failed' | tail -1)
   p=$(echo "$line" | grep -Eo '^[0-9]+'); f=$(echo "$line" | grep -Eo '[0-9]+ failed' | grep -Eo '[0-9]+')
   passed=$((passed + ${p:-0})); failed=$((failed + ${f:-0}))
-  if [ $rc -ne 0 ] && [ "${f:-0}" -eq 0 ]; then failed=$((failed + 1)); failures+=("$s"); fi
+  while read -r why; do skip "$s" "$why"; done < <(echo "$out" | sed -nE 's/^skipped: (.*)$/\1/p')
+  if [ -z "$line" ] || [ "${p:-0}" -eq 0 ] || { [ $rc -ne 0 ] && [ "${f:-0}" -eq 0 ]; }; then
+    failed=$((failed + 1)); failures+=("$s")
+  elif [ "${f:-0}" -gt 0 ]; then
+    failures+=("$s")
+  fi
   echo "$s: ${p:-0} passed, ${f:-0} failed ($((SECONDS - t)) s)"
 done
 
+if [ "$skipped" -gt 0 ]; then
+  echo "skipped ($skipped):"; printf '  %s\n' "${skips[@]}"
+  if $ci; then
+    echo "CI=true: the $skipped skipped test(s) count as failed"
+    failed=$((failed + skipped)); failures+=("$skipped skipped")
+  else
+    echo "(not counted outside CI; CI=true counts them as failed)"
+  fi
+fi
 [ ${#failures[@]} -gt 0 ] && echo "failing: ${failures[*]}"
 echo "$passed passed, $failed failed"
 [ "$failed" -eq 0 ]

@@ -188,9 +188,9 @@ def statue(rng):
         wr = (0.12, side * 0.2, 0.44 + 0.05 * rng.random())
         m.add(*tube(sh, el, 0.045, 10), mat=0)
         m.add(*tube(el, wr, 0.04, 10, r1=0.03), mat=0)
-    # Texture frequencies 2.5x those of the first version: on the small preset (640x360) the
-    # finer grain gave ~30 % more SfM points and cut the median camera-centre error of COLMAP,
-    # pycolmap and Theia by 30-50 % (coarse marble blobs only give large-scale, poorly localised
+    # Fine texture: against 2.5x lower scales (5 and 9), on the small preset (640x360) this
+    # grain gives ~30 % more SfM points and a 30-50 % lower median camera-centre error for
+    # COLMAP, pycolmap and Theia (coarse marble blobs only give large-scale, poorly localised
     # SIFT features).
     mats = [material("statue_stone", (0.78, 0.72, 0.62), (0.25, 0.2, 0.16), "marble", 12.5, 0.6),
             material("statue_base", (0.35, 0.33, 0.3), (0.8, 0.78, 0.7), "voronoi", 22.5, 0.7)]

@@ -1,6 +1,6 @@
 """`sfmeval-runner table1 --quick` end to end, made cheap with generator overrides: two presets
 (statue, vehicle) at 320x180, 24 views on two rings, 4 spp; openmvg only; 100k completeness
-samples. Measured here (2 vCPU shared with two other engineers' work, load 2-3): 10-21 s for
+samples. Measured on 2 vCPUs at load 2-3: 10-21 s for
 the first call (rendering 2 x 24 frames, two openmvg runs, report), 0.2 s for the second."""
 
 import csv

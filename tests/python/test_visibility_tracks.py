@@ -1,4 +1,4 @@
-"""Visible completeness and track-based error (issue #9 items 1 and 2) on a small dataset
+"""Visible completeness and track-based error on a small dataset
 rendered by Blender (the PyPI bpy through blender_scripts/generate.py: 24 views, 512×288,
 8 samples per pixel, about 60 s), checked against independent tools:
 

@@ -1,8 +1,8 @@
 //! Inner loops of the core: exact closest point on a mesh through the BVH, k-d tree build and
 //! nearest neighbour, PLY parsing, area-uniform sampling, Umeyama. `cargo bench -p sfmeval`.
 
-// Synthetic inputs only: platform maths is fine here.
-#![allow(clippy::disallowed_methods)]
+// Synthetic inputs only: platform maths is fine here, and a failed setup stops the bench loudly.
+#![allow(clippy::disallowed_methods, clippy::expect_used)]
 
 use std::hint::black_box;
 
@@ -49,7 +49,7 @@ fn bumpy_sphere(n_lat: u32, n_lon: u32) -> TriangleMesh {
 fn noisy_points(mesh: &TriangleMesh, n: usize, seed: u64) -> Vec<Point3> {
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
     sfmeval::sampling::sample_surface(mesh, n, seed)
-        .unwrap_or_default()
+        .expect("the bench mesh has area")
         .into_iter()
         .map(|p| p.map(|c| c + (rng.random::<f64>() - 0.5) * 0.02))
         .collect()
@@ -85,9 +85,7 @@ fn bench_mesh(c: &mut Criterion) {
     c.bench_function("bvh build, 100k triangles", |b| {
         b.iter(|| MeshIndex::new(black_box(&mesh)))
     });
-    let Ok(index) = MeshIndex::new(&mesh) else {
-        return;
-    };
+    let index = MeshIndex::new(&mesh).expect("the bench mesh is indexable");
     c.bench_function("closest point on mesh, 10k queries, 100k triangles", |b| {
         b.iter(|| {
             queries
@@ -108,9 +106,7 @@ fn bench_kdtree(c: &mut Criterion) {
     c.bench_function("k-d tree build, 100k points", |b| {
         b.iter(|| CloudIndex::new(black_box(&cloud)))
     });
-    let Ok(index) = CloudIndex::new(&cloud) else {
-        return;
-    };
+    let index = CloudIndex::new(&cloud).expect("the bench cloud is indexable");
     c.bench_function("nearest neighbour, 10k queries in 100k points", |b| {
         b.iter(|| {
             queries

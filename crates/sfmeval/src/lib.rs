@@ -1,7 +1,8 @@
 //! # sfmeval core
 //!
 //! Measures a Structure-from-Motion reconstruction against ground truth: read (PLY, glTF/GLB,
-//! OBJ, SfM models) from bytes, align ([`align`]), crop, compute exact
+//! OBJ, SfM models) from bytes, align (a given similarity, camera centres, point pairs, a global
+//! search, scaled ICP: [`align`]), crop, compute exact
 //! point-to-triangle (or nearest-neighbour) accuracy and sampled completeness, statistics,
 //! precision/recall/F-score, and the `sfmeval.report/2` report.
 //!
