@@ -916,7 +916,7 @@ fn hostile_gltf() {
     guarded("hostile_gltf", 350, gltf_body);
 }
 
-/// The default limit refuses an expansion past 20 M triangles at once, whatever the graph.
+/// The default limit (10 M) refuses an expansion past it at once, whatever the graph.
 #[test]
 fn gltf_instancing_past_the_default_limit_is_refused_quickly() {
     guarded(

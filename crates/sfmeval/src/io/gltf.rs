@@ -1145,7 +1145,10 @@ mod tests {
         let g = read_gltf_with_limits(
             many.as_bytes(),
             &BTreeMap::new(),
-            &ReadLimits::triangles(10_000),
+            &ReadLimits {
+                max_triangles: 10_000,
+                max_vertices: 30_000,
+            },
         )
         .unwrap();
         assert_eq!((g.mesh.triangles.len(), g.instances), (10_000, 10_000));
