@@ -281,15 +281,32 @@ impl Builder<'_> {
             let [a, b, d] = [0, 1, 2].map(|k| bits(c[(smallest + k) % 3]));
             [a[0], a[1], a[2], b[0], b[1], b[2], d[0], d[1], d[2]]
         };
+        // Sorted by a hash of the key (16 bytes a triangle, the key itself computed once),
+        // then each hash run compared exactly.
+        let hash = |k: &[u64; 9]| {
+            k.iter().fold(0x9e37_79b9_7f4a_7c15u64, |h, &w| {
+                let mut z = (h ^ w).wrapping_add(0x9e37_79b9_7f4a_7c15);
+                z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+                z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+                z ^ (z >> 31)
+            })
+        };
         let slice = &mut self.order[start..end];
-        slice.sort_unstable_by(|&a, &b| key(a).cmp(&key(b)).then(a.cmp(&b)));
+        let mut keyed: Vec<(u64, u32)> = slice.iter().map(|&i| (hash(&key(i)), i)).collect();
+        keyed.sort_unstable();
         let mut unique = 0;
-        for i in 0..slice.len() {
-            if unique == 0 || key(slice[i]) != key(slice[unique - 1]) {
-                slice.swap(unique, i);
+        let mut run_start = 0;
+        for (k, &(h, i)) in keyed.iter().enumerate() {
+            if k == 0 || keyed[k - 1].0 != h {
+                run_start = unique;
+            }
+            let ki = key(i);
+            if !slice[run_start..unique].iter().any(|&u| key(u) == ki) {
+                slice[unique] = i;
                 unique += 1;
             }
         }
+        // The copies left behind are never referenced by a leaf.
         unique
     }
 
