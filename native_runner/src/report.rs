@@ -136,7 +136,10 @@ pub fn report(args: &ReportArgs) -> Result<Vec<Row>> {
 
 /// The dataset's ground truth with its cameras.json and depth maps when present.
 fn load_gt(dir: &Path) -> Result<Dataset> {
-    sfmeval_fs::read_dataset(&DatasetPaths::folder(path_str(dir)?))
+    sfmeval_fs::read_dataset(
+        &DatasetPaths::folder(path_str(dir)?),
+        &sfmeval::io::ReadLimits::default(),
+    )
 }
 
 /// Points of the cumulative distribution of `distances`: 201 quantiles `(distance, share)`.

@@ -12,7 +12,7 @@ use sfmeval::dataset::{Dataset, DatasetPaths, Part};
 use sfmeval::evaluate::{DEFAULT_SAMPLES, EvalOptions};
 use sfmeval::export;
 use sfmeval::geometry::{Aabb, GroundTruth};
-use sfmeval::io;
+use sfmeval::io::{self, ReadLimits};
 use sfmeval::model;
 use sfmeval::pipeline::{self, EvalRequest, ReconInput, read_reconstruction};
 use sfmeval::pose::PoseOptions;
@@ -68,6 +68,9 @@ enum Command {
     Info {
         /// A PLY, GLB, glTF or OBJ file.
         file: PathBuf,
+        /// Refuse a mesh with more triangles than this once every glTF node instance is expanded.
+        #[arg(long, value_name = "N", default_value_t = ReadLimits::DEFAULT_MAX_TRIANGLES)]
+        max_triangles: u64,
     },
     /// Evaluate the demo pair shipped with sfmeval and print the summary.
     Demo {
@@ -116,6 +119,10 @@ struct InputArgs {
     /// Point pairs for `--align points`: `{"pairs": [{"recon": [x,y,z], "gt": [x,y,z]}, ...]}`.
     #[arg(long, value_name = "FILE")]
     pairs: Option<PathBuf>,
+    /// Refuse a ground-truth mesh with more triangles than this once every glTF node instance
+    /// is expanded (checked before anything is allocated; raise it for a trusted large file).
+    #[arg(long, value_name = "N", default_value_t = ReadLimits::DEFAULT_MAX_TRIANGLES)]
+    max_triangles: u64,
 }
 
 #[derive(Args, Debug)]
@@ -229,7 +236,10 @@ pub fn run(cli: Cli) -> Result<()> {
             report.as_deref(),
             json,
         ),
-        Command::Info { file } => info(&file),
+        Command::Info {
+            file,
+            max_triangles,
+        } => info(&file, &ReadLimits::triangles(max_triangles)),
         Command::Demo { json, report } => demo(json, report.as_deref()),
     }
 }
@@ -333,6 +343,15 @@ fn dataset_paths(
     Ok(paths)
 }
 
+/// An evaluation's error, naming the file it is about: the pairs file for the point pairs'
+/// errors, else the reconstruction.
+fn run_error(e: sfmeval::Error, input: &InputArgs) -> anyhow::Error {
+    match (&input.pairs, e.concerns_point_pairs()) {
+        (Some(p), true) => anyhow::Error::new(e).context(format!("point pairs '{}'", p.display())),
+        _ => anyhow::Error::new(e).context(format!("evaluating '{}'", input.recon.display())),
+    }
+}
+
 /// Reads the reconstruction of `--recon` (with `--recon-cameras`).
 fn read_recon(input: &InputArgs) -> Result<ReconInput> {
     let files = read_input_files(&input.recon)?;
@@ -370,11 +389,13 @@ fn eval(args: &EvalArgs) -> Result<()> {
         pose: PoseOptions::default(),
     };
     let bars = Bars::new(args.quiet);
-    let mut dataset =
-        sfmeval_fs::read_dataset(&dataset_paths(&args.input, args.depth.as_deref(), true)?)?;
+    let mut dataset = sfmeval_fs::read_dataset(
+        &dataset_paths(&args.input, args.depth.as_deref(), true)?,
+        &ReadLimits::triangles(args.input.max_triangles),
+    )?;
     let recon = read_recon(&args.input)?;
     let evaluation = pipeline::run(&mut dataset, &recon, &request, &bars)
-        .with_context(|| format!("evaluating '{}'", args.input.recon.display()))?;
+        .map_err(|e| run_error(e, &args.input))?;
     if let Some(path) = &args.samples_csv {
         write_atomic(path, export::samples_csv(&evaluation).as_bytes())?;
     }
@@ -411,9 +432,13 @@ fn align_cmd(input: &InputArgs, out: Option<&Path>, seed: u64) -> Result<()> {
         pose: PoseOptions::default(),
     };
     let bars = Bars::new(false);
-    let mut dataset = sfmeval_fs::read_dataset(&dataset_paths(input, None, false)?)?;
+    let mut dataset = sfmeval_fs::read_dataset(
+        &dataset_paths(input, None, false)?,
+        &ReadLimits::triangles(input.max_triangles),
+    )?;
     let recon = read_recon(input)?;
-    let evaluation = pipeline::run(&mut dataset, &recon, &request, &bars)?;
+    let evaluation =
+        pipeline::run(&mut dataset, &recon, &request, &bars).map_err(|e| run_error(e, input))?;
     let a = &evaluation.report.alignment;
     let text: String = a
         .gt_from_recon
@@ -486,7 +511,7 @@ fn cameras_cmd(
     Ok(())
 }
 
-fn info(path: &Path) -> Result<()> {
+fn info(path: &Path, limits: &ReadLimits) -> Result<()> {
     let bytes = read(path)?;
     let name = name_of(path);
     let format = io::detect(&name, &bytes).with_context(|| format!("'{}'", path.display()))?;
@@ -500,7 +525,8 @@ fn info(path: &Path) -> Result<()> {
             println!("comment   {c}");
         }
     }
-    let dataset = Dataset::read(&Disk, &DatasetPaths::ground_truth(path_str(path)?))?;
+    let dataset =
+        Dataset::read_with_limits(&Disk, &DatasetPaths::ground_truth(path_str(path)?), limits)?;
     let gt = &dataset.loaded;
     let (kind, pts, tris, area) = match &gt.ground_truth {
         GroundTruth::Mesh(m) => ("mesh", m.vertices.len(), m.triangles.len(), m.area()),

@@ -6,6 +6,7 @@ use std::path::Path;
 use anyhow::{Context as _, Result};
 use sfmeval::dataset::{Dataset, DatasetPaths};
 use sfmeval::files::FileSource;
+use sfmeval::io::ReadLimits;
 
 /// The real filesystem. Paths are read as given (relative to the working directory or
 /// absolute).
@@ -78,9 +79,9 @@ pub fn read_input_files(path: &Path) -> Result<BTreeMap<String, Vec<u8>>> {
     Ok(sfmeval::files::read_input_files(&Disk, path_str(path)?)?)
 }
 
-/// Reads a ground truth and its optional parts from disk ([`Dataset::read`]).
-pub fn read_dataset(paths: &DatasetPaths) -> Result<Dataset> {
-    Ok(Dataset::read(&Disk, paths)?)
+/// Reads a ground truth and its optional parts from disk ([`Dataset::read_with_limits`]).
+pub fn read_dataset(paths: &DatasetPaths, limits: &ReadLimits) -> Result<Dataset> {
+    Ok(Dataset::read_with_limits(&Disk, paths, limits)?)
 }
 
 #[cfg(test)]

@@ -126,7 +126,14 @@ export function initSync(module: BufferSource | WebAssembly.Module): void;
 /** The core's version. */
 export function version(): string;
 /** Reads a ground truth (GLB, glTF + buffers, OBJ, PLY mesh or cloud). */
-export function loadGroundTruth(files: Files | RawGroundTruth): RawGroundTruth;
+export function loadGroundTruth(
+  files: Files | RawGroundTruth,
+  options?: {
+    /** Refuse a mesh with more triangles than this once every glTF node instance is expanded
+     * (default 10 000 000), before anything is allocated. */
+    maxTriangles?: number;
+  },
+): RawGroundTruth;
 /** Reads a reconstruction (PLY, or an SfM model's files). */
 export function loadReconstruction(files: Files | RawReconstruction, name?: string): RawReconstruction;
 /** Reads ground-truth cameras. */

@@ -54,9 +54,11 @@ const isBuffer = (n) => /\.bin$/i.test(n) && !/^(cameras|images|points3D|frames|
 
 /**
  * Reads a ground truth. `files` maps file names to bytes: one GLB/glTF/OBJ/PLY file, plus the
- * external buffers of a `.gltf` by their URI.
+ * external buffers of a `.gltf` by their URI. `maxTriangles` (default 10 M) refuses a mesh with
+ * more triangles once every glTF node instance is expanded, before anything is allocated: raise
+ * it for a trusted large file.
  */
-export function loadGroundTruth(files) {
+export function loadGroundTruth(files, { maxTriangles } = {}) {
   if (files instanceof wasm.GroundTruth) return files;
   const map = fileMap(files);
   const names = Object.keys(map);
@@ -64,7 +66,7 @@ export function loadGroundTruth(files) {
   if (main === undefined) throw new Error('ground truth: no file given');
   const external = {};
   for (const n of names) if (n !== main) external[n] = map[n];
-  return new wasm.GroundTruth(main.split('/').pop(), map[main], external);
+  return new wasm.GroundTruth(main.split('/').pop(), map[main], external, maxTriangles);
 }
 
 /**

@@ -86,18 +86,29 @@ pub struct GroundTruth {
 #[wasm_bindgen]
 impl GroundTruth {
     /// Reads `bytes` named `name`; `external` is an optional object `{uri: Uint8Array}` with the
-    /// external buffers of a `.gltf`.
+    /// external buffers of a `.gltf`; `max_triangles` (default 10 M) refuses a mesh with more
+    /// triangles once every glTF node instance is expanded, before anything is allocated.
     #[wasm_bindgen(constructor)]
     pub fn new(
         name: &str,
         bytes: &Uint8Array,
         external: Option<Object>,
+        max_triangles: Option<f64>,
     ) -> Result<GroundTruth, JsError> {
         let external = match external {
             Some(o) => files_of(&o)?,
             None => BTreeMap::new(),
         };
-        let loaded = io::read_ground_truth(name, &bytes.to_vec(), &external)
+        let limits = match max_triangles {
+            Some(n) if n.is_finite() && n >= 1.0 => io::ReadLimits::triangles(n as u64),
+            Some(n) => {
+                return Err(JsError::new(&format!(
+                    "maxTriangles must be a number ≥ 1, got {n}"
+                )));
+            }
+            None => io::ReadLimits::default(),
+        };
+        let loaded = io::read_ground_truth_with_limits(name, &bytes.to_vec(), &external, &limits)
             .map_err(|e| js_err(&format!("ground truth '{name}'"), e))?;
         Ok(GroundTruth {
             dataset: Dataset::new(name, loaded),
@@ -599,8 +610,13 @@ pub fn evaluate(
     };
     let _guard = CallbackGuard::set(progress);
     let bar = JsProgress::new();
-    let inner = pipeline::run(&mut gt.dataset, &recon.input, &request, &bar)
-        .map_err(|e| js_err(&format!("evaluating '{}'", recon.input.name), e))?;
+    let inner = pipeline::run(&mut gt.dataset, &recon.input, &request, &bar).map_err(|e| {
+        if e.concerns_point_pairs() {
+            js_err("options.pairs", e)
+        } else {
+            js_err(&format!("evaluating '{}'", recon.input.name), e)
+        }
+    })?;
     Ok(Evaluation { inner })
 }
 

@@ -10,7 +10,7 @@ use crate::error::{Error, Result};
 use crate::files::{self, FileSource};
 use crate::gt_views::{GtView, build_views, depth_stem};
 use crate::io::npy::DepthMap;
-use crate::io::{self, LoadedGroundTruth};
+use crate::io::{self, LoadedGroundTruth, ReadLimits};
 use crate::model::{self, Reconstruction};
 use crate::prepared::PreparedGroundTruth;
 use crate::progress::Progress;
@@ -105,8 +105,18 @@ impl Dataset {
         }
     }
 
-    /// Reads the parts named by `paths` from `source`. Every error names the file and its role.
+    /// Reads the parts named by `paths` from `source` with the default [`ReadLimits`]. Every
+    /// error names the file and its role.
     pub fn read(source: &dyn FileSource, paths: &DatasetPaths) -> Result<Dataset> {
+        Dataset::read_with_limits(source, paths, &ReadLimits::default())
+    }
+
+    /// [`Self::read`] with explicit limits on the ground-truth mesh's expanded size.
+    pub fn read_with_limits(
+        source: &dyn FileSource,
+        paths: &DatasetPaths,
+        limits: &ReadLimits,
+    ) -> Result<Dataset> {
         let gt_path = paths.ground_truth.as_str();
         let in_gt = |e: Error| e.in_file("ground truth", gt_path);
         let bytes = source.read(gt_path)?.ok_or_else(|| Error::Missing {
@@ -114,7 +124,8 @@ impl Dataset {
             file: gt_path.to_string(),
         })?;
         let external = gltf_buffers(source, gt_path, &bytes)?;
-        let loaded = io::read_ground_truth(gt_path, &bytes, &external).map_err(in_gt)?;
+        let loaded =
+            io::read_ground_truth_with_limits(gt_path, &bytes, &external, limits).map_err(in_gt)?;
         drop(bytes);
         let mut dataset = Dataset::new(gt_path, loaded);
         if let Some(p) = paths.cameras.resolve(source, false)? {

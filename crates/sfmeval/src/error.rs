@@ -95,6 +95,42 @@ pub enum Error {
         /// What is wrong.
         cause: Box<Error>,
     },
+    /// A finite value that makes no sense or lies beyond what the core can measure: a zero or
+    /// huge image width, a negative focal length, a rotation that is not one, a coordinate
+    /// beyond [`crate::geometry::MAX_COORDINATE`]. Names the item (`camera 3`, `image 'a.jpg'`,
+    /// `vertex #12`) and the field; front ends add the file name.
+    #[error("{format}: {item}: {field} {problem}")]
+    OutOfRange {
+        /// Format being read ("COLMAP text", "cameras.json", ...).
+        format: &'static str,
+        /// What holds the value: `camera 3`, `image 'a.jpg'`, `vertex #12`, `node 4`.
+        item: String,
+        /// The field: `width`, `focal length fx`, `rotation`, `x`.
+        field: String,
+        /// What is wrong, with the value and the accepted range.
+        problem: String,
+    },
+    /// A well-formed input whose expanded size passes a limit of [`crate::io::ReadLimits`]
+    /// (a glTF scene instancing meshes into more triangles than allowed), refused before
+    /// anything is allocated for it.
+    #[error("{format}: {what}: {count} is above the limit of {limit}{hint}")]
+    LimitExceeded {
+        /// Format being read.
+        format: &'static str,
+        /// What is counted (`triangles once every node instance is expanded`).
+        what: String,
+        /// The count the input would need.
+        count: u64,
+        /// The limit in force.
+        limit: u64,
+        /// How to raise the limit, with a leading separator (may be empty).
+        hint: &'static str,
+    },
+    /// The user's point pairs (the `points` alignment's pairs file) cannot be used: too few,
+    /// collinear, non-finite, out of range. A distinct variant so that front ends name the pairs
+    /// file rather than the reconstruction ([`Error::concerns_point_pairs`]).
+    #[error("point pairs: {0}")]
+    PointPairs(String),
 }
 
 /// Shorthand result type of the core.
@@ -116,6 +152,40 @@ impl Error {
             Error::Io { .. } => "io",
             Error::Missing { .. } => "missing",
             Error::InFile { cause, .. } => cause.kind(),
+            Error::OutOfRange { .. } => "out_of_range",
+            Error::LimitExceeded { .. } => "limit_exceeded",
+            Error::PointPairs(_) => "point_pairs",
+        }
+    }
+
+    /// True when the error is about the point pairs (the pairs file of the `points` alignment),
+    /// whether found while parsing it ([`crate::align::parse_point_pairs`]) or while aligning
+    /// with it ([`crate::align::align_points`]): front ends then name the pairs file, not the
+    /// reconstruction.
+    pub fn concerns_point_pairs(&self) -> bool {
+        match self {
+            Error::PointPairs(_) => true,
+            Error::InFile { cause, .. } => cause.concerns_point_pairs(),
+            Error::Malformed { format, .. }
+            | Error::Truncated { format, .. }
+            | Error::NonFinite { format, .. }
+            | Error::OutOfRange { format, .. } => *format == crate::align::points::PAIRS_FORMAT,
+            _ => false,
+        }
+    }
+
+    /// An [`Error::OutOfRange`].
+    pub(crate) fn out_of_range(
+        format: &'static str,
+        item: impl Into<String>,
+        field: impl Into<String>,
+        problem: impl Into<String>,
+    ) -> Self {
+        Error::OutOfRange {
+            format,
+            item: item.into(),
+            field: field.into(),
+            problem: problem.into(),
         }
     }
 

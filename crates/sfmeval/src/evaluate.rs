@@ -244,6 +244,7 @@ pub fn evaluate(
     let mut warnings = info.warnings.clone();
     let t = alignment.gt_from_recon;
     let points_in_gt: Vec<Point3> = recon.points.iter().map(|&p| t.apply(p)).collect();
+    crate::geometry::check_finite("aligned reconstruction", "point", &points_in_gt)?;
 
     progress.start(Stage::Accuracy, points_in_gt.len() as u64);
     let pairs = parallel::map_points(&points_in_gt, progress, |&p| gt.distance(p, options.signed));

@@ -5,6 +5,26 @@ use crate::error::{Error, Result};
 /// A 3D point or vector in f64.
 pub type Point3 = [f64; 3];
 
+/// The largest coordinate magnitude the core measures: every reader refuses a vertex, point,
+/// camera centre or translation, point-pair coordinate or transform entry beyond ±1e50 with
+/// [`Error::OutOfRange`], and the evaluation refuses a transform that maps a reconstructed
+/// point beyond it.
+///
+/// Why 1e50: distances, areas, covariances and the exact point-triangle projection multiply up
+/// to four or six coordinates (`(2·10⁵⁰)⁶ ≈ 6·10³⁰¹` still fits an `f64`), and sums of squares
+/// over a billion points stay finite, so no derived quantity overflows. Every finite `f32` value
+/// (≤ 3.4·10³⁸) is accepted, and no physical scene comes near: 10⁵⁰ m is 10²⁴ light years.
+pub const MAX_COORDINATE: f64 = 1e50;
+
+/// `v` for an error message: plain for ordinary magnitudes, in exponent form otherwise.
+pub(crate) fn show(v: f64) -> String {
+    if v != 0.0 && !(1e-4..1e9).contains(&v.abs()) {
+        format!("{v:e}")
+    } else {
+        format!("{v}")
+    }
+}
+
 /// A point cloud with optional per-point colours.
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct PointCloud {
@@ -59,9 +79,15 @@ impl Aabb {
         Some(b)
     }
 
-    /// Length of the box diagonal.
+    /// Length of the box diagonal, computed without overflow for any finite corners (the
+    /// halves of the extents are taken first when the extents themselves would overflow).
     pub fn diagonal(&self) -> f64 {
-        norm(sub(self.max, self.min))
+        let d = sub(self.max, self.min);
+        if d.iter().all(|v| v.is_finite()) {
+            return norm(d);
+        }
+        let half = [0, 1, 2].map(|k| self.max[k] / 2.0 - self.min[k] / 2.0);
+        2.0 * norm(half)
     }
 }
 
@@ -114,8 +140,43 @@ impl GroundTruth {
     }
 }
 
-/// Fails with [`Error::NonFinite`] if any coordinate is NaN or infinite.
+/// Fails with [`Error::NonFinite`] if any coordinate is NaN or infinite, and with
+/// [`Error::OutOfRange`] (naming `what #index` and the axis) if one lies beyond
+/// ±[`MAX_COORDINATE`].
 pub fn check_finite(format: &'static str, what: &'static str, points: &[Point3]) -> Result<()> {
+    check_not_nan_inf(format, what, points)?;
+    check_coordinate_range(format, what, points)
+}
+
+/// Fails with [`Error::OutOfRange`] on the first coordinate beyond ±[`MAX_COORDINATE`] (the
+/// coordinates must be finite).
+pub fn check_coordinate_range(
+    format: &'static str,
+    what: &'static str,
+    points: &[Point3],
+) -> Result<()> {
+    for (i, p) in points.iter().enumerate() {
+        if let Some(k) = (0..3).find(|&k| !(p[k].abs() <= MAX_COORDINATE)) {
+            let count = points
+                .iter()
+                .filter(|p| p.iter().any(|v| !(v.abs() <= MAX_COORDINATE)))
+                .count();
+            return Err(Error::out_of_range(
+                format,
+                format!("{what} #{i}"),
+                ["x", "y", "z"][k],
+                format!(
+                    "is {}, beyond ±{} (the largest coordinate measured); {count} {what}(s) affected",
+                    show(p[k]),
+                    show(MAX_COORDINATE)
+                ),
+            ));
+        }
+    }
+    Ok(())
+}
+
+fn check_not_nan_inf(format: &'static str, what: &'static str, points: &[Point3]) -> Result<()> {
     let mut count = 0;
     let mut first_index = 0;
     for (i, p) in points.iter().enumerate() {
@@ -159,10 +220,29 @@ pub fn cross(a: Point3, b: Point3) -> Point3 {
     ]
 }
 
-/// Euclidean norm.
+/// Euclidean norm, without overflow or underflow for any finite vector: the plain `√(a·a)`
+/// when the squares stay in range (bit-identical to it), else computed on the vector scaled by
+/// its largest component.
 #[inline]
 pub fn norm(a: Point3) -> f64 {
-    dot(a, a).sqrt()
+    let d = dot(a, a);
+    if d.is_finite() && d > 1e-290 {
+        return d.sqrt();
+    }
+    norm_scaled(a, d)
+}
+
+#[cold]
+fn norm_scaled(a: Point3, d: f64) -> f64 {
+    if d.is_nan() {
+        return f64::NAN;
+    }
+    let m = a[0].abs().max(a[1].abs()).max(a[2].abs());
+    if m == 0.0 || !m.is_finite() {
+        return m;
+    }
+    let s = a.map(|v| v / m);
+    m * dot(s, s).sqrt()
 }
 
 /// Area of a triangle.

@@ -75,7 +75,13 @@ pub fn percentile_sorted(sorted: &[f64], q: f64) -> f64 {
             let lo = pos.floor() as usize;
             let hi = (lo + 1).min(n - 1);
             let frac = pos - lo as f64;
-            sorted[lo] + (sorted[hi] - sorted[lo]) * frac
+            let v = sorted[lo] + (sorted[hi] - sorted[lo]) * frac;
+            if v.is_finite() {
+                v
+            } else {
+                // The difference overflowed (values near ±f64::MAX): interpolate the halves.
+                2.0 * (sorted[lo] / 2.0 + (sorted[hi] / 2.0 - sorted[lo] / 2.0) * frac)
+            }
         }
     }
 }
@@ -92,17 +98,29 @@ impl Statistics {
         }
         let mut sorted = values.to_vec();
         sorted.sort_unstable_by(f64::total_cmp);
+        // Scale-safe: values whose squares (or sums) could overflow are divided by the largest
+        // magnitude first and the results multiplied back; ordinary values are divided by 1
+        // (bit-identical to the plain sums).
+        let largest = sorted[0].abs().max(sorted[n - 1].abs());
+        let k = if largest.is_finite() && largest > 1e100 {
+            largest
+        } else {
+            1.0
+        };
         let (mut sum, mut sum_sq) = (0.0f64, 0.0f64);
         for &v in values {
+            let v = v / k;
             sum += v;
             sum_sq += v * v;
         }
         let nf = n as f64;
-        let mean = sum / nf;
+        let mean_k = sum / nf;
         let mut dev = 0.0f64;
         for &v in values {
-            dev += (v - mean) * (v - mean);
+            let v = v / k;
+            dev += (v - mean_k) * (v - mean_k);
         }
+        let mean = mean_k * k;
         let min = sorted[0];
         let max = sorted[n - 1];
         let p50 = percentile_sorted(&sorted, 50.0);
@@ -116,9 +134,9 @@ impl Statistics {
             min,
             max,
             mean,
-            std: (dev / nf).sqrt(),
+            std: (dev / nf).sqrt() * k,
             median: p50,
-            rms: (sum_sq / nf).sqrt(),
+            rms: (sum_sq / nf).sqrt() * k,
             percentiles: Percentiles {
                 p50,
                 p90: percentile_sorted(&sorted, 90.0),
@@ -156,7 +174,12 @@ fn histogram_range(min: f64, max: f64, p1: f64, p99: f64) -> (f64, f64) {
 pub fn histogram(values: &[f64], lo: f64, hi: f64, bins: usize) -> Histogram {
     let bins = bins.max(1);
     let width = if hi > lo {
-        (hi - lo) / bins as f64
+        let w = (hi - lo) / bins as f64;
+        if w.is_finite() {
+            w
+        } else {
+            hi / bins as f64 - lo / bins as f64
+        }
     } else {
         1.0
     };
@@ -165,7 +188,13 @@ pub fn histogram(values: &[f64], lo: f64, hi: f64, bins: usize) -> Histogram {
             if i == bins && hi > lo {
                 hi
             } else {
-                lo + width * i as f64
+                let e = lo + width * i as f64;
+                if e.is_finite() {
+                    e
+                } else {
+                    let f = i as f64 / bins as f64;
+                    lo * (1.0 - f) + hi * f
+                }
             }
         })
         .collect();
@@ -177,7 +206,11 @@ pub fn histogram(values: &[f64], lo: f64, hi: f64, bins: usize) -> Histogram {
         } else if v > hi {
             overflow += 1;
         } else {
-            let b = (((v - lo) / width).floor().max(0.0) as usize).min(bins - 1);
+            let mut x = (v - lo) / width;
+            if !x.is_finite() {
+                x = v / width - lo / width;
+            }
+            let b = (x.floor().max(0.0) as usize).min(bins - 1);
             counts[b] += 1;
         }
     }
@@ -192,6 +225,32 @@ pub fn histogram(values: &[f64], lo: f64, hi: f64, bins: usize) -> Histogram {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn huge_values_stay_finite() {
+        // Squares of 1e200 overflow; the statistics must not.
+        let v = [1e200, 3e200, -2e200, 1.5e308, -1.7e308];
+        let s = Statistics::of(&v, 10);
+        for x in [
+            s.mean,
+            s.std,
+            s.rms,
+            s.min,
+            s.max,
+            s.median,
+            s.percentiles.p90,
+            s.percentiles.p99,
+        ] {
+            assert!(x.is_finite(), "{s:?}");
+        }
+        assert!(s.histogram.edges.iter().all(|e| e.is_finite()));
+        assert_eq!(
+            s.histogram.counts.iter().sum::<u64>() + s.histogram.underflow + s.histogram.overflow,
+            5
+        );
+        let s = Statistics::of(&[1e200, 1e200], 4);
+        assert!((s.rms / 1e200 - 1.0).abs() < 1e-15 && s.std == 0.0 && s.mean == 1e200);
+    }
 
     #[test]
     fn hand_computed() {

@@ -2,7 +2,14 @@
 //! `gt_from_recon` maps reconstruction coordinates into the ground-truth frame.
 
 use crate::error::{Error, Result};
-use crate::geometry::Point3;
+use crate::geometry::{MAX_COORDINATE, Point3, show};
+
+/// A transform's scale must lie in `[MIN_SCALE, MAX_SCALE]`: beyond, the reconstruction would be
+/// blown up past [`MAX_COORDINATE`] or collapsed below anything measurable.
+pub const MIN_SCALE: f64 = 1e-50;
+
+/// See [`MIN_SCALE`].
+pub const MAX_SCALE: f64 = 1e50;
 
 /// A similarity `x ↦ s·R·x + t`, stored as the row-major 4×4 `[[sR, t], [0, 1]]`.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -40,13 +47,25 @@ impl Similarity {
         Similarity { matrix: m }
     }
 
-    /// Validates a 4×4 as a similarity: finite, last row `0 0 0 1`, upper 3×3 = s·R with R a
-    /// proper rotation (tolerance `1e-6` relative).
+    /// Validates a 4×4 as a similarity: finite, every entry within ±[`MAX_COORDINATE`], last row
+    /// `0 0 0 1`, upper 3×3 = s·R with R a proper rotation (tolerance `1e-6` relative) and `s`
+    /// in `[MIN_SCALE, MAX_SCALE]`.
     pub fn from_matrix(m: [[f64; 4]; 4]) -> Result<Similarity> {
         if m.iter().flatten().any(|v| !v.is_finite()) {
             return Err(Error::InvalidOption(
                 "transform has non-finite entries".into(),
             ));
+        }
+        for (r, row) in m.iter().enumerate() {
+            for (c, v) in row.iter().enumerate() {
+                if !(v.abs() <= MAX_COORDINATE) {
+                    return Err(Error::InvalidOption(format!(
+                        "transform entry [{r}][{c}] is {}, beyond ±{} (the largest coordinate measured)",
+                        show(*v),
+                        show(MAX_COORDINATE)
+                    )));
+                }
+            }
         }
         let last = m[3];
         if last[0].abs() > 1e-9
@@ -63,12 +82,21 @@ impl Similarity {
         if !(scale > 0.0) {
             return Err(Error::InvalidOption("transform has a non-positive determinant (a reflection or a collapse), not a similarity".into()));
         }
-        // (A/s)ᵀ(A/s) must be the identity.
+        if !(MIN_SCALE..=MAX_SCALE).contains(&scale) {
+            return Err(Error::InvalidOption(format!(
+                "transform's scale is {}, outside [{}, {}]",
+                show(scale),
+                show(MIN_SCALE),
+                show(MAX_SCALE)
+            )));
+        }
+        // (A/s)ᵀ(A/s) must be the identity (divided first: s² may underflow).
+        let r = s.rotation();
         for i in 0..3 {
             for j in 0..3 {
-                let d: f64 = (0..3).map(|k| m[k][i] * m[k][j]).sum::<f64>() / (scale * scale);
+                let d: f64 = (0..3).map(|k| r[k][i] * r[k][j]).sum::<f64>();
                 let want = if i == j { 1.0 } else { 0.0 };
-                if (d - want).abs() > 1e-6 {
+                if !((d - want).abs() <= 1e-6) {
                     return Err(Error::InvalidOption(format!(
                         "transform's 3×3 part is not a scaled rotation (RᵀR differs from I by {:.2e})",
                         (d - want).abs()
@@ -124,13 +152,22 @@ impl Similarity {
         Self::from_matrix(m)
     }
 
-    /// The uniform scale s (cube root of the 3×3 determinant).
+    /// The uniform scale s (cube root of the 3×3 determinant), without overflow or underflow
+    /// of the determinant for any finite matrix (it is taken of the matrix divided by its
+    /// largest entry when the plain product leaves the safe range).
     pub fn scale(&self) -> f64 {
-        let m = &self.matrix;
-        let det = m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1])
-            - m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0])
-            + m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0]);
-        libm::cbrt(det)
+        let det = det3(&self.matrix, 1.0);
+        if det.is_finite() && det.abs() > 1e-290 {
+            return libm::cbrt(det);
+        }
+        let k = self.matrix[..3]
+            .iter()
+            .flat_map(|row| &row[..3])
+            .fold(0.0f64, |k, v| k.max(v.abs()));
+        if !(k > 0.0 && k.is_finite()) {
+            return libm::cbrt(det);
+        }
+        k * libm::cbrt(det3(&self.matrix, k))
     }
 
     /// The rotation R (the 3×3 part divided by the scale).
@@ -193,6 +230,14 @@ impl Similarity {
     }
 }
 
+/// Determinant of the upper 3×3 of `m` divided by `k`.
+fn det3(m: &[[f64; 4]; 4], k: f64) -> f64 {
+    let a = |r: usize, c: usize| m[r][c] / k;
+    a(0, 0) * (a(1, 1) * a(2, 2) - a(1, 2) * a(2, 1))
+        - a(0, 1) * (a(1, 0) * a(2, 2) - a(1, 2) * a(2, 0))
+        + a(0, 2) * (a(1, 0) * a(2, 1) - a(1, 1) * a(2, 0))
+}
+
 fn flatten_numbers(v: &serde_json::Value) -> Result<Vec<f64>> {
     let mut out = Vec::new();
     fn walk(v: &serde_json::Value, out: &mut Vec<f64>) -> Result<()> {
@@ -234,5 +279,41 @@ mod tests {
         assert!(Similarity::parse(b"1 0.5 0 0 0 1 0 0 0 0 1 0 0 0 0 1").is_err());
         assert!(Similarity::parse(b"-1 0 0 0 0 1 0 0 0 0 1 0 0 0 0 1").is_err());
         assert!(Similarity::parse(b"1 0 0").is_err());
+    }
+
+    #[test]
+    fn huge_and_tiny_entries() {
+        // 1e150 (its determinant overflows) and 1e308 are refused with the entry named.
+        for big in ["1e150", "1e308"] {
+            let text = format!("{big} 0 0 0 0 {big} 0 0 0 0 {big} 0 0 0 0 1");
+            let e = Similarity::parse(text.as_bytes()).unwrap_err().to_string();
+            assert!(e.contains("entry [0][0]") && e.contains("beyond"), "{e}");
+        }
+        let e = Similarity::parse(b"1 0 0 1e300 0 1 0 0 0 0 1 0 0 0 0 1")
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("entry [0][3]"), "{e}");
+        // The scale is exact where the determinant alone would overflow or underflow.
+        let t = Similarity::from_parts(
+            1e40,
+            [[0.0, -1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, 1.0]],
+            [0.0; 3],
+        );
+        assert!((t.scale() / 1e40 - 1.0).abs() < 1e-14, "{}", t.scale());
+        let t = Similarity::from_parts(
+            1e-40,
+            [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]],
+            [0.0; 3],
+        );
+        assert!((t.scale() / 1e-40 - 1.0).abs() < 1e-14);
+        assert!(Similarity::from_matrix(t.matrix).is_ok());
+        // Outside [1e-50, 1e50]: refused.
+        let t = Similarity::from_parts(
+            1e-60,
+            [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]],
+            [0.0; 3],
+        );
+        let e = Similarity::from_matrix(t.matrix).unwrap_err().to_string();
+        assert!(e.contains("scale"), "{e}");
     }
 }

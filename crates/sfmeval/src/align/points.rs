@@ -5,7 +5,7 @@ use serde::{Deserialize, Serialize};
 
 use super::{is_finite, make_stage, planarity_ratio};
 use crate::error::{Error, Result};
-use crate::geometry::Point3;
+use crate::geometry::{MAX_COORDINATE, Point3, show};
 use crate::report::AlignmentStage;
 use crate::transform::Similarity;
 
@@ -23,11 +23,15 @@ struct PairsFile {
     pairs: Vec<PointPair>,
 }
 
+/// The format name of every error about a pairs file ([`Error::concerns_point_pairs`]).
+pub const PAIRS_FORMAT: &str = "point pairs";
+
 /// Parses a point-pairs file: `{"pairs": [{"recon": [x, y, z], "gt": [x, y, z]}, ...]}`
-/// (a bare list of pairs is accepted too).
+/// (a bare list of pairs is accepted too). Coordinates must be finite and within
+/// ±[`MAX_COORDINATE`] ([`Error::OutOfRange`] naming the pair and the side otherwise).
 pub fn parse_point_pairs(bytes: &[u8]) -> Result<Vec<PointPair>> {
-    let text = std::str::from_utf8(bytes)
-        .map_err(|_| Error::malformed("point pairs", "not UTF-8 text"))?;
+    let text =
+        std::str::from_utf8(bytes).map_err(|_| Error::malformed(PAIRS_FORMAT, "not UTF-8 text"))?;
     let trimmed = text.trim_start();
     let pairs = if trimmed.starts_with('[') {
         serde_json::from_str::<Vec<PointPair>>(text)
@@ -36,7 +40,7 @@ pub fn parse_point_pairs(bytes: &[u8]) -> Result<Vec<PointPair>> {
     }
     .map_err(|e| {
         Error::malformed(
-            "point pairs",
+            PAIRS_FORMAT,
             format!(
                 "{e} (expected {{\"pairs\": [{{\"recon\": [x, y, z], \"gt\": [x, y, z]}}, ...]}})"
             ),
@@ -46,18 +50,35 @@ pub fn parse_point_pairs(bytes: &[u8]) -> Result<Vec<PointPair>> {
     Ok(pairs)
 }
 
-/// Fails on the first pair with a NaN or infinite coordinate (counting them all).
+/// Fails on the first pair with a NaN or infinite coordinate (counting them all), then on the
+/// first coordinate beyond ±[`MAX_COORDINATE`].
 fn check_finite(pairs: &[PointPair]) -> Result<()> {
     let bad = |p: &PointPair| !(is_finite(&p.recon) && is_finite(&p.gt));
-    match pairs.iter().position(bad) {
-        Some(first_index) => Err(Error::NonFinite {
-            format: "point pairs",
+    if let Some(first_index) = pairs.iter().position(bad) {
+        return Err(Error::NonFinite {
+            format: PAIRS_FORMAT,
             what: "pair",
             count: pairs.iter().filter(|p| bad(p)).count(),
             first_index,
-        }),
-        None => Ok(()),
+        });
     }
+    for (i, p) in pairs.iter().enumerate() {
+        for (side, v) in [("recon", p.recon), ("gt", p.gt)] {
+            if let Some(k) = (0..3).find(|&k| !(v[k].abs() <= MAX_COORDINATE)) {
+                return Err(Error::out_of_range(
+                    PAIRS_FORMAT,
+                    format!("pair #{i}"),
+                    format!("{side}[{k}]"),
+                    format!(
+                        "is {}, beyond ±{} (the largest coordinate measured)",
+                        show(v[k]),
+                        show(MAX_COORDINATE)
+                    ),
+                ));
+            }
+        }
+    }
+    Ok(())
 }
 
 /// Minimum √(λ₂/λ₁) of the picked points on either side: below it they are too close to a
@@ -65,10 +86,19 @@ fn check_finite(pairs: &[PointPair]) -> Result<()> {
 const MIN_PLANARITY: f64 = 1e-3;
 
 /// The `points` stage: the least-squares similarity of the pairs (all used; a user picks them
-/// by hand). RMSE is the residual of the pairs in ground-truth units.
+/// by hand). RMSE is the residual of the pairs in ground-truth units. Every failure is an
+/// [`Error::PointPairs`] (too few pairs, collinear or identical points, out-of-range values, no
+/// similarity), so front ends can name the pairs file.
 pub fn align_points(pairs: &[PointPair]) -> Result<(Similarity, AlignmentStage)> {
+    align_points_inner(pairs).map_err(|e| match e {
+        Error::PointPairs(_) => e,
+        other => Error::PointPairs(other.to_string()),
+    })
+}
+
+fn align_points_inner(pairs: &[PointPair]) -> Result<(Similarity, AlignmentStage)> {
     if pairs.len() < 3 {
-        return Err(Error::InvalidOption(format!(
+        return Err(Error::PointPairs(format!(
             "the points alignment needs at least 3 point pairs, got {}",
             pairs.len()
         )));
@@ -79,7 +109,7 @@ pub fn align_points(pairs: &[PointPair]) -> Result<(Similarity, AlignmentStage)>
     for (name, set) in [("reconstruction", &src), ("ground-truth", &dst)] {
         let r = planarity_ratio(set);
         if !(r >= MIN_PLANARITY) {
-            return Err(Error::Geometry(format!(
+            return Err(Error::PointPairs(format!(
                 "the {} {name} points of the pairs are (nearly) collinear or identical (spread ratio {r:.1e}): pick at least 3 points not on one line",
                 pairs.len()
             )));
@@ -146,23 +176,43 @@ mod tests {
                 gt: [1.0, 0.0, 0.0],
             },
         ];
-        assert!(matches!(align_points(&two), Err(Error::InvalidOption(_))));
+        assert!(matches!(align_points(&two), Err(Error::PointPairs(_))));
         let line: Vec<PointPair> = (0..5)
             .map(|i| PointPair {
                 recon: [f64::from(i), 0.0, 0.0],
                 gt: [0.0, f64::from(i), 0.0],
             })
             .collect();
-        assert!(matches!(align_points(&line), Err(Error::Geometry(_))));
+        let e = align_points(&line).unwrap_err();
+        assert!(matches!(e, Error::PointPairs(_)) && e.concerns_point_pairs());
+        assert!(e.to_string().starts_with("point pairs: ") && e.to_string().contains("collinear"));
         let same: Vec<PointPair> = (0..5)
             .map(|_| PointPair {
                 recon: [1.0, 2.0, 3.0],
                 gt: [1.0, 2.0, 3.0],
             })
             .collect();
-        assert!(matches!(align_points(&same), Err(Error::Geometry(_))));
+        assert!(matches!(align_points(&same), Err(Error::PointPairs(_))));
         let mut nan = line.clone();
         nan[0].gt[1] = f64::NAN;
-        assert!(matches!(align_points(&nan), Err(Error::NonFinite { .. })));
+        let e = align_points(&nan).unwrap_err();
+        assert!(matches!(e, Error::PointPairs(_)) && e.to_string().contains("non-finite"));
+        // Huge but finite: refused with the pair and the side, and the file is the pairs'.
+        let e = parse_point_pairs(
+            br#"[{"recon": [0,0,0], "gt": [1,1,1]}, {"recon": [1e150, 0, 0], "gt": [2,1,1]}]"#,
+        )
+        .unwrap_err();
+        assert_eq!(e.kind(), "out_of_range");
+        assert!(e.concerns_point_pairs());
+        let msg = e.to_string();
+        assert!(
+            msg.contains("pair #1") && msg.contains("recon[0]") && msg.contains("1e150"),
+            "{msg}"
+        );
+        assert!(
+            parse_point_pairs(b"{\"pairs\": 3}")
+                .unwrap_err()
+                .concerns_point_pairs()
+        );
     }
 }

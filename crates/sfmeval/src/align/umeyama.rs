@@ -87,12 +87,27 @@ pub fn umeyama_weighted(
     }
     mu_s /= total;
     mu_d /= total;
+    // Scale-safe: when the spreads leave [1e-100, 1e100] (squares and sums of squares would
+    // underflow or overflow), work on the centred points divided by their largest deviation
+    // and scale back at the end; otherwise divide by 1 (bit-identical to the plain formula).
+    let spread = |pts: &[Point3], mu: &Vector3<f64>| {
+        let m = pts
+            .iter()
+            .map(|p| (to_v(*p) - mu).amax())
+            .fold(0.0f64, f64::max);
+        if m > 0.0 && !(1e-100..=1e100).contains(&m) {
+            m
+        } else {
+            1.0
+        }
+    };
+    let (ks, kd) = (spread(src, &mu_s), spread(dst, &mu_d));
     let mut sigma = Matrix3::zeros();
     let mut cov_s = Matrix3::zeros();
     let mut var_s = 0.0;
     for i in 0..src.len() {
-        let a = to_v(src[i]) - mu_s;
-        let b = to_v(dst[i]) - mu_d;
+        let a = (to_v(src[i]) - mu_s) / ks;
+        let b = (to_v(dst[i]) - mu_d) / kd;
         sigma += w(i) * b * a.transpose();
         cov_s += w(i) * a * a.transpose();
         var_s += w(i) * a.norm_squared();
@@ -123,7 +138,7 @@ pub fn umeyama_weighted(
     let r = u * s_diag * vt;
     let scale = if with_scale {
         let d = svd.singular_values;
-        (d[0] + d[1] + s_diag[(2, 2)] * d[2]) / var_s
+        (d[0] + d[1] + s_diag[(2, 2)] * d[2]) / var_s * (kd / ks)
     } else {
         1.0
     };

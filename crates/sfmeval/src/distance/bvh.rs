@@ -225,6 +225,18 @@ impl Builder<'_> {
                 hi[k] = hi[k].max(c[k]);
             }
         }
+        if (0..3).all(|k| hi[k] == lo[k]) {
+            // Every centroid in one place: copies of one triangle (a glTF node graph that
+            // instances a mesh many times in the same place) would make every query visit
+            // them all, since the rounded boxes never prune an equally distant copy. Only the
+            // distinct ones are kept (the first of each by input order, so results do not
+            // change: a copy is never strictly closer).
+            let unique = self.drop_copies(start, end);
+            if unique < n {
+                self.build(slot, start, start + unique, depth);
+                return;
+            }
+        }
         let axis = (0..3)
             .max_by(|&a, &b| (hi[a] - lo[a]).total_cmp(&(hi[b] - lo[b])))
             .unwrap_or(0);
@@ -247,6 +259,55 @@ impl Builder<'_> {
             max: [0, 1, 2].map(|k| l.max[k].max(r.max[k])),
             index: children as u32,
         };
+    }
+
+    /// Moves the distinct triangles of `order[start..end]` (same corners in the same cyclic
+    /// order = a copy) to its front, the first of each by input index, and returns how many.
+    fn drop_copies(&mut self, start: usize, end: usize) -> usize {
+        let mesh = self.mesh;
+        // Corners rotated so the smallest comes first (a rotation keeps the winding).
+        let key = |i: u32| -> [u64; 9] {
+            let c = mesh.corners(&mesh.triangles[i as usize]);
+            let bits = |p: Point3| p.map(f64::to_bits);
+            let smallest = (0..3)
+                .min_by(|&a, &b| {
+                    let (pa, pb) = (c[a], c[b]);
+                    (0..3)
+                        .map(|k| pa[k].total_cmp(&pb[k]))
+                        .find(|o| o.is_ne())
+                        .unwrap_or(std::cmp::Ordering::Equal)
+                })
+                .unwrap_or(0);
+            let [a, b, d] = [0, 1, 2].map(|k| bits(c[(smallest + k) % 3]));
+            [a[0], a[1], a[2], b[0], b[1], b[2], d[0], d[1], d[2]]
+        };
+        // Sorted by a hash of the key (16 bytes a triangle, the key itself computed once),
+        // then each hash run compared exactly.
+        let hash = |k: &[u64; 9]| {
+            k.iter().fold(0x9e37_79b9_7f4a_7c15u64, |h, &w| {
+                let mut z = (h ^ w).wrapping_add(0x9e37_79b9_7f4a_7c15);
+                z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+                z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+                z ^ (z >> 31)
+            })
+        };
+        let slice = &mut self.order[start..end];
+        let mut keyed: Vec<(u64, u32)> = slice.iter().map(|&i| (hash(&key(i)), i)).collect();
+        keyed.sort_unstable();
+        let mut unique = 0;
+        let mut run_start = 0;
+        for (k, &(h, i)) in keyed.iter().enumerate() {
+            if k == 0 || keyed[k - 1].0 != h {
+                run_start = unique;
+            }
+            let ki = key(i);
+            if !slice[run_start..unique].iter().any(|&u| key(u) == ki) {
+                slice[unique] = i;
+                unique += 1;
+            }
+        }
+        // The copies left behind are never referenced by a leaf.
+        unique
     }
 
     /// A leaf over `order[start..end]`, its box rounded outwards to `f32`.
@@ -319,6 +380,43 @@ mod tests {
                 [f(0), f(16), f(32)]
             })
             .collect()
+    }
+
+    /// A glTF that instances one mesh in many nodes at the same place stacks exact copies:
+    /// queries must not visit every copy (they did: the f32 boxes never prune an equally
+    /// distant copy), and the answer must not change.
+    #[test]
+    fn stacked_copies_do_not_slow_queries() {
+        let mut mesh = blob(20);
+        let n0 = mesh.triangles.len();
+        let first = mesh.triangles[7];
+        assert!(n0 > 7);
+        for k in 0..200_000 {
+            // The same triangle, also with its corners rotated (same winding).
+            let t = first;
+            mesh.triangles.push(match k % 3 {
+                0 => t,
+                1 => [t[1], t[2], t[0]],
+                _ => [t[2], t[0], t[1]],
+            });
+        }
+        // And the mesh again in the same place (every triangle copied once).
+        let again: Vec<[u32; 3]> = mesh.triangles[..n0].to_vec();
+        mesh.triangles.extend(again);
+        let bvh = TriangleBvh::new(&mesh);
+        let reference = TriangleBvh::new(&blob(20));
+        assert!(
+            bvh.node_count() < 4 * reference.node_count(),
+            "{}",
+            bvh.node_count()
+        );
+        let t = std::time::Instant::now();
+        for p in queries(3000) {
+            let hit = bvh.closest(p).unwrap();
+            let want = reference.closest(p).unwrap();
+            assert_eq!(hit.distance2, want.distance2, "{p:?}");
+        }
+        assert!(t.elapsed().as_secs_f64() < 2.0, "{:?}", t.elapsed());
     }
 
     #[test]

@@ -4,6 +4,12 @@
 //! and count checked against the buffers, because the crate's own reader panics on some valid
 //! files (quantized positions, gltf-rs/gltf#400). Required extensions are checked first so a
 //! Draco- or meshopt-compressed file gets a clear message instead of a validation error.
+//!
+//! Hostile node graphs: the nodes must form a tree (a node listed as a child twice, by two
+//! parents, as its own ancestor, or a scene root that is also a child, is an error naming the
+//! node), and the triangles and vertices the scene expands to are counted from the accessor
+//! counts before anything is decoded, against [`ReadLimits`]. Accessors are decoded straight
+//! into the mesh (no intermediate copy), so the memory used is that of the mesh returned.
 
 use std::collections::BTreeMap;
 
@@ -11,8 +17,9 @@ use base64::Engine as _;
 use gltf::accessor::{DataType, Dimensions};
 use gltf::mesh::Mode;
 
+use super::ReadLimits;
 use crate::error::{Error, Result};
-use crate::geometry::{Point3, TriangleMesh};
+use crate::geometry::{MAX_COORDINATE, Point3, TriangleMesh, show};
 
 const GLB: &str = "GLB";
 const GLTF: &str = "glTF";
@@ -100,8 +107,19 @@ fn split_glb(bytes: &[u8]) -> Result<(&[u8], Option<&[u8]>)> {
 }
 
 /// Reads every triangle of the default scene (else scene 0, else every root node), with node
-/// transforms applied. `external` maps relative URIs of external buffers to their bytes.
+/// transforms applied. `external` maps relative URIs of external buffers to their bytes. Uses the
+/// default [`ReadLimits`]; see [`read_gltf_with_limits`].
 pub fn read_gltf(bytes: &[u8], external: &BTreeMap<String, Vec<u8>>) -> Result<GltfMesh> {
+    read_gltf_with_limits(bytes, external, &ReadLimits::default())
+}
+
+/// [`read_gltf`] with explicit limits: the node graph is checked to be a tree and the expanded
+/// triangle and vertex counts are checked against `limits` before any accessor is decoded.
+pub fn read_gltf_with_limits(
+    bytes: &[u8],
+    external: &BTreeMap<String, Vec<u8>>,
+    limits: &ReadLimits,
+) -> Result<GltfMesh> {
     let (format, json_bytes, blob) = if is_glb(bytes) {
         let (j, b) = split_glb(bytes)?;
         (GLB, j, b)
@@ -141,9 +159,47 @@ pub fn read_gltf(bytes: &[u8], external: &BTreeMap<String, Vec<u8>>) -> Result<G
     prepare_for_validation(format, obj)?;
     let cleaned =
         serde_json::to_vec(&value).map_err(|e| Error::malformed(format, e.to_string()))?;
+    drop(value);
     let doc = gltf::Gltf::from_slice(&cleaned)
         .map_err(|e| Error::malformed(format, format!("invalid glTF: {e}")))?
         .document;
+
+    let parents = node_parents(&doc, format)?;
+    let roots: Vec<gltf::Node> = match doc.default_scene().or_else(|| doc.scenes().next()) {
+        Some(scene) => {
+            let mut listed = vec![false; parents.len()];
+            let mut roots = Vec::new();
+            for n in scene.nodes() {
+                let i = n.index();
+                if listed.get(i).copied().unwrap_or(false) {
+                    return Err(Error::malformed(
+                        format,
+                        format!("scene {} lists node {i} more than once", scene.index()),
+                    ));
+                }
+                if let Some(f) = listed.get_mut(i) {
+                    *f = true;
+                }
+                if let Some(Some(p)) = parents.get(i) {
+                    return Err(Error::malformed(
+                        format,
+                        format!(
+                            "scene {} lists node {i} as a root, but it is a child of node {p}",
+                            scene.index()
+                        ),
+                    ));
+                }
+                roots.push(n);
+            }
+            roots
+        }
+        None => doc
+            .nodes()
+            .filter(|n| parents.get(n.index()).is_some_and(Option::is_none))
+            .collect(),
+    };
+    let (triangles, vertices) = expanded_size(format, &roots)?;
+    limits.check(format, triangles, vertices)?;
 
     let buffers = resolve_buffers(&doc, format, blob, external)?;
     let mut reader = Walker {
@@ -153,20 +209,15 @@ pub fn read_gltf(bytes: &[u8], external: &BTreeMap<String, Vec<u8>>) -> Result<G
         warnings: Vec::new(),
         instances: 0,
     };
-    let roots: Vec<gltf::Node> = match doc.default_scene().or_else(|| doc.scenes().next()) {
-        Some(scene) => scene.nodes().collect(),
-        None => {
-            let mut is_child = vec![false; doc.nodes().len()];
-            for n in doc.nodes() {
-                for c in n.children() {
-                    if let Some(f) = is_child.get_mut(c.index()) {
-                        *f = true;
-                    }
-                }
-            }
-            doc.nodes().filter(|n| !is_child[n.index()]).collect()
-        }
-    };
+    // The counts are exact upper bounds of what the walk pushes.
+    reader
+        .mesh
+        .vertices
+        .reserve(usize::try_from(vertices).unwrap_or(0));
+    reader
+        .mesh
+        .triangles
+        .reserve(usize::try_from(triangles).unwrap_or(0));
     for node in roots {
         reader.walk(&node, &IDENTITY, 0)?;
     }
@@ -181,6 +232,111 @@ pub fn read_gltf(bytes: &[u8], external: &BTreeMap<String, Vec<u8>>) -> Result<G
         warnings: reader.warnings,
         instances: reader.instances,
     })
+}
+
+/// The parent of every node, checking that the nodes form a forest: no node is listed as a
+/// child twice (by one parent or two) and no node is its own ancestor.
+fn node_parents(doc: &gltf::Document, format: &'static str) -> Result<Vec<Option<usize>>> {
+    let n = doc.nodes().len();
+    let mut parent: Vec<Option<usize>> = vec![None; n];
+    for node in doc.nodes() {
+        for child in node.children() {
+            let c = child.index();
+            let slot = parent
+                .get_mut(c)
+                .ok_or_else(|| Error::malformed(format, format!("node {c} does not exist")))?;
+            if let Some(p) = *slot {
+                let how = if p == node.index() {
+                    format!("lists node {c} twice among its children")
+                } else {
+                    format!("lists node {c} as a child, but node {p} already does")
+                };
+                return Err(Error::malformed(
+                    format,
+                    format!(
+                        "node {} {how}: glTF nodes must form a tree (a node with two parents would be expanded once per path)",
+                        node.index()
+                    ),
+                ));
+            }
+            *slot = Some(node.index());
+        }
+    }
+    // Cycles: follow each node's parents; 1 = on the current path, 2 = known to reach a root.
+    let mut state = vec![0u8; n];
+    let mut path = Vec::new();
+    for start in 0..n {
+        let mut i = start;
+        path.clear();
+        loop {
+            match state.get(i).copied() {
+                Some(2) | None => break,
+                Some(1) => {
+                    return Err(Error::malformed(
+                        format,
+                        format!(
+                            "node {i} is its own ancestor (a cycle in the node hierarchy): glTF nodes must form a tree"
+                        ),
+                    ));
+                }
+                _ => {}
+            }
+            if let Some(s) = state.get_mut(i) {
+                *s = 1;
+            }
+            path.push(i);
+            match parent.get(i).copied().flatten() {
+                Some(p) => i = p,
+                None => break,
+            }
+        }
+        for &k in &path {
+            if let Some(s) = state.get_mut(k) {
+                *s = 2;
+            }
+        }
+    }
+    Ok(parent)
+}
+
+/// Triangles and vertices the scene expands to (every node instance of every mesh), from the
+/// accessor counts alone; saturating, so an absurd count cannot wrap. The nodes form a tree
+/// ([`node_parents`]), so this visits each node once.
+fn expanded_size(format: &'static str, roots: &[gltf::Node]) -> Result<(u64, u64)> {
+    let (mut triangles, mut vertices) = (0u64, 0u64);
+    let mut stack: Vec<(gltf::Node, usize)> = roots.iter().map(|n| (n.clone(), 0)).collect();
+    while let Some((node, depth)) = stack.pop() {
+        if depth > MAX_DEPTH {
+            return Err(deep(format, node.index()));
+        }
+        if let Some(mesh) = node.mesh() {
+            for prim in mesh.primitives() {
+                let Some(pos) = prim.get(&gltf::Semantic::Positions) else {
+                    continue;
+                };
+                let count = match prim.indices() {
+                    Some(acc) => acc.count() as u64,
+                    None => pos.count() as u64,
+                };
+                let t = match prim.mode() {
+                    Mode::Triangles => count / 3,
+                    Mode::TriangleStrip | Mode::TriangleFan => count.saturating_sub(2),
+                    _ => continue,
+                };
+                triangles = triangles.saturating_add(t);
+                vertices = vertices.saturating_add(pos.count() as u64);
+            }
+        }
+        stack.extend(node.children().map(|c| (c, depth + 1)));
+    }
+    Ok((triangles, vertices))
+}
+
+fn deep(format: &'static str, node: usize) -> Error {
+    Error::malformed(
+        format,
+        format!("node {node} is deeper than {MAX_DEPTH} levels in the node hierarchy"),
+    )
 }
 
 /// Prepares the JSON for the crate's validation, which itself panics on some bad indices:
@@ -369,10 +525,7 @@ const MAX_DEPTH: usize = 256;
 impl Walker {
     fn walk(&mut self, node: &gltf::Node, parent: &Mat4, depth: usize) -> Result<()> {
         if depth > MAX_DEPTH {
-            return Err(Error::malformed(
-                self.format,
-                "node hierarchy deeper than 256 levels (a cycle?)",
-            ));
+            return Err(deep(self.format, node.index()));
         }
         // glTF matrices are column-major: m[c][r].
         let cm = node.transform().matrix();
@@ -383,6 +536,22 @@ impl Walker {
             }
         }
         let world = mul(parent, &local);
+        if let Some(bad) = world
+            .iter()
+            .flatten()
+            .find(|v| !(v.abs() <= MAX_COORDINATE))
+        {
+            return Err(Error::out_of_range(
+                self.format,
+                format!("node {}", node.index()),
+                "transform",
+                format!(
+                    "(its own composed with its ancestors') has an entry of {}, beyond ±{} (a scale or translation out of range, or a value past f32)",
+                    show(*bad),
+                    show(MAX_COORDINATE)
+                ),
+            ));
+        }
         if let Some(mesh) = node.mesh() {
             self.instances += 1;
             for prim in mesh.primitives() {
@@ -418,20 +587,18 @@ impl Walker {
                 format!("mesh {mesh_index}: POSITION is not VEC3"),
             ));
         }
-        let local = decode_accessor(self.format, &self.buffers, &pos)?;
-        let n = local.len() / 3;
+        let n = pos.count();
         let base = self.mesh.vertices.len();
-        if base + n > u32::MAX as usize {
+        if base.saturating_add(n) > u32::MAX as usize {
             return Err(Error::unsupported(
                 self.format,
                 "more than 4 billion vertices",
             ));
         }
-        self.mesh.vertices.extend(
-            local
-                .chunks_exact(3)
-                .map(|c| apply(world, [c[0], c[1], c[2]])),
-        );
+        let vertices = &mut self.mesh.vertices;
+        decode_accessor(self.format, &self.buffers, &pos, |c| {
+            vertices.push(apply(world, [c[0], c[1], c[2]]));
+        })?;
         let indices: Vec<u32> = match prim.indices() {
             Some(acc) => {
                 if acc.dimensions() != Dimensions::Scalar
@@ -445,16 +612,20 @@ impl Walker {
                         format!("mesh {mesh_index}: indices are not unsigned integer scalars"),
                     ));
                 }
-                let raw = decode_accessor(self.format, &self.buffers, &acc)?;
-                let mut out = Vec::with_capacity(raw.len());
-                for v in raw {
-                    if v >= n as f64 {
-                        return Err(Error::malformed(
-                            self.format,
-                            format!("mesh {mesh_index}: index {v} ≥ vertex count {n}"),
-                        ));
+                let mut out = Vec::with_capacity(acc.count());
+                let mut bad: Option<f64> = None;
+                decode_accessor(self.format, &self.buffers, &acc, |v| {
+                    if v[0] < n as f64 {
+                        out.push(v[0] as u32);
+                    } else if bad.is_none() {
+                        bad = Some(v[0]);
                     }
-                    out.push(v as u32);
+                })?;
+                if let Some(v) = bad {
+                    return Err(Error::malformed(
+                        self.format,
+                        format!("mesh {mesh_index}: index {v} ≥ vertex count {n}"),
+                    ));
                 }
                 out
             }
@@ -518,21 +689,34 @@ fn component(dt: DataType, b: &[u8], normalized: bool) -> f64 {
     }
 }
 
-/// Decodes an accessor into a flat list of f64 components, checking every range.
+/// Most components of an accessor element (MAT4).
+const MAX_DIMS: usize = 16;
+
+/// Decodes an accessor element by element (sparse substitutions applied), checking every
+/// range first, and hands each element's components to `sink` in order; fails on a
+/// non-finite component. Nothing is allocated besides the sparse substitutions, which are
+/// bounded by their bytes.
 fn decode_accessor(
     format: &'static str,
     buffers: &[Vec<u8>],
     acc: &gltf::Accessor,
-) -> Result<Vec<f64>> {
+    mut sink: impl FnMut(&[f64]),
+) -> Result<()> {
     let dims = acc.dimensions().multiplicity();
+    if dims == 0 || dims > MAX_DIMS {
+        return Err(Error::malformed(
+            format,
+            format!("accessor {}: {dims} components", acc.index()),
+        ));
+    }
     let dt = acc.data_type();
     let csize = dt.size();
     let count = acc.count();
     let elem = csize * dims;
     let normalized = acc.normalized();
     let err = |what: &str| Error::malformed(format, format!("accessor {}: {what}", acc.index()));
-    let mut out = Vec::new();
-    match acc.view() {
+    // The dense data: a view's bytes and stride, or zeros.
+    let dense: Option<(&[u8], usize)> = match acc.view() {
         Some(view) => {
             let buf = buffers
                 .get(view.buffer().index())
@@ -564,21 +748,18 @@ fn decode_accessor(
                     });
                 }
             }
-            out.reserve(count * dims);
-            for i in 0..count {
-                let at = acc.offset() + i * stride;
-                for k in 0..dims {
-                    out.push(component(dt, &view_bytes[at + k * csize..], normalized));
-                }
-            }
+            Some((view_bytes, stride))
         }
         None => {
             if count > 100_000_000 {
                 return Err(err("sparse/zero accessor with an implausible count"));
             }
-            out.resize(count * dims, 0.0);
+            None
         }
-    }
+    };
+    // Sparse substitutions, sorted by element index (the last one wins for repeated indices).
+    let mut sparse_idx: Vec<(usize, usize)> = Vec::new();
+    let mut sparse_bytes: &[u8] = &[];
     if let Some(sparse) = acc.sparse() {
         let n = sparse.count();
         let iv = sparse.indices();
@@ -590,7 +771,7 @@ fn decode_accessor(
             gltf::accessor::sparse::IndexType::U16 => 2,
             gltf::accessor::sparse::IndexType::U32 => 4,
         };
-        let istart = iv.view().offset() + iv.offset();
+        let istart = iv.view().offset().saturating_add(iv.offset());
         let ibytes = ibuf
             .get(istart..istart.saturating_add(n.saturating_mul(isize)))
             .ok_or_else(|| err("sparse indices run past their buffer"))?;
@@ -598,10 +779,11 @@ fn decode_accessor(
         let vbuf = buffers
             .get(vv.view().buffer().index())
             .ok_or_else(|| err("sparse buffer missing"))?;
-        let vstart = vv.view().offset() + vv.offset();
-        let vbytes = vbuf
+        let vstart = vv.view().offset().saturating_add(vv.offset());
+        sparse_bytes = vbuf
             .get(vstart..vstart.saturating_add(n.saturating_mul(elem)))
             .ok_or_else(|| err("sparse values run past their buffer"))?;
+        sparse_idx.reserve(n);
         for j in 0..n {
             let b = &ibytes[j * isize..];
             let idx = match isize {
@@ -612,20 +794,48 @@ fn decode_accessor(
             if idx >= count {
                 return Err(err("sparse index out of range"));
             }
-            for k in 0..dims {
-                out[idx * dims + k] = component(dt, &vbytes[j * elem + k * csize..], normalized);
-            }
+            sparse_idx.push((idx, j));
         }
+        sparse_idx.sort_by_key(|&(idx, j)| (idx, std::cmp::Reverse(j)));
+        sparse_idx.dedup_by_key(|e| e.0);
     }
-    if out.iter().any(|v| !v.is_finite()) {
+    let mut next_sparse = sparse_idx.iter().peekable();
+    let mut values = [0.0f64; MAX_DIMS];
+    let (mut bad, mut first_bad) = (0usize, 0usize);
+    for i in 0..count {
+        let src: Option<&[u8]> = match next_sparse.peek() {
+            Some(&&(idx, j)) if idx == i => {
+                next_sparse.next();
+                sparse_bytes.get(j * elem..)
+            }
+            _ => dense.and_then(|(bytes, stride)| bytes.get(acc.offset() + i * stride..)),
+        };
+        let el = &mut values[..dims];
+        match src {
+            Some(b) => {
+                for (k, v) in el.iter_mut().enumerate() {
+                    *v = component(dt, &b[k * csize..], normalized);
+                }
+            }
+            None => el.fill(0.0),
+        }
+        if el.iter().any(|v| !v.is_finite()) {
+            if bad == 0 {
+                first_bad = i;
+            }
+            bad += 1;
+        }
+        sink(el);
+    }
+    if bad > 0 {
         return Err(Error::NonFinite {
             format,
             what: "accessor value",
-            count: out.iter().filter(|v| !v.is_finite()).count(),
-            first_index: out.iter().position(|v| !v.is_finite()).unwrap_or(0) / dims.max(1),
+            count: bad,
+            first_index: first_bad,
         });
     }
-    Ok(out)
+    Ok(())
 }
 
 #[cfg(test)]
@@ -831,6 +1041,143 @@ mod tests {
                 .len(),
             1
         );
+    }
+
+    /// Nodes `[{"children":[1,1]}, ..., {"mesh":0}]`: each level lists its child twice.
+    fn dag(levels: usize) -> String {
+        let mut nodes: Vec<String> = (0..levels)
+            .map(|i| format!(r#"{{"children":[{},{}]}}"#, i + 1, i + 1))
+            .collect();
+        nodes.push(r#"{"mesh":0}"#.into());
+        format!("[{}]", nodes.join(","))
+    }
+
+    #[test]
+    fn node_graphs_must_be_trees() {
+        let err = |nodes: &str, extra: &str| {
+            read(&gltf_json(&QUAD[..3], None, 4, nodes, extra))
+                .unwrap_err()
+                .to_string()
+        };
+        // A DAG 40 levels deep (2^40 paths): refused at once, naming the node.
+        let t = std::time::Instant::now();
+        let e = err(&dag(40), "");
+        assert!(e.contains("node 0 lists node 1 twice"), "{e}");
+        assert!(t.elapsed().as_secs_f64() < 1.0);
+        // Two parents.
+        let e = err(r#"[{"children":[2]},{"children":[2]},{"mesh":0}]"#, "");
+        assert!(
+            e.contains("node 1 lists node 2 as a child, but node 0 already does"),
+            "{e}"
+        );
+        // A cycle (not reachable from the scene root, which is fine otherwise).
+        let e = err(r#"[{"mesh":0},{"children":[2]},{"children":[1]}]"#, "");
+        assert!(e.contains("is its own ancestor"), "{e}");
+        let e = err(r#"[{"mesh":0,"children":[0]}]"#, "");
+        assert!(e.contains("node 0"), "{e}");
+        // A scene repeating its root, and a root that is a child.
+        let repeat = String::from_utf8(gltf_json(&QUAD[..3], None, 4, PLAIN, ""))
+            .unwrap()
+            .replace(
+                r#""scenes":[{"nodes":[0]}]"#,
+                r#""scenes":[{"nodes":[0,0,0]}]"#,
+            );
+        let e = read(repeat.as_bytes()).unwrap_err().to_string();
+        assert!(e.contains("scene 0 lists node 0 more than once"), "{e}");
+        let child_root = String::from_utf8(gltf_json(
+            &QUAD[..3],
+            None,
+            4,
+            r#"[{"children":[1]},{"mesh":0}]"#,
+            "",
+        ))
+        .unwrap()
+        .replace(
+            r#""scenes":[{"nodes":[0]}]"#,
+            r#""scenes":[{"nodes":[0,1]}]"#,
+        );
+        let e = read(child_root.as_bytes()).unwrap_err().to_string();
+        assert!(
+            e.contains("node 1 as a root, but it is a child of node 0"),
+            "{e}"
+        );
+        // A deep but valid chain is read (transforms composed once per node).
+        let chain: Vec<String> = (0..100)
+            .map(|i| format!(r#"{{"children":[{}],"translation":[1,0,0]}}"#, i + 1))
+            .chain([r#"{"mesh":0}"#.to_string()])
+            .collect();
+        let g = read(&gltf_json(
+            &QUAD[..3],
+            None,
+            4,
+            &format!("[{}]", chain.join(",")),
+            "",
+        ))
+        .unwrap();
+        assert_eq!(g.mesh.vertices[0], [100.0, 0.0, 0.0]);
+    }
+
+    #[test]
+    fn expanded_size_is_bounded_before_decoding() {
+        // One mesh instanced by 10 000 nodes: 10 000 triangles.
+        let nodes: Vec<String> = (0..10_000).map(|_| r#"{"mesh":0}"#.to_string()).collect();
+        let roots: Vec<String> = (0..10_000).map(|i| i.to_string()).collect();
+        let many = String::from_utf8(gltf_json(
+            &QUAD[..3],
+            None,
+            4,
+            &format!("[{}]", nodes.join(",")),
+            "",
+        ))
+        .unwrap()
+        .replace(
+            r#""scenes":[{"nodes":[0]}]"#,
+            &format!(r#""scenes":[{{"nodes":[{}]}}]"#, roots.join(",")),
+        );
+        let limits = ReadLimits::triangles(9_999);
+        let e = read_gltf_with_limits(many.as_bytes(), &BTreeMap::new(), &limits).unwrap_err();
+        assert_eq!(e.kind(), "limit_exceeded");
+        let msg = e.to_string();
+        assert!(
+            msg.contains("10000") && msg.contains("9999") && msg.contains("max-triangles"),
+            "{msg}"
+        );
+        let g = read_gltf_with_limits(
+            many.as_bytes(),
+            &BTreeMap::new(),
+            &ReadLimits {
+                max_triangles: 10_000,
+                max_vertices: 30_000,
+            },
+        )
+        .unwrap();
+        assert_eq!((g.mesh.triangles.len(), g.instances), (10_000, 10_000));
+        // An accessor without a buffer view costs no bytes: its count is bounded too.
+        let sparse: Vec<u8> = 0u32
+            .to_le_bytes()
+            .into_iter()
+            .chain([1.0f32, 2.0, 3.0].iter().flat_map(|v| v.to_le_bytes()))
+            .collect();
+        let b64 = base64::engine::general_purpose::STANDARD.encode(&sparse);
+        let zeros = format!(
+            r#"{{"asset":{{"version":"2.0"}},"scene":0,"scenes":[{{"nodes":[0]}}],"nodes":[{{"mesh":0}}],"meshes":[{{"primitives":[{{"attributes":{{"POSITION":0}}}}]}}],"accessors":[{{"componentType":5126,"count":COUNT,"type":"VEC3","min":[0,0,0],"max":[0,0,0],"sparse":{{"count":1,"indices":{{"bufferView":0,"componentType":5125}},"values":{{"bufferView":1}}}}}}],"bufferViews":[{{"buffer":0,"byteLength":4}},{{"buffer":0,"byteOffset":4,"byteLength":12}}],"buffers":[{{"byteLength":16,"uri":"data:application/octet-stream;base64,{b64}"}}]}}"#
+        );
+        let g = read(zeros.replace("COUNT", "6").as_bytes()).unwrap();
+        assert_eq!(g.mesh.vertices[0], [1.0, 2.0, 3.0]);
+        assert_eq!(g.mesh.vertices[5], [0.0, 0.0, 0.0]);
+        let e = read(zeros.replace("COUNT", "90000000").as_bytes()).unwrap_err();
+        assert_eq!(e.kind(), "limit_exceeded", "{e}");
+        // Huge node transforms: refused naming the node.
+        let e = read(&gltf_json(
+            &QUAD[..3],
+            None,
+            4,
+            r#"[{"mesh":0,"scale":[1e30,1e30,1e30],"children":[1]},{"mesh":0,"scale":[1e30,1,1]}]"#,
+            "",
+        ))
+        .unwrap_err();
+        assert_eq!(e.kind(), "out_of_range");
+        assert!(e.to_string().contains("node 1: transform"), "{e}");
     }
 
     #[test]

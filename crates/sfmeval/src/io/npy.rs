@@ -321,7 +321,8 @@ pub struct DepthMap {
 
 impl DepthMap {
     /// Reads a depth map from `.npy` bytes (shape `(height, width)`). Non-finite or negative
-    /// depths are refused.
+    /// depths are refused, and so are `float64` depths beyond the `f32` range (≈ 3.4·10³⁸) the
+    /// map is kept in.
     pub fn from_npy(bytes: &[u8]) -> Result<DepthMap> {
         let a = read_npy(bytes)?;
         if a.rows == 0 || a.cols == 0 {
@@ -333,14 +334,14 @@ impl DepthMap {
             .values
             .iter()
             .enumerate()
-            .filter(|(_, v)| !(v.is_finite() && **v >= 0.0))
+            .filter(|(_, v)| !((**v as f32).is_finite() && **v >= 0.0))
             .map(|(i, _)| i)
             .collect();
         if let Some(&first) = bad.first() {
             return Err(Error::malformed(
                 FMT,
                 format!(
-                    "{} depth value(s) are negative or not finite; the first at row {}, column {}",
+                    "{} depth value(s) are negative, not finite or beyond the f32 range; the first at row {}, column {}",
                     bad.len(),
                     first / a.cols,
                     first % a.cols

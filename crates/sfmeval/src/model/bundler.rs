@@ -184,6 +184,7 @@ pub fn read_bundler(out: &[u8], list: Option<&[u8]>) -> Result<Reconstruction> {
         rec.warnings
             .push("no image list: images are named camera_0, camera_1, ...".into());
     }
+    rec.validate(FMT, false)?;
     Ok(rec)
 }
 

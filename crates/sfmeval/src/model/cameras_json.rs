@@ -56,7 +56,8 @@ struct JsonPose {
 
 /// Reads a `cameras.json`. The result's [`Reconstruction::warnings`] mention a non-`gltf`
 /// frame only when asked through [`frame_of`]; rotations are checked to be rotations
-/// (orthonormal, determinant +1, tolerance 1e-4).
+/// (orthonormal, determinant +1, [`super::ROTATION_TOLERANCE`]) and cameras and poses for sense
+/// ([`Reconstruction::validate`]).
 pub fn read_cameras_json(bytes: &[u8]) -> Result<Reconstruction> {
     let file: File = serde_json::from_slice(bytes).map_err(|e| {
         if e.is_eof() {
@@ -149,13 +150,12 @@ pub fn read_cameras_json(bytes: &[u8]) -> Result<Reconstruction> {
                 first_index: i,
             });
         }
-        if let Some(dev) = rotation_defect(&pose.rotation) {
-            return Err(Error::malformed(
+        if let Some(dev) = super::rotation_defect(&pose.rotation) {
+            return Err(Error::out_of_range(
                 FMT,
-                format!(
-                    "image '{}': rotation is not a rotation matrix ({dev})",
-                    super::text::clip(&im.name)
-                ),
+                format!("image '{}'", super::text::clip(&im.name)),
+                "cam_from_world.rotation",
+                dev,
             ));
         }
         let group = groups.entry(im.model_index.unwrap_or(0)).or_default();
@@ -182,6 +182,7 @@ pub fn read_cameras_json(bytes: &[u8]) -> Result<Reconstruction> {
     };
     let mut rec = super::choose_largest(models)?;
     rec.cameras = cameras;
+    rec.validate(FMT, true)?;
     if let Some(f) = frame_note {
         rec.warnings.push(format!(
             "cameras.json frame is '{}', not 'gltf' or 'reconstruction'",
@@ -196,28 +197,6 @@ pub fn read_cameras_json(bytes: &[u8]) -> Result<Reconstruction> {
 pub fn frame_of(bytes: &[u8]) -> Option<String> {
     let v: serde_json::Value = serde_json::from_slice(bytes).ok()?;
     v.get("frame")?.as_str().map(str::to_string)
-}
-
-/// `None` when `r` is a rotation within 1e-4, else what is wrong.
-fn rotation_defect(r: &[[f64; 3]; 3]) -> Option<String> {
-    let rrt = super::mat_mul(r, &super::transpose(r));
-    let mut worst = 0.0f64;
-    for (i, row) in rrt.iter().enumerate() {
-        for (j, v) in row.iter().enumerate() {
-            let want = if i == j { 1.0 } else { 0.0 };
-            worst = worst.max((v - want).abs());
-        }
-    }
-    if worst > 1e-4 {
-        return Some(format!("R·Rᵀ differs from I by {worst:.2e}"));
-    }
-    let det = r[0][0] * (r[1][1] * r[2][2] - r[1][2] * r[2][1])
-        - r[0][1] * (r[1][0] * r[2][2] - r[1][2] * r[2][0])
-        + r[0][2] * (r[1][0] * r[2][1] - r[1][1] * r[2][0]);
-    if det < 0.0 {
-        return Some("determinant is −1 (a reflection)".into());
-    }
-    None
 }
 
 /// Writes a reconstruction's cameras and poses as `cameras.json` (`frame` = `reconstruction`
@@ -334,12 +313,94 @@ mod tests {
             Err(Error::Malformed { .. })
         ));
         let mirrored = pose.replace("[0,0,1]]", "[0,0,-1]]");
-        assert!(matches!(
-            read_cameras_json(
-                with(&format!(r#"{{"name":"a.jpg","camera_id":1,{mirrored}}}"#)).as_bytes()
+        let e = read_cameras_json(
+            with(&format!(r#"{{"name":"a.jpg","camera_id":1,{mirrored}}}"#)).as_bytes(),
+        )
+        .unwrap_err();
+        assert_eq!(e.kind(), "out_of_range");
+        let msg = e.to_string();
+        assert!(
+            msg.contains("image 'a.jpg'") && msg.contains("rotation") && msg.contains("reflection"),
+            "{msg}"
+        );
+        // Finite but absurd values: each refused naming the image or camera and the field.
+        let cases = [
+            (
+                with(&format!(
+                    r#"{{"name":"a.jpg","camera_id":1,{}}}"#,
+                    pose.replace("[0,0,0]", "[1e150,0,0]")
+                )),
+                "translation x",
             ),
-            Err(Error::Malformed { .. })
-        ));
+            (
+                with(&format!(
+                    r#"{{"name":"a.jpg","camera_id":1,{}}}"#,
+                    pose.replace("[1,0,0]", "[1e308,0,0]")
+                )),
+                "rotation",
+            ),
+            (
+                with(&format!(
+                    r#"{{"name":"a.jpg","camera_id":1,{}}}"#,
+                    pose.replace("[1,0,0]", "[0.9,0,0]")
+                )),
+                "rotation",
+            ),
+            (
+                with(&format!(r#"{{"name":"a.jpg","camera_id":1,{pose}}}"#))
+                    .replace(r#""width":4"#, r#""width":18446744073709551615"#),
+                "width",
+            ),
+            (
+                with(&format!(r#"{{"name":"a.jpg","camera_id":1,{pose}}}"#))
+                    .replace(r#""height":3"#, r#""height":0"#),
+                "height",
+            ),
+            (
+                with(&format!(r#"{{"name":"a.jpg","camera_id":1,{pose}}}"#))
+                    .replace(r#""fx":1"#, r#""fx":-1"#),
+                "focal length fx",
+            ),
+            (
+                with(&format!(r#"{{"name":"a.jpg","camera_id":1,{pose}}}"#))
+                    .replace(r#""fy":1"#, r#""fy":1e308"#),
+                "focal length fy",
+            ),
+            (
+                with(&format!(r#"{{"name":"a.jpg","camera_id":1,{pose}}}"#))
+                    .replace(r#""cx":2"#, r#""cx":1e300"#),
+                "principal point cx",
+            ),
+        ];
+        for (text, field) in cases {
+            let e = read_cameras_json(text.as_bytes()).unwrap_err();
+            assert_eq!(e.kind(), "out_of_range", "{field}: {e}");
+            let msg = e.to_string();
+            assert!(msg.contains(field), "{field}: {msg}");
+            assert!(
+                msg.contains("image 'a.jpg'") || msg.contains("camera 1"),
+                "{msg}"
+            );
+        }
+        // Both sizes 0 (unknown) and a principal point outside the image: warnings.
+        let unknown = with(&format!(r#"{{"name":"a.jpg","camera_id":1,{pose}}}"#))
+            .replace(r#""width":4,"height":3"#, r#""width":0,"height":0"#);
+        let r = read_cameras_json(unknown.as_bytes()).unwrap();
+        assert!(
+            r.warnings
+                .iter()
+                .any(|w| w.contains("camera 1") && w.contains("unknown")),
+            "{:?}",
+            r.warnings
+        );
+        let outside = with(&format!(r#"{{"name":"a.jpg","camera_id":1,{pose}}}"#))
+            .replace(r#""cx":2"#, r#""cx":-50"#);
+        let r = read_cameras_json(outside.as_bytes()).unwrap();
+        assert!(
+            r.warnings.iter().any(|w| w.contains("principal point")),
+            "{:?}",
+            r.warnings
+        );
         // JSON has no NaN literal: a NaN pose is a parse error, never a panic.
         let nan = pose.replace("[0,0,0]", "[NaN,0,0]");
         assert!(

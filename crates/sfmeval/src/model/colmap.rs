@@ -662,7 +662,7 @@ fn assemble(
             "{dangling_track} track element(s) refer to images that are not in images; dropped"
         ));
     }
-    rec.check_finite(fmt)?;
+    rec.validate(fmt, true)?;
     Ok(rec)
 }
 

@@ -30,7 +30,22 @@ mod text;
 pub(crate) mod fuzz_tests;
 
 use crate::error::{Error, Result};
-use crate::geometry::{Point3, PointCloud};
+use crate::geometry::{MAX_COORDINATE, Point3, PointCloud, show};
+
+/// Largest image width or height accepted, in pixels (a gigapixel panorama is 10⁵ wide); 0 means
+/// unknown (NVM and Bundler store no size) and is allowed.
+pub const MAX_IMAGE_SIZE: u64 = 1_000_000;
+
+/// Focal lengths must lie in `[MIN_FOCAL_PX, MAX_FOCAL_PX]` pixels (positive; a telephoto lens
+/// on a small-pixel sensor reaches 10⁶), except for models without one (equirectangular).
+pub const MIN_FOCAL_PX: f64 = 1e-6;
+
+/// See [`MIN_FOCAL_PX`]; principal points must also lie within ±`MAX_FOCAL_PX`.
+pub const MAX_FOCAL_PX: f64 = 1e9;
+
+/// A rotation matrix is accepted when every entry of `R·Rᵀ − I` is within this and its
+/// determinant is positive (matrices written with 5 significant digits pass).
+pub const ROTATION_TOLERANCE: f64 = 1e-4;
 
 /// A row-major 3×3 matrix.
 pub type Mat3 = [[f64; 3]; 3];
@@ -92,12 +107,17 @@ impl Rigid {
     }
 }
 
-/// Rotation matrix of a Hamilton quaternion `[w, x, y, z]`, normalised first.
+/// Rotation matrix of a Hamilton quaternion `[w, x, y, z]`, normalised first (without overflow
+/// or underflow: any finite, non-zero quaternion is a rotation). `None` for a zero or
+/// non-finite quaternion.
 pub fn quaternion_to_matrix(q: [f64; 4]) -> Option<Mat3> {
-    let n = (q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]).sqrt();
-    if !(n.is_finite() && n > 0.0) {
+    let m = q.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    if !(m.is_finite() && m > 0.0) || q.iter().any(|v| !v.is_finite()) {
         return None;
     }
+    // Scaled by the largest component first, so neither 1e308 nor 1e-300 breaks the norm.
+    let q = q.map(|v| v / m);
+    let n = (q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]).sqrt();
     let [w, x, y, z] = q.map(|v| v / n);
     Some([
         [
@@ -148,6 +168,44 @@ pub fn transpose(m: &Mat3) -> Mat3 {
         }
     }
     t
+}
+
+/// `None` when `r` is a rotation within [`ROTATION_TOLERANCE`] (`R·Rᵀ = I`, determinant +1),
+/// else what is wrong.
+pub fn rotation_defect(r: &Mat3) -> Option<String> {
+    if r.iter().flatten().any(|v| !v.is_finite()) {
+        return Some("has a non-finite entry".into());
+    }
+    if let Some(v) = r
+        .iter()
+        .flatten()
+        .find(|v| v.abs() > 1.0 + ROTATION_TOLERANCE)
+    {
+        return Some(format!(
+            "is not a rotation: it has an entry of {} (a rotation's are within ±1)",
+            show(*v)
+        ));
+    }
+    let rrt = mat_mul(r, &transpose(r));
+    let mut worst = 0.0f64;
+    for (i, row) in rrt.iter().enumerate() {
+        for (j, v) in row.iter().enumerate() {
+            let want = if i == j { 1.0 } else { 0.0 };
+            worst = worst.max((v - want).abs());
+        }
+    }
+    if !(worst <= ROTATION_TOLERANCE) {
+        return Some(format!(
+            "is not a rotation: R·Rᵀ differs from I by {worst:.2e} (tolerance {ROTATION_TOLERANCE:e})"
+        ));
+    }
+    let det = r[0][0] * (r[1][1] * r[2][2] - r[1][2] * r[2][1])
+        - r[0][1] * (r[1][0] * r[2][2] - r[1][2] * r[2][0])
+        + r[0][2] * (r[1][0] * r[2][1] - r[1][1] * r[2][0]);
+    if det < 0.0 {
+        return Some("is not a rotation: its determinant is −1 (a reflection)".into());
+    }
+    None
 }
 
 /// Rotation angle of a rotation matrix in degrees, in `[0, 180]`; robust near 0 and 180°
@@ -202,6 +260,109 @@ impl Camera {
     /// Mean focal length `(fx + fy) / 2` in pixels.
     pub fn focal(&self) -> f64 {
         0.5 * (self.fx + self.fy)
+    }
+
+    /// Whether the model has a focal length at all (equirectangular / OpenMVG `spherical` have
+    /// none: `fx = fy = 0`).
+    pub fn has_focal(&self) -> bool {
+        let none = colmap::camera_model_by_name(&self.model)
+            .is_some_and(|m| m.focal == colmap::FocalLayout::None);
+        !(none || self.model.eq_ignore_ascii_case("spherical"))
+    }
+
+    /// Checks the intrinsics for sense; `item` names the camera in messages (`camera 3`,
+    /// `camera 2 (image 'a.jpg')`). Errors ([`Error::OutOfRange`]): a width or height beyond
+    /// [`MAX_IMAGE_SIZE`], only one of them 0, a focal length (of a model with one) outside
+    /// `[MIN_FOCAL_PX, MAX_FOCAL_PX]` — negative, zero or absurd —, a principal point or
+    /// parameter beyond ±[`MAX_FOCAL_PX`] / ±[`MAX_COORDINATE`], a non-finite value. Warnings
+    /// (returned): both sizes 0 (unknown) when `size_stored`, a principal point outside the
+    /// image.
+    pub fn check(
+        &self,
+        format: &'static str,
+        item: &str,
+        size_stored: bool,
+    ) -> Result<Vec<String>> {
+        let mut warnings = Vec::new();
+        let bad =
+            |field: &str, problem: String| Err(Error::out_of_range(format, item, field, problem));
+        for (field, v) in [("width", self.width), ("height", self.height)] {
+            if v > MAX_IMAGE_SIZE {
+                return bad(
+                    field,
+                    format!("is {v} px, beyond the {MAX_IMAGE_SIZE} px accepted"),
+                );
+            }
+        }
+        if (self.width == 0) != (self.height == 0) {
+            let field = if self.width == 0 { "width" } else { "height" };
+            return bad(
+                field,
+                format!(
+                    "is 0 while the image is {} px {}: image sizes must be 1..={MAX_IMAGE_SIZE} px",
+                    self.width.max(self.height),
+                    if self.width == 0 { "high" } else { "wide" }
+                ),
+            );
+        }
+        if size_stored && self.width == 0 {
+            warnings.push(format!(
+                "{item}: width and height are 0 (unknown): the principal point and the focal-length error cannot be checked against the image size"
+            ));
+        }
+        if self.has_focal() {
+            for (field, f) in [("focal length fx", self.fx), ("focal length fy", self.fy)] {
+                if !(MIN_FOCAL_PX..=MAX_FOCAL_PX).contains(&f) {
+                    return bad(
+                        field,
+                        format!(
+                            "is {} px; a focal length must be positive, in [{}, {}] px",
+                            show(f),
+                            show(MIN_FOCAL_PX),
+                            show(MAX_FOCAL_PX)
+                        ),
+                    );
+                }
+            }
+        }
+        for (field, c) in [
+            ("principal point cx", self.cx),
+            ("principal point cy", self.cy),
+        ] {
+            if !(c.abs() <= MAX_FOCAL_PX) {
+                return bad(
+                    field,
+                    format!("is {} px, beyond ±{} px", show(c), show(MAX_FOCAL_PX)),
+                );
+            }
+        }
+        if let Some(i) = self.params.iter().position(|v| !v.is_finite()) {
+            return bad(&format!("parameter #{i}"), "is not finite".into());
+        }
+        if let Some(i) = self
+            .params
+            .iter()
+            .position(|v| !(v.abs() <= MAX_COORDINATE))
+        {
+            return bad(
+                &format!("parameter #{i}"),
+                format!(
+                    "is {}, beyond ±{}",
+                    show(self.params[i]),
+                    show(MAX_COORDINATE)
+                ),
+            );
+        }
+        if self.width > 0 {
+            let (w, h) = (self.width as f64, self.height as f64);
+            if !(0.0..=w).contains(&self.cx) || !(0.0..=h).contains(&self.cy) {
+                warnings.push(format!(
+                    "{item}: principal point ({}, {}) lies outside its {}×{} image",
+                    self.cx, self.cy, self.width, self.height
+                ));
+            }
+        }
+        Ok(warnings)
     }
 }
 
@@ -353,7 +514,77 @@ impl Reconstruction {
         }
     }
 
-    /// Fails with [`Error::NonFinite`] when a pose or a point is NaN/infinite.
+    /// Checks what a reader returns, and adds its warnings: every camera's intrinsics
+    /// ([`Camera::check`]; `size_stored` when the format stores the image size), every pose
+    /// (finite, a rotation within [`ROTATION_TOLERANCE`], translation and camera centre within
+    /// ±[`MAX_COORDINATE`]), every 3D point and 2D observation within ±[`MAX_COORDINATE`].
+    /// Errors name the camera or image and the field ([`Error::OutOfRange`]).
+    pub fn validate(&mut self, format: &'static str, size_stored: bool) -> Result<()> {
+        let mut warnings = Vec::new();
+        for cam in &self.cameras {
+            let image = self
+                .images
+                .iter()
+                .filter(|im| im.camera_id == cam.id)
+                .map(|im| im.name.as_str())
+                .next();
+            let item = match image {
+                // One camera per image (NVM, Bundler): name the image too.
+                Some(name) if !size_stored => {
+                    format!("camera {} (image '{}')", cam.id, text::clip(name))
+                }
+                _ => format!("camera {}", cam.id),
+            };
+            warnings.extend(cam.check(format, &item, size_stored)?);
+        }
+        for im in &self.images {
+            let item = || format!("image '{}' (id {})", text::clip(&im.name), im.id);
+            if let Some(defect) = rotation_defect(&im.cam_from_world.rotation) {
+                return Err(Error::out_of_range(format, item(), "rotation", defect));
+            }
+            for (field, v) in [
+                ("translation", im.cam_from_world.translation),
+                ("camera centre", im.center()),
+            ] {
+                if let Some(k) = (0..3).find(|&k| !(v[k].abs() <= MAX_COORDINATE)) {
+                    return Err(Error::out_of_range(
+                        format,
+                        item(),
+                        format!("{field} {}", ["x", "y", "z"][k]),
+                        format!(
+                            "is {}, beyond ±{} (the largest coordinate measured)",
+                            show(v[k]),
+                            show(MAX_COORDINATE)
+                        ),
+                    ));
+                }
+            }
+            if let Some((k, o)) = im
+                .observations
+                .iter()
+                .enumerate()
+                .find(|(_, o)| o.xy.iter().any(|v| !(v.abs() <= MAX_COORDINATE)))
+            {
+                return Err(Error::out_of_range(
+                    format,
+                    item(),
+                    format!("observation #{k}"),
+                    format!(
+                        "is at ({}, {}), beyond ±{} px",
+                        show(o.xy[0]),
+                        show(o.xy[1]),
+                        show(MAX_COORDINATE)
+                    ),
+                ));
+            }
+        }
+        self.check_finite(format)?;
+        self.warnings.extend(warnings);
+        Ok(())
+    }
+
+    /// Fails with [`Error::NonFinite`] when a pose or a point is NaN/infinite, and with
+    /// [`Error::OutOfRange`] when a point lies beyond ±[`MAX_COORDINATE`].
     pub fn check_finite(&self, format: &'static str) -> Result<()> {
         let bad: Vec<usize> = self
             .images

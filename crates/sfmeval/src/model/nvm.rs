@@ -7,6 +7,7 @@
 use super::text::{self, clip};
 use super::{Camera, Image, Point3D, Reconstruction, Rigid};
 use crate::error::{Error, Result};
+use crate::geometry::{MAX_COORDINATE, show};
 
 const FMT: &str = "NVM";
 
@@ -156,6 +157,7 @@ pub fn read_nvm_models(bytes: &[u8]) -> Result<Vec<(String, Reconstruction)>> {
                     .into(),
             );
         }
+        rec.validate(FMT, false)?;
         models.push((format!("model {}", models.len() + 1), rec));
     }
     if models.is_empty() {
@@ -195,6 +197,14 @@ fn camera_line(
     let f = num(0, "focal length")?;
     let q = [num(1, "qw")?, num(2, "qx")?, num(3, "qy")?, num(4, "qz")?];
     let c = [num(5, "Cx")?, num(6, "Cy")?, num(7, "Cz")?];
+    if let Some(k) = (0..3).find(|&k| !(c[k].abs() <= MAX_COORDINATE)) {
+        return Err(Error::out_of_range(
+            FMT,
+            format!("line {line}: camera '{}'", clip(&name)),
+            ["centre Cx", "centre Cy", "centre Cz"][k],
+            format!("is {}, beyond ±{}", show(c[k]), show(MAX_COORDINATE)),
+        ));
+    }
     let r = num(8, "radial distortion")?;
     let rotation = super::quaternion_to_matrix(q).ok_or_else(|| {
         Error::malformed(

@@ -12,6 +12,7 @@ use serde_json::Value;
 
 use super::{Camera, Image, Point3D, Reconstruction, Rigid};
 use crate::error::{Error, Result};
+use crate::geometry::{MAX_COORDINATE, show};
 
 const FMT: &str = "OpenMVG sfm_data";
 
@@ -129,6 +130,9 @@ pub fn read_openmvg_json(bytes: &[u8]) -> Result<Reconstruction> {
                 .and_then(|p| type_names.get(&(p & 0x7fff_ffff)).cloned())
                 .ok_or_else(|| malformed(format!("intrinsic {key}: unknown polymorphic type")))?,
         };
+        if rec.cameras.iter().any(|c| c.id == key) {
+            return Err(malformed(format!("intrinsic key {key} appears twice")));
+        }
         let data = pointer_data(value, &mut seen, &format!("intrinsic {key}"))?;
         let width = data
             .get("width")
@@ -187,7 +191,20 @@ pub fn read_openmvg_json(bytes: &[u8]) -> Result<Reconstruction> {
             }
         }
         let c = vec_n::<3>(value.get("center"), "center")?;
-        poses.insert(key, Rigid::from_rotation_center(r, c));
+        if let Some(k) = (0..3).find(|&k| !(c[k].abs() <= MAX_COORDINATE)) {
+            return Err(Error::out_of_range(
+                FMT,
+                format!("extrinsic {key}"),
+                format!("center {}", ["x", "y", "z"][k]),
+                format!("is {}, beyond ±{}", show(c[k]), show(MAX_COORDINATE)),
+            ));
+        }
+        if poses
+            .insert(key, Rigid::from_rotation_center(r, c))
+            .is_some()
+        {
+            return Err(malformed(format!("extrinsic key {key} appears twice")));
+        }
     }
 
     // Views.
@@ -207,7 +224,11 @@ pub fn read_openmvg_json(bytes: &[u8]) -> Result<Reconstruction> {
         let camera_id = id_intrinsic.filter(|i| rec.cameras.iter().any(|c| c.id == *i));
         match (pose, camera_id) {
             (Some(pose), Some(camera_id)) => {
-                image_of_view.insert(id_view, rec.images.len());
+                if image_of_view.insert(id_view, rec.images.len()).is_some() {
+                    return Err(malformed(format!(
+                        "view id {id_view} appears twice (view {key})"
+                    )));
+                }
                 rec.images.push(Image {
                     id: id_view,
                     name,
@@ -247,6 +268,7 @@ pub fn read_openmvg_json(bytes: &[u8]) -> Result<Reconstruction> {
             track,
         });
     }
+    rec.validate(FMT, true)?;
     if missing_intrinsic > 0 {
         rec.warnings.push(format!(
             "{missing_intrinsic} posed view(s) have no valid intrinsic; counted as unregistered"

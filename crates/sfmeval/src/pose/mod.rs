@@ -166,6 +166,12 @@ pub fn vector_angle_deg(a: Point3, b: Point3) -> f64 {
     match (na > tiny, nb > tiny) {
         (false, false) => 0.0,
         (true, true) => {
+            // Unit vectors when the products could overflow (the angle does not change).
+            let (a, b) = if na > 1e100 || nb > 1e100 {
+                (a.map(|v| v / na), b.map(|v| v / nb))
+            } else {
+                (a, b)
+            };
             let c = crate::geometry::cross(a, b);
             libm::atan2(norm(c), crate::geometry::dot(a, b)).to_degrees()
         }
@@ -311,6 +317,7 @@ pub fn evaluate_cameras_matched(
     let mut images = Vec::with_capacity(pairs.len());
     // Per GT image: estimated pose in the GT frame (rotation, translation up to scale).
     let mut est_in_gt: Vec<Option<(Mat3, Point3)>> = vec![None; gt.images.len()];
+    let mut unusable = 0usize;
     for &(g, e) in &pairs {
         let (Some(gi), Some(ei)) = (gt.images.get(g), est.images.get(e)) else {
             continue;
@@ -318,6 +325,11 @@ pub fn evaluate_cameras_matched(
         // cam_from_gt = cam_from_recon ∘ recon_from_gt: R = R_est · R_sᵀ.
         let r_est_gt = mat_mul(&ei.cam_from_world.rotation, &transpose(&rs));
         let c_est_gt = gt_from_recon.apply(ei.center());
+        if c_est_gt.iter().any(|v| !v.is_finite()) {
+            // Out of f64 range once aligned: as unusable as a NaN pose.
+            unusable += 1;
+            continue;
+        }
         let rot_err =
             rotation_angle_deg(&mat_mul(&gi.cam_from_world.rotation, &transpose(&r_est_gt)));
         let center_err = norm(sub(c_est_gt, gi.center()));
@@ -337,9 +349,24 @@ pub fn evaluate_cameras_matched(
             },
         });
     }
+    if unusable > 0 {
+        warnings.push(format!(
+            "{unusable} estimated camera centre(s) leave the f64 range once aligned; counted as unregistered"
+        ));
+    }
+    // A scene radius so small that a centre error in % of it leaves the f64 range.
+    let pct_usable = radius > 0.0 && images.iter().all(|i| i.center_error_percent.is_finite());
+    if radius > 0.0 && !pct_usable {
+        warnings.push(format!(
+            "scene radius is {radius:e}: centre errors in % of it are out of range and not given"
+        ));
+        for i in &mut images {
+            i.center_error_percent = 0.0;
+        }
+    }
     let rot: Vec<f64> = images.iter().map(|i| i.rotation_error_deg).collect();
     let cen: Vec<f64> = images.iter().map(|i| i.center_error).collect();
-    let cen_pct: Vec<f64> = if radius > 0.0 {
+    let cen_pct: Vec<f64> = if pct_usable {
         images.iter().map(|i| i.center_error_percent).collect()
     } else {
         Vec::new()
