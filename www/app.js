@@ -58,7 +58,7 @@ async function restartWorker() {
     const { files, transfer } = await readFiles(src.files);
     await call(type, { files, ...extra }, transfer);
   };
-  await reload('loadGt', sources.gt);
+  await reload('loadGt', sources.gt, { maxTriangles: Number($('max-triangles').value) || undefined });
   await reload('loadRecon', sources.recon, { name: sources.recon && sources.recon.name });
   await reload('loadCameras', sources.cams);
   await reload('loadDepth', sources.depth);
@@ -223,13 +223,16 @@ function clearStale() {
   delete document.body.dataset.stale;
 }
 
+let lastGtFiles = null; // the last ground truth chosen, loaded or not (max triangles reloads it)
 async function loadGt(fileList) {
   showError('');
   setBusy(true);
   setInputInfo('gt', 'reading…');
+  lastGtFiles = fileList;
   try {
     const { files, transfer } = await readFiles(fileList);
-    const gt = await call('loadGt', { files }, transfer);
+    const maxTriangles = Number($('max-triangles').value) || undefined;
+    const gt = await call('loadGt', { files, maxTriangles }, transfer);
     state.gt = gt;
     sources.gt = { files: Array.from(fileList) };
     state.beside = null;
@@ -433,6 +436,8 @@ $('demo').onclick = async () => {
 // ---- alignment --------------------------------------------------------------------------
 const alignMethod = () => document.querySelector('input[name=align]:checked').value;
 const viewMode = () => document.querySelector('input[name=view]:checked').value;
+// A new triangle limit applies to the ground truth already chosen: read it again.
+$('max-triangles').addEventListener('change', () => { if (lastGtFiles) handleFiles('gt', lastGtFiles); });
 $('file-transform').addEventListener('change', async (e) => {
   const f = e.target.files[0];
   if (f) { $('transform').value = alignedTransform(await f.text()); document.querySelector('input[name=align][value=given]').checked = true; refreshPoints(); }

@@ -16,10 +16,10 @@ const handlers = {
     await init();
     return { version: version() };
   },
-  loadGt({ files }) {
+  loadGt({ files, maxTriangles }) {
     const bytes = {};
     for (const [n, b] of Object.entries(files)) bytes[n] = new Uint8Array(b);
-    const g = loadGroundTruth(bytes);
+    const g = loadGroundTruth(bytes, { maxTriangles });
     if (gt) gt.free();
     gt = g;
     const vertices = new Float32Array(g.vertices());

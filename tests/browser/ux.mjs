@@ -292,6 +292,62 @@ try {
     await page.context().close();
   }
 
+  // ---- hostile ground truths: a glTF node DAG is refused at once and the page stays usable;
+  // a mesh instanced past "max triangles" is refused naming the option, and raising it reads it ----
+  {
+    const tag = 'hostile';
+    const page = await newPage(1366, 768);
+    const glb = (nodes, roots) => {
+      // one triangle, instanced by the nodes that carry `mesh: 0`
+      const bin = Buffer.alloc(48);
+      [0, 0, 0, 1, 0, 0, 0, 1, 0].forEach((v, i) => bin.writeFloatLE(v, 4 * i));
+      [0, 1, 2].forEach((v, i) => bin.writeUInt32LE(v, 36 + 4 * i));
+      const doc = {
+        asset: { version: '2.0' }, scene: 0, scenes: [{ nodes: roots }], nodes,
+        meshes: [{ primitives: [{ attributes: { POSITION: 0 }, indices: 1 }] }],
+        accessors: [
+          { bufferView: 0, componentType: 5126, count: 3, type: 'VEC3', min: [0, 0, 0], max: [1, 1, 0] },
+          { bufferView: 1, componentType: 5125, count: 3, type: 'SCALAR' }],
+        bufferViews: [{ buffer: 0, byteOffset: 0, byteLength: 36 }, { buffer: 0, byteOffset: 36, byteLength: 12 }],
+        buffers: [{ byteLength: 48 }],
+      };
+      let json = Buffer.from(JSON.stringify(doc));
+      json = Buffer.concat([json, Buffer.alloc((4 - (json.length % 4)) % 4, 0x20)]);
+      const header = Buffer.alloc(12);
+      header.write('glTF', 0); header.writeUInt32LE(2, 4); header.writeUInt32LE(12 + 8 + json.length + 8 + bin.length, 8);
+      const chunk = (b, type) => { const h = Buffer.alloc(8); h.writeUInt32LE(b.length, 0); h.write(type, 4); return Buffer.concat([h, b]); };
+      return Buffer.concat([header, chunk(json, 'JSON'), chunk(bin, 'BIN\0')]);
+    };
+    // 60 levels, each listing its child twice: 2^60 paths if expanded
+    const dag = Array.from({ length: 61 }, (_, i) => (i < 60 ? { children: [i + 1, i + 1] } : { mesh: 0 }));
+    const dropGt = async (name, buffer) => {
+      await page.locator('#file-gt').scrollIntoViewIfNeeded();
+      await page.setInputFiles('#file-gt', { name, mimeType: 'application/octet-stream', buffer });
+      await page.waitForFunction(() => !/reading/.test(document.getElementById('info-gt').textContent), null, { timeout: 30000 });
+    };
+    const t = Date.now();
+    await dropGt('dag.glb', glb(dag, [0]));
+    const ms = Date.now() - t;
+    const text = await page.textContent('#error');
+    const responsive = await page.evaluate(() => new Promise((r) => { const s = performance.now(); setTimeout(() => r(performance.now() - s), 0); }));
+    check(`${tag} gltf-dag-refused-quickly-naming-the-node`, /dag\.glb/.test(text) && /node/.test(text) && /parent/.test(text)
+      && inView(await where(page, '#banner')) && ms < 20000 && responsive < 1000, `${ms} ms, "${text}"`);
+    // 12 nodes instancing the triangle: 12 triangles expanded
+    const instances = glb(Array.from({ length: 12 }, (_, i) => ({ mesh: 0, translation: [2 * i, 0, 0] })), [...Array(12).keys()]);
+    await page.fill('#max-triangles', '10');
+    await page.dispatchEvent('#max-triangles', 'change');
+    await dropGt('instances.glb', instances);
+    const limited = await page.textContent('#error');
+    check(`${tag} triangle-limit-refuses-naming-the-option`, /instances\.glb/.test(limited) && /12/.test(limited)
+      && /maxTriangles|max-triangles/.test(limited), `"${limited}"`);
+    await page.fill('#max-triangles', '12');
+    await page.dispatchEvent('#max-triangles', 'change');
+    await page.waitForFunction(() => /^instances\.glb \(/.test(document.getElementById('info-gt').textContent), null, { timeout: 30000 });
+    check(`${tag} raising-the-limit-reads-the-same-file`, / 12 triangles/.test(await page.textContent('#info-gt')),
+      await page.textContent('#info-gt'));
+    await page.context().close();
+  }
+
   // ---- the page's wording of the core's alignment notes (crates/sfmeval/src/align) ---------
   {
     const page = await newPage(1366, 768);
@@ -327,7 +383,7 @@ try {
 } finally {
   const foreign = requests.filter((u) => !u.startsWith(origin) && !u.startsWith('data:') && !u.startsWith('blob:'));
   check('ux no-request-leaves-the-origin', foreign.length === 0 && requests.length > 0, foreign.join(', '));
-  const bad = consoleErrors.filter((t) => !/broken\.ply|Failed to load resource/.test(t));
+  const bad = consoleErrors.filter((t) => !/broken\.ply|dag\.glb|instances\.glb|Failed to load resource/.test(t));
   check('ux no-console-errors', bad.length === 0, bad.join(' | '));
   console.log(`page: ux checks in ${((Date.now() - t0) / 1000).toFixed(1)} s`);
   await browser.close();
