@@ -1,7 +1,7 @@
 //! The ground-truth views of a dataset: each image's exact camera (`cameras.json`) with its depth
 //! map (`depth/<stem>.npy`, `docs/dataset.md`). Projection, depth look-up in the 2×2 pixel
 //! neighbourhood of a sub-pixel position, and back-projection of a pixel to its 3D surface point.
-//! Used by [`crate::visibility`] and [`crate::track_error`].
+//! Used by [`crate::visibility`] and by the track-based error of [`crate::pipeline`].
 //!
 //! Pixel convention: COLMAP's (the top-left pixel's centre is at (0.5, 0.5)); depth pixel
 //! `(i, j)` holds the depth of the ray through `(i + 0.5, j + 0.5)`.

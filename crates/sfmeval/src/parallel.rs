@@ -45,7 +45,7 @@ where
     }
 }
 
-/// Maps `f` over 3D points visited in Morton order ([`morton_order`]: neighbours in space are
+/// Maps `f` over 3D points visited in Morton order (a Z-curve: neighbours in space are
 /// queried one after the other, which keeps a BVH or k-d tree in cache) and returns the results
 /// in input order, like [`map`]. Worth it for closest-point queries on large inputs.
 pub fn map_points<R, F>(points: &[Point3], progress: &dyn Progress, f: F) -> Vec<R>
