@@ -133,6 +133,10 @@ pub enum Error {
     PointPairs(String),
 }
 
+/// The format name of point-pairs files in errors (`crate::align::points::PAIRS_FORMAT`): the
+/// errors that carry it concern the pairs file ([`Error::concerns_point_pairs`]).
+pub(crate) const POINT_PAIRS_FORMAT: &str = "point pairs";
+
 /// Shorthand result type of the core.
 pub type Result<T, E = Error> = core::result::Result<T, E>;
 
@@ -169,7 +173,7 @@ impl Error {
             Error::Malformed { format, .. }
             | Error::Truncated { format, .. }
             | Error::NonFinite { format, .. }
-            | Error::OutOfRange { format, .. } => *format == crate::align::points::PAIRS_FORMAT,
+            | Error::OutOfRange { format, .. } => *format == POINT_PAIRS_FORMAT,
             _ => false,
         }
     }

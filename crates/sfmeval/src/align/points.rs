@@ -24,7 +24,7 @@ struct PairsFile {
 }
 
 /// The format name of every error about a pairs file ([`Error::concerns_point_pairs`]).
-pub const PAIRS_FORMAT: &str = "point pairs";
+pub const PAIRS_FORMAT: &str = crate::error::POINT_PAIRS_FORMAT;
 
 /// Parses a point-pairs file: `{"pairs": [{"recon": [x, y, z], "gt": [x, y, z]}, ...]}`
 /// (a bare list of pairs is accepted too). Coordinates must be finite and within
