@@ -536,3 +536,17 @@ def test_every_fixture_model_still_gives_a_valid_report(evaluate, scene):
                              "--gt-cameras", MODELS / "gt_cameras.json")
         assert kind == "ok", (recon, rep)
         assert rep["cameras"]["matched"] >= 5, recon
+
+
+def test_ground_truth_camera_warnings_reach_the_report(evaluate, tmp_path):
+    """A ground-truth camera whose principal point lies outside its image is accepted with a
+    warning, and that warning is in the report (it named only the reconstruction's before)."""
+    cams = json.loads((MODELS / "gt_cameras.json").read_text())
+    cams["cameras"][0]["cx"] = -500.0
+    gt_cams = tmp_path / "gt_cameras.json"
+    gt_cams.write_text(json.dumps(cams))
+    kind, rep = evaluate("--gt", ROOT / "tests" / "fixtures" / "core" / "trimesh_mesh.glb",
+                         "--gt-cameras", gt_cams, "--recon", MODELS / "colmap_text", "--align", "cameras")
+    assert kind == "ok", rep
+    hits = [w for w in rep["warnings"] if w.startswith("ground-truth cameras: ")]
+    assert hits and "principal point" in hits[0] and "outside" in hits[0], rep["warnings"]

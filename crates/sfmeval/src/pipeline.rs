@@ -247,12 +247,17 @@ pub fn run(
         ));
     };
     let gt_cameras = dataset.cameras();
+    let gt_camera_warnings = gt_cameras
+        .into_iter()
+        .flat_map(|c| &c.warnings)
+        .map(|w| format!("ground-truth cameras: {w}"));
     let mut warnings: Vec<String> = dataset
         .loaded
         .warnings
         .iter()
-        .chain(&recon.warnings)
         .cloned()
+        .chain(gt_camera_warnings)
+        .chain(recon.warnings.iter().cloned())
         .collect();
     let (pairs, matches) = match (gt_cameras, &recon.model) {
         (Some(g), Some(e)) => {
