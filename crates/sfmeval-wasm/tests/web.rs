@@ -25,7 +25,7 @@ fn options(json: &str) -> JsValue {
 
 #[wasm_bindgen_test]
 fn evaluates_the_demo_with_its_transform() {
-    let mut gt = GroundTruth::new("tetra.ply", &Uint8Array::from(GT), None).unwrap();
+    let mut gt = GroundTruth::new("tetra.ply", &Uint8Array::from(GT), None, None).unwrap();
     assert!(gt.is_mesh());
     assert_eq!(gt.vertices().length() % 3, 0);
     let recon = Reconstruction::new("cloud.ply", &files("cloud.ply", RECON)).unwrap();
@@ -72,6 +72,7 @@ fn errors_carry_the_core_message() {
         "broken.glb",
         &Uint8Array::from(&b"glTF\x02\0\0\0junk"[..]),
         None,
+        None,
     )
     .err()
     .expect("a broken GLB is an error");
@@ -92,9 +93,12 @@ fn errors_carry_the_core_message() {
     assert!(parse_crop(r#"{"max_distance": -1}"#).is_err());
     assert!(parse_crop(r#"{"schema":"sfmeval.crop/1","max_distance": 0.1}"#).is_ok());
     assert_eq!(parse_transform_text(TRANSFORM).unwrap().len(), 16);
-    let mut gt = GroundTruth::new("tetra.ply", &Uint8Array::from(GT), None).unwrap();
+    let mut gt = GroundTruth::new("tetra.ply", &Uint8Array::from(GT), None, None).unwrap();
     let recon = Reconstruction::new("cloud.ply", &files("cloud.ply", RECON)).unwrap();
     assert!(evaluate(&mut gt, &recon, options(r#"{"samples": 0}"#), None).is_err());
     assert!(evaluate(&mut gt, &recon, options(r#"{"bogus": 1}"#), None).is_err());
     assert!(evaluate(&mut gt, &recon, options(r#"{"align": "given"}"#), None).is_err());
+    // The triangle limit: the tetrahedron's 4 triangles pass 4 and fail 3.
+    assert!(GroundTruth::new("tetra.ply", &Uint8Array::from(GT), None, Some(4.0)).is_ok());
+    assert!(GroundTruth::new("tetra.ply", &Uint8Array::from(GT), None, Some(3.0)).is_err());
 }
