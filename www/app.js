@@ -228,7 +228,7 @@ async function loadGt(fileList) {
   showError('');
   setBusy(true);
   setInputInfo('gt', 'reading…');
-  lastGtFiles = fileList;
+  lastGtFiles = Array.from(fileList); // a copy: the input's own list empties when it is reset
   try {
     const { files, transfer } = await readFiles(fileList);
     const maxTriangles = Number($('max-triangles').value) || undefined;
