@@ -223,12 +223,10 @@ function clearStale() {
   delete document.body.dataset.stale;
 }
 
-let lastGtFiles = null; // the last ground truth chosen, loaded or not (max triangles reloads it)
 async function loadGt(fileList) {
   showError('');
   setBusy(true);
   setInputInfo('gt', 'reading…');
-  lastGtFiles = Array.from(fileList); // a copy: the input's own list empties when it is reset
   try {
     const { files, transfer } = await readFiles(fileList);
     const maxTriangles = Number($('max-triangles').value) || undefined;
@@ -436,8 +434,6 @@ $('demo').onclick = async () => {
 // ---- alignment --------------------------------------------------------------------------
 const alignMethod = () => document.querySelector('input[name=align]:checked').value;
 const viewMode = () => document.querySelector('input[name=view]:checked').value;
-// A new triangle limit applies to the ground truth already chosen: read it again.
-$('max-triangles').addEventListener('change', () => { if (lastGtFiles) handleFiles('gt', lastGtFiles); });
 $('file-transform').addEventListener('change', async (e) => {
   const f = e.target.files[0];
   if (f) { $('transform').value = alignedTransform(await f.text()); document.querySelector('input[name=align][value=given]').checked = true; refreshPoints(); }

@@ -293,7 +293,7 @@ try {
   }
 
   // ---- hostile ground truths: a glTF node DAG is refused at once and the page stays usable;
-  // a mesh instanced past "max triangles" is refused naming the option, and raising it reads it ----
+  // a mesh instanced past "max triangles" is refused naming the option ----
   {
     const tag = 'hostile';
     const page = await newPage(1366, 768);
@@ -340,11 +340,6 @@ try {
     const limited = await page.textContent('#error');
     check(`${tag} triangle-limit-refuses-naming-the-option`, /instances\.glb/.test(limited) && /12/.test(limited)
       && /maxTriangles|max-triangles/.test(limited), `"${limited}"`);
-    await page.fill('#max-triangles', '12');
-    await page.dispatchEvent('#max-triangles', 'change');
-    await page.waitForFunction(() => /^instances\.glb \(/.test(document.getElementById('info-gt').textContent), null, { timeout: 30000 });
-    check(`${tag} raising-the-limit-reads-the-same-file`, / 12 triangles/.test(await page.textContent('#info-gt')),
-      await page.textContent('#info-gt'));
     await page.context().close();
   }
 
