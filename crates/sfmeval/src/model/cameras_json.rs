@@ -397,7 +397,9 @@ mod tests {
             .replace(r#""cx":2"#, r#""cx":-50"#);
         let r = read_cameras_json(outside.as_bytes()).unwrap();
         assert!(
-            r.warnings.iter().any(|w| w.contains("principal point")),
+            r.warnings
+                .iter()
+                .any(|w| w.contains("camera 1: the principal point lies outside")),
             "{:?}",
             r.warnings
         );

@@ -282,7 +282,7 @@ impl Camera {
         format: &'static str,
         item: &str,
         size_stored: bool,
-    ) -> Result<Vec<String>> {
+    ) -> Result<Vec<CameraWarning>> {
         let mut warnings = Vec::new();
         let bad =
             |field: &str, problem: String| Err(Error::out_of_range(format, item, field, problem));
@@ -306,9 +306,7 @@ impl Camera {
             );
         }
         if size_stored && self.width == 0 {
-            warnings.push(format!(
-                "{item}: width and height are 0 (unknown): the principal point and the focal-length error cannot be checked against the image size"
-            ));
+            warnings.push(CameraWarning::UnknownSize);
         }
         if self.has_focal() {
             for (field, f) in [("focal length fx", self.fx), ("focal length fy", self.fy)] {
@@ -356,13 +354,37 @@ impl Camera {
         if self.width > 0 {
             let (w, h) = (self.width as f64, self.height as f64);
             if !(0.0..=w).contains(&self.cx) || !(0.0..=h).contains(&self.cy) {
-                warnings.push(format!(
-                    "{item}: principal point ({}, {}) lies outside its {}×{} image",
-                    self.cx, self.cy, self.width, self.height
-                ));
+                warnings.push(CameraWarning::PrincipalPointOutside);
             }
         }
         Ok(warnings)
+    }
+}
+
+/// Something odd but measurable about a camera ([`Camera::check`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
+pub enum CameraWarning {
+    /// Width and height are both 0 in a format that stores them: unknown.
+    UnknownSize,
+    /// The principal point lies outside the image.
+    PrincipalPointOutside,
+}
+
+impl CameraWarning {
+    /// The warning for the cameras named in `items` (at most five are listed).
+    pub fn message(self, items: &[String]) -> String {
+        let mut list = items.iter().take(5).cloned().collect::<Vec<_>>().join(", ");
+        if items.len() > 5 {
+            list.push_str(&format!(" and {} more", items.len() - 5));
+        }
+        match self {
+            CameraWarning::UnknownSize => format!(
+                "{list}: width and height are 0 (unknown): the principal point and the focal-length error cannot be checked against the image size"
+            ),
+            CameraWarning::PrincipalPointOutside => {
+                format!("{list}: the principal point lies outside the image")
+            }
+        }
     }
 }
 
@@ -520,23 +542,27 @@ impl Reconstruction {
     /// ±[`MAX_COORDINATE`]), every 3D point and 2D observation within ±[`MAX_COORDINATE`].
     /// Errors name the camera or image and the field ([`Error::OutOfRange`]).
     pub fn validate(&mut self, format: &'static str, size_stored: bool) -> Result<()> {
-        let mut warnings = Vec::new();
-        for cam in &self.cameras {
-            let image = self
-                .images
-                .iter()
-                .filter(|im| im.camera_id == cam.id)
-                .map(|im| im.name.as_str())
-                .next();
-            let item = match image {
-                // One camera per image (NVM, Bundler): name the image too.
-                Some(name) if !size_stored => {
-                    format!("camera {} (image '{}')", cam.id, text::clip(name))
-                }
-                _ => format!("camera {}", cam.id),
-            };
-            warnings.extend(cam.check(format, &item, size_stored)?);
+        // One camera per image (NVM, Bundler): name the image too.
+        let mut first_image: std::collections::BTreeMap<u64, &str> = Default::default();
+        if !size_stored {
+            for im in &self.images {
+                first_image.entry(im.camera_id).or_insert(im.name.as_str());
+            }
         }
+        let mut noted: std::collections::BTreeMap<CameraWarning, Vec<String>> = Default::default();
+        for cam in &self.cameras {
+            let item = match first_image.get(&cam.id) {
+                Some(name) => format!("camera {} (image '{}')", cam.id, text::clip(name)),
+                None => format!("camera {}", cam.id),
+            };
+            for w in cam.check(format, &item, size_stored)? {
+                noted.entry(w).or_default().push(item.clone());
+            }
+        }
+        let warnings: Vec<String> = noted
+            .into_iter()
+            .map(|(w, items)| w.message(&items))
+            .collect();
         for im in &self.images {
             let item = || format!("image '{}' (id {})", text::clip(&im.name), im.id);
             if let Some(defect) = rotation_defect(&im.cam_from_world.rotation) {
