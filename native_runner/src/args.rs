@@ -250,7 +250,13 @@ impl EvalArgs {
     /// pairs are refused, a batch has neither).
     pub fn align_request(&self) -> Result<AlignRequest> {
         let mode = AlignMode::parse(&self.align)?;
-        Ok(AlignRequest::new(Some(mode), None, Vec::new())?)
+        AlignRequest::new(Some(mode), None, Vec::new()).map_err(|e| match e {
+            sfmeval::Error::AlignInput { mode, problem } => anyhow::anyhow!(
+                "--align {mode} {problem}, which a batch of runs does not have: use one of \
+                 auto, cameras, global, icp or their +icp forms"
+            ),
+            e => e.into(),
+        })
     }
 }
 
@@ -354,4 +360,35 @@ pub struct SweepArgs {
     /// How every run is measured.
     #[command(flatten)]
     pub eval: EvalArgs,
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// `EvalArgs` alone on a command line.
+    #[derive(Parser)]
+    struct Eval {
+        #[command(flatten)]
+        eval: EvalArgs,
+    }
+
+    fn request(align: &str) -> Result<AlignRequest> {
+        Eval::try_parse_from(["test", "--align", align])?
+            .eval
+            .align_request()
+    }
+
+    #[test]
+    fn a_batch_refuses_modes_that_need_a_transform_or_pairs() {
+        assert_eq!(request("cameras+icp").unwrap().mode, AlignMode::CamerasIcp);
+        let e = request("given").unwrap_err().to_string();
+        assert!(
+            e.starts_with("--align given needs a transform, which a batch"),
+            "{e}"
+        );
+        let e = request("points").unwrap_err().to_string();
+        assert!(e.starts_with("--align points needs point pairs"), "{e}");
+        assert!(request("nonsense").is_err());
+    }
 }

@@ -345,3 +345,22 @@ def test_eval_cameras_and_cameras_icp(run_eval, suzanne_case, tmp_path):
         assert cams["matched"] == 10 and cams["alignment"]["stage"] == "cameras"
         assert cams["rotation_error_deg"]["max"] < 1e-4
         assert cams["center_error"]["max"] < 1e-9 * rad
+
+
+@pytest.mark.parametrize("args, message", [
+    (["--align", "given"], "--align given needs --transform FILE"),
+    (["--align", "points+icp"], "--align points+icp needs --pairs FILE"),
+    (["--align", "none", "--transform", "T"], "--align none ignores --transform (use --align given"),
+    (["--align", "cameras", "--transform", "T"], "--align cameras ignores --transform (it is used by"),
+])
+def test_eval_names_the_flag_an_alignment_lacks_or_ignores(sfmeval_bin, tmp_path, args, message):
+    """A request the core refuses (`Error::AlignInput`) is told in the flags the user typed,
+    before any file is read, and nothing is written."""
+    (tmp_path / "t.txt").write_text("1 0 0 0\n0 1 0 0\n0 0 1 0\n0 0 0 1\n")
+    args = [str(tmp_path / "t.txt") if a == "T" else a for a in args]
+    out = tmp_path / "report.json"
+    r = subprocess.run([sfmeval_bin, "eval", "--gt", str(SUZANNE), "--recon", str(SUZANNE),
+                        "--report", str(out), *args], capture_output=True, text=True)
+    assert r.returncode != 0
+    assert message in r.stderr, r.stderr
+    assert not out.exists()

@@ -6,6 +6,7 @@ use std::path::{Path, PathBuf};
 use anyhow::{Context as _, Result, bail};
 use clap::builder::PossibleValuesParser;
 use clap::{Args, Parser, Subcommand};
+use sfmeval::AlignInputProblem;
 use sfmeval::align::{AlignMode, AlignRequest, PointPair, parse_point_pairs};
 use sfmeval::crop::{Crop, Volume};
 use sfmeval::dataset::{Dataset, DatasetPaths, Part};
@@ -301,15 +302,26 @@ fn align_request(input: &InputArgs) -> Result<AlignRequest> {
         None => Vec::new(),
     };
     let mode = input.align.as_deref().map(AlignMode::parse).transpose()?;
-    AlignRequest::new(mode, transform, pairs).map_err(|e| {
-        // Name the flags the user types.
-        let text = e.to_string();
-        let text = text
-            .replace("needs a transform", "needs --transform FILE")
-            .replace("needs point pairs", "needs --pairs FILE")
-            .replace("ignores the transform", "ignores --transform");
-        anyhow::anyhow!(text)
+    AlignRequest::new(mode, transform, pairs).map_err(|e| match e {
+        sfmeval::Error::AlignInput { mode, problem } => {
+            anyhow::anyhow!("--align {mode} {}", flag_problem(problem))
+        }
+        e => e.into(),
     })
+}
+
+/// An alignment request's problem in the flags the user types.
+fn flag_problem(problem: AlignInputProblem) -> &'static str {
+    match problem {
+        AlignInputProblem::MissingTransform => "needs --transform FILE",
+        AlignInputProblem::MissingPairs => "needs --pairs FILE",
+        AlignInputProblem::TransformIgnoredUseGiven => {
+            "ignores --transform (use --align given, the default with --transform)"
+        }
+        AlignInputProblem::TransformIgnored => {
+            "ignores --transform (it is used by --align given and as the start of --align icp)"
+        }
+    }
 }
 
 /// Where the ground truth's parts are: `--dataset` gives the folder layout, `--gt`,

@@ -131,6 +131,32 @@ pub enum Error {
     /// file rather than the reconstruction ([`Error::concerns_point_pairs`]).
     #[error("point pairs: {0}")]
     PointPairs(String),
+    /// An alignment request whose mode lacks an input it needs or is given one it would
+    /// ignore. Typed so that front ends can name their own flag or field for the input.
+    #[error("alignment '{mode}' {problem}")]
+    AlignInput {
+        /// The mode's name (`given`, `points+icp`, ...).
+        mode: &'static str,
+        /// What is missing or ignored.
+        problem: AlignInputProblem,
+    },
+}
+
+/// What is wrong with an alignment request's inputs ([`Error::AlignInput`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, thiserror::Error)]
+pub enum AlignInputProblem {
+    /// `given` without a transform.
+    #[error("needs a transform")]
+    MissingTransform,
+    /// `points` or `points+icp` without point pairs.
+    #[error("needs point pairs")]
+    MissingPairs,
+    /// `none`: a transform it would ignore (`given` uses it, the default with a transform).
+    #[error("ignores the transform (use 'given', the default with a transform)")]
+    TransformIgnoredUseGiven,
+    /// A mode other than `given`, `icp` or `none` with a transform it would ignore.
+    #[error("ignores the transform (it is used by 'given' and as the start of 'icp')")]
+    TransformIgnored,
 }
 
 /// The format name of point-pairs files in errors (`crate::align::points::PAIRS_FORMAT`): the
@@ -159,6 +185,7 @@ impl Error {
             Error::OutOfRange { .. } => "out_of_range",
             Error::LimitExceeded { .. } => "limit_exceeded",
             Error::PointPairs(_) => "point_pairs",
+            Error::AlignInput { .. } => "align_input",
         }
     }
 

@@ -65,4 +65,4 @@ mod track_error;
 pub mod transform;
 pub mod visibility;
 
-pub use error::{Error, Result};
+pub use error::{AlignInputProblem, Error, Result};

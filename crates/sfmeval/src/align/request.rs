@@ -5,7 +5,7 @@
 use std::fmt;
 
 use crate::align::{AlignMethod, PointPair};
-use crate::error::{Error, Result};
+use crate::error::{AlignInputProblem, Error, Result};
 use crate::transform::Similarity;
 
 /// How the reconstruction is brought into the ground-truth frame.
@@ -212,30 +212,27 @@ impl AlignRequest {
         }
     }
 
-    /// Checks that the mode has what it needs and that nothing given is ignored.
+    /// Checks that the mode has what it needs and that nothing given is ignored
+    /// ([`Error::AlignInput`]).
     pub fn validate(&self) -> Result<()> {
         let mode = self.mode;
-        if mode.needs_transform() && self.transform.is_none() {
-            return Err(Error::InvalidOption(format!(
-                "alignment '{mode}' needs a transform"
-            )));
-        }
-        if mode.needs_pairs() && self.pairs.is_empty() {
-            return Err(Error::InvalidOption(format!(
-                "alignment '{mode}' needs point pairs"
-            )));
-        }
-        if self.transform.is_some() && !matches!(mode, AlignMode::Given | AlignMode::Icp) {
-            let hint = if mode == AlignMode::None {
-                " (use 'given', the default with a transform)"
+        let problem = if mode.needs_transform() && self.transform.is_none() {
+            AlignInputProblem::MissingTransform
+        } else if mode.needs_pairs() && self.pairs.is_empty() {
+            AlignInputProblem::MissingPairs
+        } else if self.transform.is_some() && !matches!(mode, AlignMode::Given | AlignMode::Icp) {
+            if mode == AlignMode::None {
+                AlignInputProblem::TransformIgnoredUseGiven
             } else {
-                " (it is used by 'given' and as the start of 'icp')"
-            };
-            return Err(Error::InvalidOption(format!(
-                "alignment '{mode}' ignores the transform{hint}"
-            )));
-        }
-        Ok(())
+                AlignInputProblem::TransformIgnored
+            }
+        } else {
+            return Ok(());
+        };
+        Err(Error::AlignInput {
+            mode: mode.name(),
+            problem,
+        })
     }
 }
 
@@ -290,6 +287,14 @@ mod tests {
         assert!(err(AlignMode::None, t, vec![]).contains("use 'given'"));
         assert!(err(AlignMode::Cameras, t, vec![]).contains("ignores the transform"));
         assert!(AlignRequest::new(Some(AlignMode::Icp), t, vec![]).is_ok());
+        // Typed, so that front ends name their own flag.
+        assert_eq!(
+            AlignRequest::new(Some(AlignMode::PointsIcp), None, vec![]),
+            Err(Error::AlignInput {
+                mode: "points+icp",
+                problem: AlignInputProblem::MissingPairs
+            })
+        );
         assert!(AlignRequest::new(Some(AlignMode::Points), None, vec![pair]).is_ok());
     }
 
