@@ -277,6 +277,20 @@ pub struct ReportCmd {
     pub eval: EvalArgs,
 }
 
+/// The dataset generator's flags, shared by `table1` and `sweep`.
+#[derive(Args)]
+pub struct GeneratorArgs {
+    /// Extra generator overrides `section.key=value` for every dataset (repeatable).
+    #[arg(long = "set")]
+    pub sets: Vec<String>,
+    /// The blender_scripts folder (default: found from the binary or the working directory).
+    #[arg(long)]
+    pub blender_scripts: Option<PathBuf>,
+    /// Redo everything (default: reuse rendered datasets and finished runs).
+    #[arg(long)]
+    pub fresh: bool,
+}
+
 /// Arguments of `table1`.
 #[derive(Args)]
 pub struct Table1Args {
@@ -292,15 +306,9 @@ pub struct Table1Args {
     /// Only these presets (default: statue vase bicycle hydrant vehicle).
     #[arg(long, num_args = 1..)]
     pub presets: Vec<String>,
-    /// Extra generator overrides `section.key=value` for every dataset (repeatable).
-    #[arg(long = "set")]
-    pub sets: Vec<String>,
-    /// The blender_scripts folder (default: found from the binary or the working directory).
-    #[arg(long)]
-    pub blender_scripts: Option<PathBuf>,
-    /// Redo everything (default: reuse rendered datasets and finished runs).
-    #[arg(long)]
-    pub fresh: bool,
+    /// The dataset generator.
+    #[command(flatten)]
+    pub generator: GeneratorArgs,
     /// How the runs execute.
     #[command(flatten)]
     pub exec: ExecArgs,
@@ -325,9 +333,6 @@ pub struct SweepArgs {
     /// Generator config file (TOML/JSON) of the base dataset.
     #[arg(long)]
     pub dataset_config: Option<PathBuf>,
-    /// Fixed generator overrides `section.key=value` for every variant (repeatable).
-    #[arg(long = "set")]
-    pub sets: Vec<String>,
     /// Pipelines: names or specs KIND[:key=value,...] separated by commas or `;`, or `all`.
     #[arg(long, num_args = 1.., required = true)]
     pub pipelines: Vec<String>,
@@ -342,12 +347,9 @@ pub struct SweepArgs {
     /// `report.thresholds[*].recall`, optionally `=LABEL` (repeatable).
     #[arg(long = "metric", value_name = "PATH[=LABEL]")]
     pub metrics: Vec<String>,
-    /// The blender_scripts folder (default: found from the binary or the working directory).
-    #[arg(long)]
-    pub blender_scripts: Option<PathBuf>,
-    /// Redo everything (default: reuse rendered variants and finished runs).
-    #[arg(long)]
-    pub fresh: bool,
+    /// The dataset generator.
+    #[command(flatten)]
+    pub generator: GeneratorArgs,
     /// Redo runs that failed or timed out (finished ones are reused).
     #[arg(long)]
     pub retry_failed: bool,

@@ -63,7 +63,9 @@ pub fn table1(a: &Table1Args) -> Result<()> {
     let t0 = Instant::now();
     a.exec.check()?;
     let python = crate::env::find_python(a.tools.python.as_deref())?;
-    let scripts = std::path::absolute(find_blender_scripts(a.blender_scripts.as_deref())?)?;
+    let scripts = std::path::absolute(find_blender_scripts(
+        a.generator.blender_scripts.as_deref(),
+    )?)?;
     let presets: Vec<String> = if a.presets.is_empty() {
         PRESETS.iter().map(|s| s.to_string()).collect()
     } else {
@@ -88,10 +90,10 @@ pub fn table1(a: &Table1Args) -> Result<()> {
         };
         let dest = ds_root.join(&name);
         let complete = dest.join("dataset.json").is_file() && dest.join("cameras.json").is_file();
-        if complete && !a.fresh {
+        if complete && !a.generator.fresh {
             eprintln!("table1: reusing {}", dest.display());
         } else {
-            let secs = generate(&python, &scripts, p, a.quick, &a.sets, &dest)?;
+            let secs = generate(&python, &scripts, p, a.quick, &a.generator.sets, &dest)?;
             gen_times.insert(name.clone(), secs.into());
         }
         datasets.push(Dataset::open(&dest)?);
@@ -101,7 +103,7 @@ pub fn table1(a: &Table1Args) -> Result<()> {
     let customs = crate::pipelines::parse_customs(&a.tools.customs)?;
     let specs = crate::pipelines::parse_list(&a.pipelines, &customs)?;
     let env = crate::env::make_env(&a.tools, &runs)?;
-    let opts = a.exec.batch_options(&runs, !a.fresh, false)?;
+    let opts = a.exec.batch_options(&runs, !a.generator.fresh, false)?;
     let t_runs = Instant::now();
     let summary = crate::run::run_batch(&datasets, &specs, &customs, &env, &opts)?;
     let runs_seconds = t_runs.elapsed().as_secs_f64();

@@ -141,6 +141,8 @@ pub struct Evaluation {
     pub completeness_points: Vec<Point3>,
     /// Their distances to the reconstruction.
     pub completeness_distances: Vec<f64>,
+    /// The thresholds the report's P/R/F were computed at, resolved once.
+    pub thresholds: Thresholds,
     /// Per completeness sample, the ground-truth images that see it (with depth maps only).
     pub sample_views: Option<Vec<u32>>,
     /// Per completeness sample, covered / missed / unseen at the report's `labels_tau` (with
@@ -413,6 +415,7 @@ pub fn evaluate(
         status,
         completeness_points,
         completeness_distances,
+        thresholds: resolved,
         sample_views: None,
         sample_labels: None,
         track_errors: None,

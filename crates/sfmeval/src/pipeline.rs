@@ -530,13 +530,12 @@ fn add_track_error(
         .iter()
         .map(|s| *s == PointStatus::Kept)
         .collect();
-    let taus: Vec<f64> = report.thresholds.iter().map(|t| t.tau).collect();
     let (section, warning) = track_error::aggregate(
         convention,
         &outcomes,
         &evaluation.distances,
         &kept,
-        &taus,
+        &evaluation.thresholds.taus,
         request.eval.histogram_bins,
     );
     report.warnings.extend(warning);

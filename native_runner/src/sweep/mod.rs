@@ -45,7 +45,9 @@ pub fn sweep(a: &SweepArgs) -> Result<()> {
     a.exec.check()?;
     // absolute paths: the generator runs in the datasets folder
     let python = find_python(a.tools.python.as_deref())?;
-    let scripts = std::path::absolute(find_blender_scripts(a.blender_scripts.as_deref())?)?;
+    let scripts = std::path::absolute(find_blender_scripts(
+        a.generator.blender_scripts.as_deref(),
+    )?)?;
     let customs = parse_customs(&a.tools.customs)?;
     let specs = parse_list(&a.pipelines, &customs)?;
     let eval = a.eval.eval_options()?;
@@ -54,7 +56,7 @@ pub fn sweep(a: &SweepArgs) -> Result<()> {
         a.dataset_preset.as_deref(),
         a.dataset_config.as_deref(),
         a.visibility,
-        &a.sets,
+        &a.generator.sets,
     )?;
     let base = resolved_config(&python, &scripts, &base_args)?;
     // every value's overrides first: a bad value stops the sweep before anything is rendered
@@ -62,8 +64,14 @@ pub fn sweep(a: &SweepArgs) -> Result<()> {
     let out = std::path::absolute(&a.out)
         .with_context(|| format!("output folder {}", a.out.display()))?;
     let ds_root = out.join("datasets");
-    let (variants, datasets) =
-        variants::render(&planned, &base_args, &ds_root, a.fresh, &python, &scripts)?;
+    let (variants, datasets) = variants::render(
+        &planned,
+        &base_args,
+        &ds_root,
+        a.generator.fresh,
+        &python,
+        &scripts,
+    )?;
     let render_seconds = t0.elapsed().as_secs_f64();
     // runs
     let runs = out.join("runs");
@@ -71,7 +79,9 @@ pub fn sweep(a: &SweepArgs) -> Result<()> {
     let t_runs = Instant::now();
     if !datasets.is_empty() {
         let env = make_env(&a.tools, &runs)?;
-        let opts = a.exec.batch_options(&runs, !a.fresh, a.retry_failed)?;
+        let opts = a
+            .exec
+            .batch_options(&runs, !a.generator.fresh, a.retry_failed)?;
         let sum = run_batch(&datasets, &specs, &customs, &env, &opts)?;
         eprintln!(
             "sweep: runs: {} executed, {} reused",
