@@ -62,6 +62,7 @@ try {
   const info = await page.textContent('#info-runs');
   const pipelines = readdirSync(join(runs, 'statue')).sort();
   check('compare-recognises-runs', info.includes(`${pipelines.length} reconstructions (${pipelines.length} runner runs)`), info);
+  check('compare-ready', await page.isEnabled('#compare'), 'Compare button disabled');
   const t0 = Date.now();
   await page.click('#compare');
   await page.waitForFunction(() => document.body.dataset.compared || document.getElementById('error').textContent, null, { timeout: 300000 });
@@ -84,14 +85,15 @@ try {
   //    same model folder with the same flags (only the reconstruction's name differs: the CLI
   //    names it by the folder, the runner and the page "<dataset>/<pipeline>")
   const reports = await page.evaluate(() => window.sfmeval.compare.entries.map((e) => [e.row.pipeline, e.reportJson]));
-  for (const [p, json] of reports) {
+  for (const [p, json] of reports.filter(([, j]) => j)) {
     const runner = readFileSync(join(table, 'reports', 'statue', `${p}.json`), 'utf8');
     check(`compare-report-${p}-equals-runner`, json === runner, firstDiff(json, runner));
     const file = join(out, `compare-cli-${p}.json`);
     execFileSync(cli, ['eval', '--dataset', dataset, '--recon', join(runs, 'statue', p, 'model'), '--quiet', '--report', file]);
     const cliRaw = readFileSync(file, 'utf8');
     const named = '"reconstruction": {\n      "name": "model",';
-    const cliText = cliRaw.replace(named, `"reconstruction": {\n      "name": "statue/${p}",`);
+    // (the name also starts the reader's notes: "model: removed 36 point(s) ...")
+    const cliText = cliRaw.replace(named, `"reconstruction": {\n      "name": "statue/${p}",`).replaceAll('"model: ', `"statue/${p}: `);
     check(`compare-report-${p}-cli-names-the-folder`, cliText !== cliRaw, cliRaw.slice(0, 200));
     check(`compare-report-${p}-equals-cli`, json === cliText, firstDiff(json, cliText));
   }
@@ -112,15 +114,20 @@ try {
 
   // 5. sorting: mean ascending, then descending
   await page.click('#cmp-table button.sort[data-k="mean"]');
-  let means = (await tableRows()).map((r) => r.cells.mean.v);
+  // (a run that failed has no mean: last either way)
+  let means = (await tableRows()).map((r) => r.cells.mean.v).filter((v) => v != null);
   check('compare-sort-ascending', means.every((v, i) => i === 0 || means[i - 1] <= v), means.join());
   await page.click('#cmp-table button.sort[data-k="mean"]');
-  means = (await tableRows()).map((r) => r.cells.mean.v);
+  means = (await tableRows()).map((r) => r.cells.mean.v).filter((v) => v != null);
   check('compare-sort-descending', means.every((v, i) => i === 0 || means[i - 1] >= v) && means[0] > means[means.length - 1], means.join());
 
   // 6. the curves: precision, recall and F of every reconstruction on one plot
+  const okRuns = pipelines.filter((p) => JSON.parse(readFileSync(join(runs, 'statue', p, 'run.json'), 'utf8')).status === 'ok');
+  check('compare-has-a-failed-run', okRuns.length >= 2 && okRuns.length < pipelines.length, okRuns.join());
+  const failedRow = rows.find((r) => !okRuns.includes(r.pipeline));
+  check('compare-failed-run-row', failedRow && failedRow.cells.status.text === 'failed' && failedRow.cells.mean.v == null, JSON.stringify(failedRow));
   const series = Number(await page.getAttribute('#cmp-curves', 'data-series'));
-  check('compare-curves-overlaid', series === 3 * pipelines.length, `${series} series`);
+  check('compare-curves-overlaid', series === 3 * okRuns.length, `${series} series for ${okRuns.length} evaluated runs`);
 
   // 7. the viewer: the model with cameras in view A: one frustum per registered image, GT ones
   //    too, coloured by centre error (the largest error at the yellow end, the smallest darker)
@@ -150,7 +157,7 @@ try {
   await page.locator('#viewer').screenshot({ path: join(out, 'compare-frusta.png') });
 
   // 8. side by side: a second viewer with another reconstruction, same viewpoint
-  const other = (idx + 1) % rows.length;
+  const other = await page.evaluate((i) => window.sfmeval.compare.entries.findIndex((e, k) => k !== i && e.pointsInGt), idx);
   await page.selectOption('#cmp-view-b', String(other));
   await page.waitForTimeout(500);
   const side = await page.evaluate(() => {
@@ -162,7 +169,7 @@ try {
     return { a: [a.left, a.width, a.height], b: [b.left, b.width, b.height], points: v2.points ? v2.points.geometry.attributes.position.count : 0,
       same: v2.camera.position.distanceTo(window.sfmevalViewer.camera.position) < 1e-9 };
   });
-  const otherPoints = rows.find((r, i) => i === other) && await page.evaluate((i) => window.sfmeval.compare.entries[i].pointsInGt.length / 3, other);
+  const otherPoints = await page.evaluate((i) => window.sfmeval.compare.entries[i].pointsInGt.length / 3, other);
   check('side-by-side-viewers', side && side.b[0] >= side.a[0] + side.a[1] - 2 && side.b[1] > 200 && side.points === otherPoints && side.same, JSON.stringify({ side, otherPoints }));
   // the second canvas draws something
   const shot = await page.locator('#view3d-b').screenshot({ path: join(out, 'compare-side-b.png') });
