@@ -3,7 +3,7 @@
 //! `sfmeval_table` code the runner uses.
 
 use sfmeval::evaluate::PointStatus;
-use sfmeval_table::{RunFacts, Row};
+use sfmeval_table::{Row, RunFacts};
 use wasm_bindgen::prelude::*;
 
 use crate::{Evaluation, js_err};
