@@ -942,6 +942,7 @@ for (const [box, kind] of [['show-gt-cams', 'gtCams'], ['show-est-cams', 'estCam
     if (window.sfmevalViewer2) window.sfmevalViewer2.setVisible(kind, e.target.checked);
   });
 }
+$('fit-cams').onclick = () => viewer.fitCameras();
 /** The estimated cameras' colour scale beside the points' colour bar. */
 function showCameraScale(cams) {
   const el = $('cb-cams');

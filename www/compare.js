@@ -289,6 +289,8 @@ export function setupCompare({ call, viewer, measureOptions, showError, download
     if (value === '' || !e || !e.pointsInGt) return;
     v.setPoints(e.pointsInGt, $('heat') && $('heat').checked ? e.colors : null);
     drawCameras(v, e.cameras);
+    // the first time cameras are shown here, frame them (they stand well outside the object)
+    if (e.cameras && e.cameras.gtPoses && !v.framedCameras) { v.fitCameras(); v.framedCameras = true; }
   }
   function updateSide() {
     const b = $('cmp-view-b').value;

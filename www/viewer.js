@@ -160,7 +160,7 @@ export class Viewer {
     if (old) { this.world.remove(old); old.geometry.dispose(); delete this.cams[kind]; }
     if (!poses || !poses.length) return;
     const n = poses.length / 14;
-    const depth = 0.05 * this.diag;
+    const depth = 0.1 * this.diag;
     const pos = new Float32Array(n * 16 * 3);
     const col = new Float32Array(n * 16 * 3);
     const base = new THREE.Color(color);
@@ -186,6 +186,21 @@ export class Viewer {
     this.cams[kind] = lines;
     lines.visible = this.camVisible ? this.camVisible[kind] !== false : true;
     this.world.add(lines);
+  }
+
+  /** Frames the ground truth and every camera drawn (the frusta stand well outside the object). */
+  fitCameras() {
+    this.fit();
+    let r = this.diag / 2;
+    for (const o of Object.values(this.cams || {})) {
+      const p = o.geometry.attributes.position.array;
+      for (let i = 0; i < p.length; i += 3) r = Math.max(r, Math.hypot(p[i] - this.offset[0], p[i + 1] - this.offset[1], p[i + 2] - this.offset[2]));
+    }
+    const k = (2 * r) / this.diag;
+    this.camera.position.multiplyScalar(k);
+    this.camera.far = Math.max(this.camera.far, this.diag * 100 * k);
+    this.camera.updateProjectionMatrix();
+    this.orbit.update();
   }
 
   /** Cameras drawn per kind: `{gtCams: n, estCams: n}` (hidden ones too). */

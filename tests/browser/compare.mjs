@@ -179,6 +179,23 @@ try {
   const single = await page.evaluate(() => document.getElementById('viewer2').hidden);
   check('side-by-side-off', single === true, String(single));
 
+  // 9. loose files: one row each, named by the file; reports equal `sfmeval eval` on that file
+  const root = resolve(new URL('../..', import.meta.url).pathname);
+  const loose = [join(root, 'tests/fixtures/global/pycolmap_points3D.ply'), join(root, 'data/demo/sparse.ply')];
+  await page.setInputFiles('#file-runs', loose);
+  const before = Number(await page.evaluate(() => document.body.dataset.compared));
+  await page.click('#compare');
+  await page.waitForFunction((n) => Number(document.body.dataset.compared) > n || document.getElementById('error').textContent, before, { timeout: 300000 });
+  const looseRows = (await tableRows()).map((r) => r.pipeline).sort();
+  check('compare-loose-files-rows', looseRows.join() === 'pycolmap_points3D.ply,sparse.ply', looseRows.join());
+  const looseReports = await page.evaluate(() => window.sfmeval.compare.entries.map((e) => [e.row.pipeline, e.reportJson]));
+  for (const [name, json] of looseReports) {
+    const file = join(out, `compare-cli-${name}.json`);
+    execFileSync(cli, ['eval', '--gt', join(dataset, 'ground_truth.glb'), '--gt-cameras', join(dataset, 'cameras.json'), '--recon', loose.find((f) => f.endsWith(`/${name}`)), '--quiet', '--report', file]);
+    const want = readFileSync(file, 'utf8');
+    check(`compare-loose-report-${name}-equals-cli`, json === want, firstDiff(json, want));
+  }
+
   check('compare-no-request-leaves-origin', requests.every((u) => u.startsWith(origin) || u.startsWith('blob:') || u.startsWith('data:')), requests.filter((u) => !u.startsWith(origin)).join(' '));
   check('compare-no-console-errors', consoleErrors.length === 0, consoleErrors.join(' | '));
 } catch (e) {
