@@ -196,6 +196,43 @@ try {
     check(`compare-loose-report-${name}-equals-cli`, json === want, firstDiff(json, want));
   }
 
+  // 10. the runs folder dropped on the drop zone: the page walks the folder entries. Playwright
+  //     cannot drop a real folder, so the drop event carries entries (the FileSystemEntry
+  //     interface: isFile/isDirectory, file(), createReader().readEntries()) over the files the
+  //     folder input picked; the page's own walk, grouping and evaluation do the rest.
+  await page.setInputFiles('#dir-runs', runs);
+  await page.setInputFiles('#file-runs', loose);
+  await page.evaluate(() => {
+    const picked = [...document.getElementById('dir-runs').files];
+    const root = { name: picked[0].webkitRelativePath.split('/')[0], dirs: new Map(), files: [] };
+    for (const f of picked) {
+      let node = root;
+      for (const p of f.webkitRelativePath.split('/').slice(1, -1)) {
+        if (!node.dirs.has(p)) node.dirs.set(p, { name: p, dirs: new Map(), files: [] });
+        node = node.dirs.get(p);
+      }
+      node.files.push(f);
+    }
+    const fileEntry = (f) => ({ isFile: true, isDirectory: false, name: f.name, file: (res) => res(f) });
+    const dirEntry = (n) => ({
+      isFile: false, isDirectory: true, name: n.name,
+      createReader() {
+        let given = false;
+        return { readEntries(res) { res(given ? [] : [...[...n.dirs.values()].map(dirEntry), ...n.files.map(fileEntry)]); given = true; } };
+      },
+    });
+    const ev = new Event('drop', { bubbles: true, cancelable: true });
+    Object.defineProperty(ev, 'dataTransfer', { value: { items: [{ webkitGetAsEntry: () => dirEntry(root) }], files: [] } });
+    document.getElementById('drop-runs').dispatchEvent(ev);
+  });
+  await page.waitForFunction((n) => document.getElementById('info-runs').textContent.startsWith(`${n} reconstructions (${n} runner runs)`), pipelines.length, { timeout: 10000 })
+    .then(() => check('compare-drop-folder-recognised', true), async () => check('compare-drop-folder-recognised', false, await page.textContent('#info-runs')));
+  const beforeDrop = Number(await page.evaluate(() => document.body.dataset.compared));
+  await page.click('#compare');
+  await page.waitForFunction((n) => Number(document.body.dataset.compared) > n || document.getElementById('error').textContent, beforeDrop, { timeout: 300000 });
+  const droppedMd = await downloadText('#cmp-dl-table-md');
+  check('compare-drop-folder-table-equals-runner', droppedMd === readFileSync(join(table, 'table.md'), 'utf8'), firstDiff(droppedMd, readFileSync(join(table, 'table.md'), 'utf8')));
+
   check('compare-no-request-leaves-origin', requests.every((u) => u.startsWith(origin) || u.startsWith('blob:') || u.startsWith('data:')), requests.filter((u) => !u.startsWith(origin)).join(' '));
   check('compare-no-console-errors', consoleErrors.length === 0, consoleErrors.join(' | '));
 } catch (e) {
