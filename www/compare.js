@@ -175,6 +175,7 @@ export function setupCompare({ call, viewer, measureOptions, showError, download
     $('compare').disabled = true;
     showError('');
     const entries = [];
+    const problems = [];
     const base = measureOptions();
     const options = { tau: base.tau, tau_percent_of_diagonal: base.tau_percent_of_diagonal, samples: base.samples, seed: base.seed, align: 'auto' };
     try {
@@ -193,21 +194,30 @@ export function setupCompare({ call, viewer, measureOptions, showError, download
         const files = {};
         const transfer = [];
         for (const [n, f] of Object.entries(it.files)) { const b = await f.arrayBuffer(); files[n] = b; transfer.push(b); }
-        if (!transfer.length) throw new Error(`${it.path}: no model files (model/ or sparse.ply)`);
         const recName = run ? `${run.dataset}/${run.pipeline}` : it.pipeline;
-        let r;
         try {
-          r = await call('compareRun', { files, name: recName, runJson: runText, dataset: name, options }, transfer);
+          if (!transfer.length) throw new Error('no model files (model/ or sparse.ply)');
+          const r = await call('compareRun', { files, name: recName, runJson: runText, dataset: name, options }, transfer);
+          entries.push({ ...r, report: JSON.parse(r.reportJson), path: it.path });
         } catch (err) {
-          throw new Error(`${it.path}: ${err.message}`);
+          // as the runner: the run stays in the table, "evaluation failed" with the reason
+          problems.push(`${it.path}: ${err.message}`);
+          const record = runText ?? JSON.stringify({
+            dataset: name, pipeline: it.pipeline, tool: 'file', version: null, status: 'failed', reason: null,
+            wall_seconds: 0, cpu_seconds: 0, peak_memory_bytes: 0, images_total: 0, images_registered: 0, points: 0,
+          });
+          const { row } = await call('runRowOnly', { runJson: record });
+          entries.push({ row: { ...row, status: 'evaluation failed', reason: err.message }, report: null, path: it.path });
         }
-        entries.push({ ...r, report: JSON.parse(r.reportJson), path: it.path });
       }
       state.entries = entries;
       const { tables } = await call('comparisonTables', { rows: entries.map((e) => e.row) });
       state.tables = tables;
       render();
-      $('compare-status').textContent = `compared ${entries.length} reconstruction${entries.length === 1 ? '' : 's'}`;
+      $('compare-status').textContent = `compared ${entries.length} reconstruction${entries.length === 1 ? '' : 's'}${problems.length ? ` (${problems.length} could not be evaluated)` : ''}`;
+      if (problems.length) {
+        showError(`compare: ${problems.length} of ${entries.length} could not be evaluated (marked "evaluation failed" in the table): ${problems.join('; ')}`, 'file-runs');
+      }
       document.body.dataset.compared = String(Number(document.body.dataset.compared || 0) + 1);
     } catch (err) {
       fail(`compare failed: ${err.message}`);

@@ -7,7 +7,7 @@
 // Prints one "ok NAME" / "FAILED NAME: why" line per check; exits 1 when one failed.
 import { chromium } from 'playwright-core';
 import { execFileSync } from 'node:child_process';
-import { readFileSync, mkdirSync, readdirSync } from 'node:fs';
+import { readFileSync, mkdirSync, readdirSync, writeFileSync } from 'node:fs';
 import { join, resolve } from 'node:path';
 
 const args = Object.fromEntries(process.argv.slice(2).reduce((a, v, i, all) => (v.startsWith('--') ? [...a, [v.slice(2), all[i + 1]]] : a), []));
@@ -182,14 +182,22 @@ try {
   // 9. loose files: one row each, named by the file; reports equal `sfmeval eval` on that file
   const root = resolve(new URL('../..', import.meta.url).pathname);
   const loose = [join(root, 'tests/fixtures/global/pycolmap_points3D.ply'), join(root, 'data/demo/sparse.ply')];
-  await page.setInputFiles('#file-runs', loose);
+  const broken = join(out, 'broken.ply');
+  writeFileSync(broken, 'ply\nformat ascii 1.0\nelement vertex 2\nproperty float x\nend_header\n1\n');
+  await page.setInputFiles('#file-runs', [...loose, broken]);
   const before = Number(await page.evaluate(() => document.body.dataset.compared));
   await page.click('#compare');
-  await page.waitForFunction((n) => Number(document.body.dataset.compared) > n || document.getElementById('error').textContent, before, { timeout: 300000 });
+  await page.waitForFunction((n) => Number(document.body.dataset.compared) > n, before, { timeout: 300000 });
   const looseRows = (await tableRows()).map((r) => r.pipeline).sort();
-  check('compare-loose-files-rows', looseRows.join() === 'pycolmap_points3D.ply,sparse.ply', looseRows.join());
+  check('compare-loose-files-rows', looseRows.join() === 'broken.ply,pycolmap_points3D.ply,sparse.ply', looseRows.join());
+  // a file that cannot be read: its row says so, the others are evaluated, the banner names it
+  const brokenRow = (await tableRows()).find((r) => r.pipeline === 'broken.ply');
+  const banner = await page.textContent('#error');
+  check('compare-unreadable-file-row', brokenRow && brokenRow.cells.status.text === 'evaluation failed' && /broken\.ply/.test(banner) && /1 of 3 could not be evaluated/.test(banner),
+    JSON.stringify({ status: brokenRow && brokenRow.cells.status.text, banner }));
+  await page.click('#banner-close');
   const looseReports = await page.evaluate(() => window.sfmeval.compare.entries.map((e) => [e.row.pipeline, e.reportJson]));
-  for (const [name, json] of looseReports) {
+  for (const [name, json] of looseReports.filter(([, j]) => j)) {
     const file = join(out, `compare-cli-${name}.json`);
     execFileSync(cli, ['eval', '--gt', join(dataset, 'ground_truth.glb'), '--gt-cameras', join(dataset, 'cameras.json'), '--recon', loose.find((f) => f.endsWith(`/${name}`)), '--quiet', '--report', file]);
     const want = readFileSync(file, 'utf8');
