@@ -4,7 +4,8 @@
 # and in a bundler-free page in Chromium (report byte for byte the CLI's), every alignment path
 # through the npm package in Node against the CLI (byte for byte), and the page end to end in
 # Chromium via playwright-core (tests/browser/e2e.mjs: results equal the CLI's; tests/browser/ux.mjs:
-# layout at 1366×768 and 1920×1080, errors in view, keyboard, axe-core, cancel).
+# layout at 1366×768 and 1920×1080, errors in view, keyboard, axe-core, cancel; tests/browser/compare.mjs:
+# a runner runs folder compared in the page equals `sfmeval-runner report`'s table and reports).
 # SFMEVAL_BENCH=1 also runs the speed benchmarks (bench/data; not tests): whole eval in the page,
 # and per operation in Node (tests/browser/bench-ops.mjs).
 # Ends with "N passed, N failed".
@@ -93,6 +94,33 @@ t=$SECONDS
 node tests/browser/ux.mjs --url "http://127.0.0.1:$port/" --out "$out" >"$log/ux.log" 2>&1
 count ux "$log/ux.log" $?
 echo "ux: $((SECONDS - t)) s (screenshots ux-*.png in $out)"
+
+# Compare: a runner runs folder of four pipelines (custom commands that copy the demo's COLMAP
+# model and two real sparse clouds of the same statue from tests/fixtures/global, and one that
+# fails) on a dataset
+# made of the demo's ground truth and cameras; the page's table, its exports and every report
+# must equal what `sfmeval-runner report` writes for that folder (tests/browser/compare.mjs).
+t=$SECONDS
+cmp=$out/compare-runs
+rm -rf "$cmp" && mkdir -p "$cmp/statue/images"
+cp data/demo/ground_truth.glb data/demo/cameras.json "$cmp/statue/"
+# the custom commands never read the images: empty files give the dataset its 36 image names
+for i in $(seq -f %04g 0 35); do : > "$cmp/statue/images/$i.jpg"; done
+fx=$ROOT/tests/fixtures/global
+if cargo build --release --locked -p sfmeval-runner >"$log/runner.log" 2>&1 &&
+  ./target/release/sfmeval-runner run --datasets "$cmp/statue" --intrinsics known --out "$cmp/runs" \
+    --pipelines 'sparse-colmap;pycolmap-ply;theia-ply;broken' --custom "broken=exit 3; {out}" \
+    --custom "sparse-colmap=cp '$ROOT/data/demo/sparse/'*.txt {out}/" \
+    --custom "pycolmap-ply=cp '$fx/pycolmap_points3D.ply' {out}/" \
+    --custom "theia-ply=cp '$fx/theia_points.ply' {out}/" >>"$log/runner.log" 2>&1 &&
+  ./target/release/sfmeval-runner report "$cmp/runs" --out "$cmp/table" >>"$log/runner.log" 2>&1; then
+  node tests/browser/compare.mjs --url "http://127.0.0.1:$port/" --runs "$cmp/runs" --dataset "$cmp/statue" \
+    --table "$cmp/table" --cli target/release/sfmeval --out "$out" >"$log/compare.log" 2>&1
+  count compare "$log/compare.log" $?
+else
+  fail "compare: making the runs folder" "$log/runner.log"
+fi
+echo "compare: $((SECONDS - t)) s (screenshots compare*.png in $out)"
 
 if [ "${SFMEVAL_BENCH:-0}" = 1 ]; then
   node tests/browser/bench.mjs --url "http://127.0.0.1:$port/" --cli target/release/sfmeval 2>&1 | tee "$log/bench.log"

@@ -1,6 +1,7 @@
 // The page: inputs, alignment, crop, evaluation in a worker, results and downloads.
 import { Viewer } from './viewer.js';
 import { histogramPlot, curvesPlot, VIRIDIS } from './plots.js';
+import { setupCompare, drawCameras } from './compare.js';
 
 const $ = (id) => document.getElementById(id);
 const state = {
@@ -782,6 +783,8 @@ async function runEvaluation() {
     showResults(r);
     refreshPoints();
     viewer.setCoverage(r.samplePoints, r.sampleLabels);
+    drawCameras(viewer, r.cameras);
+    showCameraScale(r.cameras);
     $('show-coverage').disabled = !r.sampleLabels;
     $('show-coverage').checked = !!r.sampleLabels;
     viewer.setVisible('coverage', $('show-coverage').checked);
@@ -933,6 +936,19 @@ $('point-size').addEventListener('input', (e) => viewer.setPointSize(Number(e.ta
 $('show-gt').addEventListener('change', (e) => viewer.setVisible('gt', e.target.checked));
 $('show-recon').addEventListener('change', (e) => viewer.setVisible('recon', e.target.checked));
 $('show-coverage').addEventListener('change', (e) => viewer.setVisible('coverage', e.target.checked));
+for (const [box, kind] of [['show-gt-cams', 'gtCams'], ['show-est-cams', 'estCams']]) {
+  $(box).addEventListener('change', (e) => {
+    viewer.setVisible(kind, e.target.checked);
+    if (window.sfmevalViewer2) window.sfmevalViewer2.setVisible(kind, e.target.checked);
+  });
+}
+$('fit-cams').onclick = () => viewer.fitCameras();
+/** The estimated cameras' colour scale beside the points' colour bar. */
+function showCameraScale(cams) {
+  const el = $('cb-cams');
+  el.hidden = !(cams && cams.estPoses);
+  if (!el.hidden) el.textContent = `cameras: centre error 0 → ≥ ${Number(cams.camClip.toPrecision(3))} (same colours)`;
+}
 $('heat').addEventListener('change', refreshPoints);
 
 // downloads
@@ -955,5 +971,9 @@ call('init').then((m) => {
 hideProgress();
 showError('');
 updateRunButton();
+const compare = setupCompare({
+  call, viewer, measureOptions: options, showError, download,
+  gtName: () => (state.gt ? state.gt.name : null),
+});
 // for tests and scripting
-window.sfmeval = { state, call, currentCrop, cropText, prAt, reportNotes, matrixText, alignedTransform };
+window.sfmeval = { compare, state, call, currentCrop, cropText, prAt, reportNotes, matrixText, alignedTransform };

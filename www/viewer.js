@@ -52,7 +52,8 @@ export class Viewer {
   }
 
   resize() {
-    const w = this.container.clientWidth || 300;
+    // the page's viewer shares its box with a second one when comparing side by side
+    const w = (this.container.classList.contains('split') ? 0.5 : 1) * (this.container.clientWidth || 300);
     const h = this.container.clientHeight || 300;
     this.renderer.setSize(w, h, false);
     this.camera.aspect = w / h;
@@ -147,6 +148,68 @@ export class Viewer {
     this.world.add(this.coverage);
   }
 
+  /**
+   * Draws camera frusta (`kind`: 'gtCams' or 'estCams'): `poses` in the ground-truth frame, 14
+   * numbers per camera (centre, world_from_cam row-major, tan of the half field of view in x
+   * and y; 0 means unknown), each frustum in its `colors` entry (r,g,b bytes) or in `color`.
+   * `null` poses remove them. One LineSegments object per kind; `userData.cameras` is the count.
+   */
+  setCameras(kind, poses, colors = null, color = 0xffffff) {
+    this.cams = this.cams || {};
+    const old = this.cams[kind];
+    if (old) { this.world.remove(old); old.geometry.dispose(); delete this.cams[kind]; }
+    if (!poses || !poses.length) return;
+    const n = poses.length / 14;
+    const depth = 0.1 * this.diag;
+    const pos = new Float32Array(n * 16 * 3);
+    const col = new Float32Array(n * 16 * 3);
+    const base = new THREE.Color(color);
+    for (let i = 0; i < n; i++) {
+      const p = poses.subarray(14 * i, 14 * i + 14);
+      const tx = p[12] > 0 ? p[12] : 0.5;
+      const ty = p[13] > 0 ? p[13] : 0.375;
+      // a corner (sx, sy) of the image plane at `depth`: centre + R (sx tx, sy ty, 1) depth
+      const corner = (sx, sy) => [0, 1, 2].map((r) => p[r] + depth * (p[3 + 3 * r] * sx * tx + p[4 + 3 * r] * sy * ty + p[5 + 3 * r]));
+      const c = [p[0], p[1], p[2]];
+      const k = [corner(-1, -1), corner(1, -1), corner(1, 1), corner(-1, 1)];
+      const segs = [c, k[0], c, k[1], c, k[2], c, k[3], k[0], k[1], k[1], k[2], k[2], k[3], k[3], k[0]];
+      const rgb = colors ? [colors[3 * i] / 255, colors[3 * i + 1] / 255, colors[3 * i + 2] / 255] : [base.r, base.g, base.b];
+      segs.forEach((v, j) => { pos.set(v, 3 * (16 * i + j)); col.set(rgb, 3 * (16 * i + j)); });
+    }
+    const g = new THREE.BufferGeometry();
+    g.setAttribute('position', new THREE.BufferAttribute(pos, 3));
+    g.setAttribute('color', new THREE.BufferAttribute(col, 3));
+    const lines = new THREE.LineSegments(g, new THREE.LineBasicMaterial({ vertexColors: true }));
+    lines.name = kind;
+    lines.userData.cameras = n;
+    lines.userData.colors = colors ? Array.from(colors) : null;
+    this.cams[kind] = lines;
+    lines.visible = this.camVisible ? this.camVisible[kind] !== false : true;
+    this.world.add(lines);
+  }
+
+  /** Frames the ground truth and every camera drawn (the frusta stand well outside the object). */
+  fitCameras() {
+    this.fit();
+    let r = this.diag / 2;
+    for (const o of Object.values(this.cams || {})) {
+      const p = o.geometry.attributes.position.array;
+      for (let i = 0; i < p.length; i += 3) r = Math.max(r, Math.hypot(p[i] - this.offset[0], p[i + 1] - this.offset[1], p[i + 2] - this.offset[2]));
+    }
+    const k = (2 * r) / this.diag;
+    this.camera.position.multiplyScalar(k);
+    this.camera.far = Math.max(this.camera.far, this.diag * 100 * k);
+    this.camera.updateProjectionMatrix();
+    this.orbit.update();
+  }
+
+  /** Cameras drawn per kind: `{gtCams: n, estCams: n}` (hidden ones too). */
+  cameraCounts() {
+    const out = {};
+    for (const [k, o] of Object.entries(this.cams || {})) out[k] = { count: o.userData.cameras, visible: o.visible, colors: o.userData.colors };
+    return out;
+  }
+
   setPointSize(s) {
     this.pointSize = s;
     if (this.points) this.points.material.size = s;
@@ -155,6 +218,11 @@ export class Viewer {
   }
 
   setVisible(name, v) {
+    if (name === 'gtCams' || name === 'estCams') {
+      this.camVisible = { ...(this.camVisible || {}), [name]: v };
+      if (this.cams && this.cams[name]) this.cams[name].visible = v;
+      return;
+    }
     const o = name === 'gt' ? this.gtMesh : name === 'coverage' ? this.coverage : this.points;
     if (o) o.visible = v;
   }

@@ -2,7 +2,7 @@
 // {id, ok, ...} or {id, ok: false, error}, and {type: 'progress', id, stage, done, total}.
 import {
   init, version, loadGroundTruth, loadReconstruction, loadCameras, raw, cropFile, parseCrop,
-  parseTransform, parsePointPairs,
+  parseTransform, parsePointPairs, errorColors, POSE_STRIDE, comparisonTables, runRow,
 } from './sfmeval/index.js';
 
 let gt = null;
@@ -10,6 +10,46 @@ let recon = null;
 let cameraFiles = null; // attached to each new ground truth
 let depthFiles = null; // attached after the cameras
 let last = null; // the last raw Evaluation
+
+/**
+ * Camera poses (`POSE_STRIDE` numbers each, reconstruction frame) mapped into the ground-truth
+ * frame by the row-major similarity `m` of scale `s`.
+ */
+function posesInGt(poses, m, s) {
+  const out = new Float64Array(poses.length);
+  for (let i = 0; i < poses.length; i += POSE_STRIDE) {
+    for (let r = 0; r < 3; r++) {
+      out[i + r] = m[4 * r] * poses[i] + m[4 * r + 1] * poses[i + 1] + m[4 * r + 2] * poses[i + 2] + m[4 * r + 3];
+      for (let c = 0; c < 3; c++) {
+        let v = 0;
+        for (let k = 0; k < 3; k++) v += m[4 * r + k] * poses[i + 3 + 3 * k + c];
+        out[i + 3 + 3 * r + c] = v / s;
+      }
+    }
+    out[i + 12] = poses[i + 12];
+    out[i + 13] = poses[i + 13];
+  }
+  return out;
+}
+
+/**
+ * The frusta of an evaluation: the ground-truth cameras, and the estimated ones after the
+ * alignment their errors were measured after (the report's `cameras.alignment`), coloured by
+ * centre error (viridis, clipped at the errors' 95th percentile as the points' map is at the
+ * distances'; grey where the image has no ground truth). Null parts without cameras.
+ */
+function cameraData(r, report) {
+  const gtPoses = gt.hasCameras ? gt.cameraPoses() : null;
+  const cams = report.cameras;
+  const poses = r.cameraPoses();
+  if (!cams || !poses.length) return { gtPoses, estPoses: null, estColors: null, estErrors: null, camClip: null };
+  const m = cams.alignment.gt_from_recon.flat();
+  const estPoses = posesInGt(poses, m, cams.alignment.scale);
+  const byName = new Map(cams.images.map((im) => [im.estimated_name, im.center_error]));
+  const estErrors = Float64Array.from(r.cameraNames(), (n) => byName.get(n) ?? NaN);
+  const camClip = cams.center_error.percentiles.p95;
+  return { gtPoses, estPoses, estErrors, estColors: errorColors(estErrors, camClip), camClip };
+}
 
 const handlers = {
   async init() {
@@ -107,13 +147,65 @@ const handlers = {
     const sampleLabels = e.sampleLabels() ?? null;
     const samplePoints = sampleLabels ? e.completenessPointsF32() : null;
     const extra = sampleLabels ? [sampleLabels.buffer, samplePoints.buffer] : [];
+    const reportJson = e.reportJson();
+    const cameras = cameraData(recon, JSON.parse(reportJson));
     return {
       reply: {
-        reportJson: e.reportJson(), pointsInGt, distances, status, completeness, colors, clip,
-        gtFromRecon: Array.from(e.gtFromRecon()), ms, sampleLabels, samplePoints,
+        reportJson, pointsInGt, distances, status, completeness, colors, clip,
+        gtFromRecon: Array.from(e.gtFromRecon()), ms, sampleLabels, samplePoints, cameras,
       },
       transfer: [pointsInGt.buffer, distances.buffer, status.buffer, completeness.buffer, colors.buffer, ...extra],
     };
+  },
+  /**
+   * Compare: reads one reconstruction of the comparison, evaluates it against the loaded ground
+   * truth (its index prepared once and reused) and returns its report, its table row (from
+   * `runJson`, the run's run.json text, or a row made from the reconstruction for loose
+   * files), what the viewer and the curves need, and frees it.
+   */
+  compareRun({ files, name, runJson, dataset, options, id }) {
+    if (!gt) throw new Error('load a ground truth first');
+    const bytes = {};
+    for (const [n, b] of Object.entries(files)) bytes[n] = new Uint8Array(b);
+    const r = loadReconstruction(bytes, name);
+    const progress = (stage, done, total) => postMessage({ type: 'progress', id, stage, done, total });
+    try {
+      if (cameraFiles && !gt.hasCameras) gt.setCameras(loadCameras(cameraFiles));
+      if (depthFiles && gt.hasCameras && !gt.hasDepthMaps) gt.setDepthMaps(depthFiles);
+      const t0 = performance.now();
+      const e = raw.evaluate(gt, r, options, progress);
+      try {
+        const reportJson = e.reportJson();
+        const report = JSON.parse(reportJson);
+        const run = runJson ?? JSON.stringify({
+          dataset, pipeline: name, tool: 'file', version: null, status: 'ok', reason: null,
+          wall_seconds: 0, cpu_seconds: 0, peak_memory_bytes: 0,
+          images_total: report.cameras ? report.cameras.ground_truth : 0,
+          images_registered: r.images, points: r.pointCount,
+        });
+        const row = JSON.parse(e.runRow(run));
+        const status = e.status();
+        const dist = e.distances();
+        const kept = Float64Array.from(dist.filter((_, i) => status[i] === 0)).sort();
+        const comp = Float64Array.from(e.completenessDistances()).sort();
+        const pointsInGt = e.pointsInGtF32();
+        const clip = e.defaultClip();
+        const colors = e.colors(clip);
+        const cameras = cameraData(r, report);
+        return {
+          reply: { reportJson, row, kept, comp, pointsInGt, colors, clip, cameras, ms: performance.now() - t0 },
+          transfer: [kept.buffer, comp.buffer, pointsInGt.buffer, colors.buffer],
+        };
+      } finally { e.free(); }
+    } finally { r.free(); }
+  },
+  /** The row of a run that did not end ok, from its run.json text. */
+  runRowOnly({ runJson }) {
+    return { row: runRow(runJson) };
+  },
+  /** The comparison tables' texts (`sfmeval-runner report`'s files) of these rows. */
+  comparisonTables({ rows }) {
+    return { tables: comparisonTables(rows) };
   },
   colors({ clip }) {
     if (!last) throw new Error('no evaluation yet');

@@ -14,7 +14,6 @@ mod adapters;
 mod args;
 mod chart;
 mod commands;
-mod csv;
 mod dataset;
 mod env;
 mod exec;
@@ -23,13 +22,11 @@ mod generator;
 mod html;
 mod pipelines;
 mod report;
-mod row;
 mod run;
 mod setup;
 mod sweep;
 mod table;
 mod table1;
-mod text;
 
 use std::process::ExitCode;
 

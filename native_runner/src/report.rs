@@ -14,9 +14,10 @@ use sfmeval::progress::NoProgress;
 use sfmeval::report::Report;
 use sfmeval_fs::{path_str, read_input_files, write_atomic};
 
-use crate::row::{Prf, Row};
 use crate::run::{RunRecord, Status, list_runs, read_record};
 use crate::table::write_tables;
+use sfmeval_table::Row;
+use sfmeval_table::run::{base_row, evaluated_row, report_path};
 
 /// Options of `report`.
 #[derive(Debug, Clone)]
@@ -91,7 +92,7 @@ pub fn report(args: &ReportArgs) -> Result<Vec<Row>> {
             None
         };
         for (rec, dir) in &records {
-            let mut row = base_row(rec);
+            let mut row = base_row(&rec.facts());
             if rec.status == Status::Ok {
                 match &mut gt {
                     None => {
@@ -102,12 +103,10 @@ pub fn report(args: &ReportArgs) -> Result<Vec<Row>> {
                         ));
                     }
                     Some(g) => match evaluate_run(g, dir, rec, args) {
-                        Ok((report, cdf)) => {
-                            let rel = format!("reports/{}/{}.json", rec.dataset, rec.pipeline);
+                        Ok((report, kept)) => {
+                            let rel = report_path(&rec.dataset, &rec.pipeline);
                             write_atomic(&args.out.join(&rel), report.to_json().as_bytes())?;
-                            fill_row(&mut row, &report);
-                            row.cdf = cdf;
-                            row.report = Some(rel);
+                            row = evaluated_row(&rec.facts(), &report, &kept);
                         }
                         Err(e) => {
                             row.status = "evaluation failed".into();
@@ -142,32 +141,12 @@ fn load_gt(dir: &Path) -> Result<Dataset> {
     )
 }
 
-/// Points of the cumulative distribution of `distances`: 201 quantiles `(distance, share)`.
-fn cdf_points(distances: &[f64]) -> Vec<(f64, f64)> {
-    let mut d: Vec<f64> = distances
-        .iter()
-        .copied()
-        .filter(|x| x.is_finite())
-        .collect();
-    if d.is_empty() {
-        return Vec::new();
-    }
-    d.sort_by(f64::total_cmp);
-    let n = d.len();
-    (0..=200)
-        .map(|k| {
-            let i = ((k as f64 / 200.0) * (n - 1) as f64).round() as usize;
-            (d[i.min(n - 1)], (i + 1) as f64 / n as f64)
-        })
-        .collect()
-}
-
 fn evaluate_run(
     gt: &mut Dataset,
     dir: &Path,
     rec: &RunRecord,
     args: &ReportArgs,
-) -> Result<(Report, Vec<(f64, f64)>)> {
+) -> Result<(Report, Vec<f64>)> {
     let model = dir.join("model");
     let mut files = if model.is_dir() {
         read_input_files(&model)?
@@ -193,62 +172,5 @@ fn evaluate_run(
         .filter(|(_, s)| matches!(s, sfmeval::evaluate::PointStatus::Kept))
         .map(|(d, _)| *d)
         .collect();
-    let cdf = cdf_points(&kept);
-    Ok((evaluation.report, cdf))
-}
-
-fn base_row(rec: &RunRecord) -> Row {
-    Row {
-        dataset: rec.dataset.clone(),
-        pipeline: rec.pipeline.clone(),
-        tool: rec.tool.clone(),
-        version: rec.version.clone(),
-        status: rec.status.label().to_string(),
-        reason: rec.reason.clone(),
-        images_total: rec.images_total,
-        images_registered: rec.images_registered,
-        points: rec.points as u64,
-        wall_seconds: rec.wall_seconds,
-        cpu_seconds: rec.cpu_seconds,
-        peak_memory_mb: rec.peak_memory_bytes as f64 / 1e6,
-        mean: None,
-        median: None,
-        rms: None,
-        completeness_mean: None,
-        thresholds: Vec::new(),
-        rotation_median_deg: None,
-        center_median: None,
-        center_median_percent: None,
-        center_max_percent: None,
-        cdf: Vec::new(),
-        report: None,
-    }
-}
-
-fn fill_row(row: &mut Row, r: &Report) {
-    let a = &r.accuracy.stats;
-    row.points = r.inputs.reconstruction.points;
-    row.mean = Some(a.mean);
-    row.median = Some(a.median);
-    row.rms = Some(a.rms);
-    row.completeness_mean = Some(r.completeness.stats.mean);
-    row.thresholds = r
-        .thresholds
-        .iter()
-        .map(|t| Prf {
-            tau: t.tau,
-            tau_percent_of_diagonal: t.tau_percent_of_diagonal,
-            precision: t.precision,
-            recall: t.recall,
-            f_score: t.f_score,
-        })
-        .collect();
-    if let Some(c) = &r.cameras {
-        let c = &c.errors;
-        row.rotation_median_deg = Some(c.rotation_error_deg.median);
-        row.center_median = Some(c.center_error.median);
-        row.center_median_percent = Some(c.center_error_percent.median);
-        row.center_max_percent = Some(c.center_error_percent.max);
-        row.images_registered = c.registered;
-    }
+    Ok((evaluation.report, kept))
 }

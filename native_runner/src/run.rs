@@ -18,34 +18,8 @@ use crate::exec::{StepResult, run_step};
 use crate::files::{partial_name, replace_dir};
 use crate::pipelines::PipelineSpec;
 
-/// Schema id of run.json.
-pub const RUN_SCHEMA: &str = "sfmeval.run/1";
-
-/// How a run ended.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(rename_all = "snake_case")]
-pub enum Status {
-    /// The tool produced a model; sparse.ply and cameras.json are written.
-    Ok,
-    /// A command failed or its output could not be read.
-    Failed,
-    /// The run hit its timeout.
-    Timeout,
-    /// The tool is not installed here.
-    NotInstalled,
-}
-
-impl Status {
-    /// `ok`, `failed`, `timeout`, `not installed`.
-    pub fn label(self) -> &'static str {
-        match self {
-            Status::Ok => "ok",
-            Status::Failed => "failed",
-            Status::Timeout => "timeout",
-            Status::NotInstalled => "not installed",
-        }
-    }
-}
+pub use sfmeval_table::Status;
+pub use sfmeval_table::run::RUN_SCHEMA;
 
 /// `run.json`: everything about how one run went.
 #[derive(Debug, Clone, Serialize, Deserialize)]
@@ -101,6 +75,26 @@ pub struct RunRecord {
     /// Extra facts the adapter reported (tool.json).
     #[serde(default)]
     pub tool_report: serde_json::Value,
+}
+
+impl RunRecord {
+    /// The fields the tables use.
+    pub fn facts(&self) -> sfmeval_table::RunFacts {
+        sfmeval_table::RunFacts {
+            dataset: self.dataset.clone(),
+            pipeline: self.pipeline.clone(),
+            tool: self.tool.clone(),
+            version: self.version.clone(),
+            status: self.status,
+            reason: self.reason.clone(),
+            wall_seconds: self.wall_seconds,
+            cpu_seconds: self.cpu_seconds,
+            peak_memory_bytes: self.peak_memory_bytes,
+            images_total: self.images_total,
+            images_registered: self.images_registered,
+            points: self.points,
+        }
+    }
 }
 
 /// Options of a batch.

@@ -93,6 +93,9 @@ try {
   const modelArgs = ['--recon', demo('sparse'), '--gt-cameras', demo('cameras.json')];
   const expectedModel = cliReport(modelArgs, 'cli-model.json');
   const pageModel = await downloadText('#dl-report');
+  // the model's cameras as frusta: one per registered image, and the ground truth's
+  const frusta = await page.evaluate(() => window.sfmevalViewer.cameraCounts());
+  check('frusta-drawn', frusta.estCams && frusta.estCams.count === 36 && frusta.gtCams && frusta.gtCams.count === 36 && frusta.estCams.colors.length === 3 * 36, JSON.stringify({ est: frusta.estCams && frusta.estCams.count, gt: frusta.gtCams && frusta.gtCams.count }));
   check('report-model-auto-equals-cli', noteSame('report-model-auto-equals-cli', pageModel.text, expectedModel), `page ${pageModel.path} vs cli-model.json: ${firstDiff(pageModel.text, expectedModel)}`);
   const rep = JSON.parse(expectedModel);
   const cell = (row, k) => page.textContent(`#stats tr[data-row=${row}] td[data-k=${k}]`);

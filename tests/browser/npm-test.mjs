@@ -54,6 +54,24 @@ const n = r.report.inputs.reconstruction.points;
 check('npm-arrays', r.distances().length === n && r.status().length === n && r.colors().length === 3 * n && r.pointsInGt().length === 3 * n);
 check('npm-colored-ply', Buffer.from(r.coloredPly().slice(0, 4)).toString() === 'ply\n');
 check('npm-csv', r.csv().startsWith('index,x,y,z,distance,signed_distance,status\n'));
+// the runner's table through the package: a run's row from run.json + this evaluation, a failed
+// run's row, and the tables' text
+const runJson = JSON.stringify({ dataset: 'demo', pipeline: 'colmap', tool: 'colmap', version: '3.9', status: 'ok', reason: null,
+  wall_seconds: 1, cpu_seconds: 1, peak_memory_bytes: 1e6, images_total: 36, images_registered: 36, points: n });
+const row = r.runRow(runJson);
+const failedRow = sfmeval.runRow(runJson.replace('"ok"', '"failed"').replace('"pipeline":"colmap"', '"pipeline":"theia"'));
+const tables = sfmeval.comparisonTables([row, failedRow]);
+check('npm-run-row', row.mean === r.report.accuracy.mean && row.cdf.length === 201 && row.report === 'reports/demo/colmap.json'
+  && failedRow.status === 'failed' && failedRow.mean === null, JSON.stringify({ mean: row.mean, report: row.report, failed: failedRow.status }));
+check('npm-comparison-tables', tables.table1_md.includes('| dataset | colmap | theia |\n') && tables.table_md.startsWith(tables.table1_md)
+  && tables.table1_csv.startsWith('dataset,colmap.mean_m,') && tables.runs_csv.split('\n').length === 4 && JSON.parse(tables.summary_json).rows.length === 2,
+  tables.table1_md);
+const gtObj = sfmeval.loadGroundTruth({ 'ground_truth.glb': demo('ground_truth.glb') });
+gtObj.setCameras(sfmeval.loadCameras({ 'cameras.json': demo('cameras.json') }));
+const rec = sfmeval.loadReconstruction(model, 'sparse');
+check('npm-camera-poses', gtObj.cameraPoses().length === 36 * sfmeval.POSE_STRIDE && rec.cameraPoses().length === 36 * sfmeval.POSE_STRIDE
+  && rec.cameraNames().length === 36 && sfmeval.errorColors([0, 1], 1).length === 6);
+gtObj.free(); rec.free();
 r.free();
 
 try {

@@ -113,6 +113,9 @@ export interface EvaluationResult {
   csv(): string;
   /** `gt_from_recon`, row-major, 16 numbers. */
   gtFromRecon(): Float64Array;
+  /** This run's row of the comparison tables (as in the runner's summary.json), from its
+   * run.json text. */
+  runRow(runJson: string): RunRow;
   /** The accuracy 95th percentile (the CLI's default colour clip). */
   defaultClip(): number;
   /** Frees the wasm memory of this result. */
@@ -156,6 +159,66 @@ export function cropFile(crop: Crop): string;
 export function parseTransform(text: string): number[][];
 /** Parses a point-pairs file. */
 export function parsePointPairs(text: string): PointPair[];
+
+/** One threshold of a run row. */
+export interface RunPrf {
+  tau: number;
+  tau_percent_of_diagonal: number;
+  precision: number;
+  recall: number;
+  f_score: number;
+}
+
+/** One run's row of the comparison tables (`sfmeval-runner report`'s summary.json rows). */
+export interface RunRow {
+  dataset: string;
+  pipeline: string;
+  tool: string;
+  version: string | null;
+  /** `ok`, `failed`, `timeout`, `not installed`, `evaluation failed`. */
+  status: string;
+  reason: string | null;
+  images_total: number;
+  images_registered: number;
+  points: number;
+  wall_seconds: number;
+  cpu_seconds: number;
+  peak_memory_mb: number;
+  mean: number | null;
+  median: number | null;
+  rms: number | null;
+  completeness_mean: number | null;
+  thresholds: RunPrf[];
+  rotation_median_deg: number | null;
+  center_median: number | null;
+  center_median_percent: number | null;
+  center_max_percent: number | null;
+  /** `[distance, share]` points of the cumulative distribution of the kept points. */
+  cdf: [number, number][];
+  /** `reports/<dataset>/<pipeline>.json`. */
+  report: string | null;
+}
+
+/** The row of a run that was not evaluated, from its run.json text. */
+export function runRow(runJson: string): RunRow;
+
+/** The texts of the files `sfmeval-runner report` writes for these rows. */
+export interface ComparisonTables {
+  table1_md: string;
+  table1_csv: string;
+  runs_csv: string;
+  table_md: string;
+  summary_json: string;
+}
+
+export function comparisonTables(rows: RunRow[]): ComparisonTables;
+
+/** Viewer colours: r,g,b per value, viridis saturating at `clip` (the points' map), NaN grey. */
+export function errorColors(values: ArrayLike<number>, clip: number): Uint8Array;
+
+/** Numbers per camera of `cameraPoses()`: centre (3), world_from_cam row-major (9), tangents of
+ * the half field of view in x and y (0 when unknown). */
+export const POSE_STRIDE: 14;
 
 export const GroundTruth: typeof rawBindings.GroundTruth;
 export type GroundTruth = RawGroundTruth;

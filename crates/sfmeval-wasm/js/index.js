@@ -108,6 +108,8 @@ function wrap(e) {
     coloredPly: (clip = e.defaultClip()) => e.coloredPly(clip),
     csv: () => e.csv(),
     gtFromRecon: () => e.gtFromRecon(),
+    /** This run's row of the comparison tables (`summary.json`'s), from its run.json text. */
+    runRow: (runJson) => JSON.parse(e.runRow(runJson)),
     defaultClip: () => e.defaultClip(),
     free: () => e.free(),
   };
@@ -167,6 +169,28 @@ export function parseTransform(text) {
 export function parsePointPairs(text) {
   return wasm.parsePointPairs(text);
 }
+
+/** The row of a run that was not evaluated (status not ok), from its run.json text. */
+export function runRow(runJson) {
+  return JSON.parse(wasm.runRow(runJson));
+}
+
+/**
+ * The comparison tables of `rows` (rows of `runRow` / `evaluation.runRow`), each the text of the
+ * file `sfmeval-runner report` writes: `{table1_md, table1_csv, runs_csv, table_md, summary_json}`.
+ */
+export function comparisonTables(rows) {
+  return wasm.comparisonTables(JSON.stringify(rows));
+}
+
+/** Viewer colours (`Uint8Array` r,g,b per value: viridis saturating at `clip`, NaN grey). */
+export function errorColors(values, clip) {
+  return wasm.errorColors(Float64Array.from(values), clip);
+}
+
+/** Numbers per camera in `GroundTruth.cameraPoses()` / `Reconstruction.cameraPoses()`:
+ * centre (3), world_from_cam row-major (9), tan of the half field of view in x and y. */
+export const POSE_STRIDE = 14;
 
 export const GroundTruth = wasm.GroundTruth;
 export const Reconstruction = wasm.Reconstruction;

@@ -26,6 +26,12 @@ use sfmeval::progress::{Progress, Stage};
 use sfmeval::transform::Similarity;
 use wasm_bindgen::prelude::*;
 
+mod poses;
+mod table;
+
+pub use poses::error_colors;
+pub use table::{comparison_tables, run_row};
+
 /// Installs the panic hook so that a Rust panic shows its message in the console.
 #[wasm_bindgen(start)]
 pub fn start() {

@@ -102,3 +102,65 @@ fn errors_carry_the_core_message() {
     assert!(GroundTruth::new("tetra.ply", &Uint8Array::from(GT), None, Some(4.0)).is_ok());
     assert!(GroundTruth::new("tetra.ply", &Uint8Array::from(GT), None, Some(3.0)).is_err());
 }
+
+const RUN_JSON: &str = r#"{"schema":"sfmeval.run/1","dataset":"tetra","dataset_dir":"/d","pipeline":"colmap","kind":"colmap","tool":"colmap","version":"3.9","status":"ok","reason":null,"command":[],"options":{},"wall_seconds":1.5,"cpu_seconds":2.0,"peak_memory_bytes":2500000,"exit_status":0,"images_total":36,"images_registered":30,"points":5,"models":1,"started_unix":0,"finished_unix":1,"log":"log.txt","steps":[],"warnings":[]}"#;
+
+#[wasm_bindgen_test]
+fn builds_the_runner_rows_and_tables() {
+    let mut gt = GroundTruth::new("tetra.ply", &Uint8Array::from(GT), None, None).unwrap();
+    let recon = Reconstruction::new("tetra/colmap", &files("cloud.ply", RECON)).unwrap();
+    let opts = Object::new();
+    Reflect::set(&opts, &"transform".into(), &TRANSFORM.into()).unwrap();
+    Reflect::set(&opts, &"samples".into(), &2_000.into()).unwrap();
+    let e = evaluate(&mut gt, &recon, opts.into(), None).unwrap();
+    let row: serde_json::Value = serde_json::from_str(&e.run_row(RUN_JSON).unwrap()).unwrap();
+    assert_eq!(row["pipeline"], "colmap");
+    assert_eq!(row["points"], 5);
+    assert_eq!(row["peak_memory_mb"], 2.5);
+    assert_eq!(row["report"], "reports/tetra/colmap.json");
+    assert_eq!(row["cdf"].as_array().unwrap().len(), 201);
+    assert_eq!(row["thresholds"].as_array().unwrap().len(), 3);
+    // a failed run: the row from run.json alone
+    let failed = sfmeval_wasm::run_row(&RUN_JSON.replace("\"ok\"", "\"timeout\"")).unwrap();
+    let failed: serde_json::Value = serde_json::from_str(&failed).unwrap();
+    assert_eq!(failed["status"], "timeout");
+    assert!(failed["mean"].is_null());
+    // a broken run.json names the file
+    let err = sfmeval_wasm::run_row("{}").err().unwrap();
+    let msg = js_sys::Error::from(JsValue::from(err)).message();
+    assert!(String::from(msg).starts_with("run.json: missing field"));
+    let rows = format!("[{row},{failed}]");
+    let t = sfmeval_wasm::comparison_tables(&rows).unwrap();
+    let md = Reflect::get(&t, &"table1_md".into())
+        .unwrap()
+        .as_string()
+        .unwrap();
+    assert!(md.contains("| dataset | colmap |\n"), "{md}");
+    let csv = Reflect::get(&t, &"runs_csv".into())
+        .unwrap()
+        .as_string()
+        .unwrap();
+    assert!(csv.starts_with("dataset,pipeline,status,points,registered,"));
+}
+
+#[wasm_bindgen_test]
+fn camera_poses_for_the_frusta() {
+    let cams = include_bytes!("../../../data/demo/cameras.json");
+    let r = Reconstruction::new("cams", &files("cameras.json", cams)).unwrap();
+    let poses = r.camera_poses().to_vec();
+    assert_eq!(poses.len(), 36 * 14);
+    assert_eq!(r.camera_names().len(), 36);
+    // the first image's centre as the file gives it, and the PINHOLE 640×360, f 700 frustum
+    let c = [2.058960199356, 0.749400258064, 1.4901e-08];
+    for k in 0..3 {
+        assert!((poses[k] - c[k]).abs() < 1e-6, "{poses:?}");
+    }
+    assert!((poses[12] - 320.0 / 700.0).abs() < 1e-12 && (poses[13] - 180.0 / 700.0).abs() < 1e-12);
+    // a bare cloud has no cameras
+    let cloud = Reconstruction::new("cloud.ply", &files("cloud.ply", RECON)).unwrap();
+    assert_eq!(cloud.camera_poses().length(), 0);
+    let colors = sfmeval_wasm::error_colors(&[0.0, 1.0, f64::NAN], 1.0).to_vec();
+    assert_eq!(colors.len(), 9);
+    assert_eq!(&colors[6..], &[128, 128, 128]);
+    assert_ne!(&colors[0..3], &colors[3..6]);
+}

@@ -205,17 +205,8 @@ pub trait Adapter: Send + Sync {
     }
 }
 
-/// The built-in pipelines, in table order.
-pub const BUILTIN: [&str; 8] = [
-    "colmap",
-    "pycolmap",
-    "pycolmap-global",
-    "theia",
-    "theia-incremental",
-    "openmvg",
-    "openmvg-global",
-    "visualsfm",
-];
+/// The built-in pipelines, in table order (the list the tables order by).
+pub const BUILTIN: [&str; 8] = sfmeval_table::BUILTIN_PIPELINES;
 
 /// The adapter of a built-in pipeline, or of a custom one defined by `customs`.
 pub fn adapter(

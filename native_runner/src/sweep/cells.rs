@@ -5,8 +5,8 @@ use std::path::Path;
 
 use serde_json::Value as Json;
 
-use crate::row::Row;
 use crate::sweep::variants::{Planned, Variant};
+use sfmeval_table::Row;
 
 /// One (value, pipeline) cell of the sweep.
 #[derive(Debug, Clone)]

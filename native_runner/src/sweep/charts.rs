@@ -6,7 +6,7 @@ use crate::chart::value::Value;
 use crate::sweep::cells::Cell;
 use crate::sweep::factor::Factor;
 use crate::sweep::metrics::{Metric, lookup};
-use crate::text::one_line;
+use sfmeval_table::text::one_line;
 
 /// One chart per metric, one series per pipeline (in `pipes` order).
 pub fn charts(

@@ -32,10 +32,10 @@ use crate::exec::shell_quote;
 use crate::generator::{find_blender_scripts, resolved_config};
 use crate::pipelines::{parse_customs, parse_list};
 use crate::report::{ReportArgs, report};
-use crate::row::Row;
 use crate::run::run_batch;
 use crate::sweep::factor::parse_factor;
 use crate::sweep::metrics::metric_file;
+use sfmeval_table::Row;
 
 /// The whole sweep: plan and render the variants, run the pipelines, evaluate, write
 /// `sweep.csv`, `charts/`, `sweep.html` and `sweep.json`.

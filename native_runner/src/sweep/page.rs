@@ -6,7 +6,7 @@ use crate::chart::line::{Chart, svg_inline};
 use crate::html::{self, esc};
 use crate::sweep::factor::Factor;
 use crate::sweep::variants::Variant;
-use crate::text::one_line;
+use sfmeval_table::text::one_line;
 
 /// The page's own style, after the shell's.
 const STYLE: &str = "th,td{border:1px solid #ccc;padding:3px 7px;text-align:left}th{background:#f3f3f3}td.failed{color:#a00;background:#fff3f3}\n.charts{display:flex;flex-wrap:wrap;gap:1em}.charts figure{margin:0}svg{border:1px solid #ddd}code{background:#f5f5f5;padding:1px 3px}";

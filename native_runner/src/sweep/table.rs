@@ -1,9 +1,9 @@
 //! `sweep.csv`: every cell's status and metric values.
 
-use crate::csv::CsvWriter;
 use crate::sweep::cells::Cell;
 use crate::sweep::factor::Factor;
 use crate::sweep::metrics::{Metric, lookup};
+use sfmeval_table::csv::CsvWriter;
 
 /// `sweep.csv`: one row per (value, pipeline): factor, value, dataset, pipeline, status,
 /// reason, then every metric (empty where there is none).

@@ -8,9 +8,9 @@ use crate::chart::cdf::{self, Curve};
 use crate::chart::palette::color;
 use crate::chart::value::Value;
 use crate::html::{self, esc};
-use crate::row::Row;
-use crate::table::cells::{table1_cell, wide_for_html};
-use crate::table::order::find;
+use sfmeval_table::Row;
+use sfmeval_table::cells::{table1_cell, wide_for_html};
+use sfmeval_table::order::find;
 
 /// The page's own style, after the shell's.
 const STYLE: &str = "th,td{border:1px solid #ccc;padding:3px 7px;text-align:right}th{background:#f3f3f3}td.l,th.l{text-align:left}\ntr.failed td,td.failed{color:#a00;background:#fff3f3}.charts{display:flex;flex-wrap:wrap;gap:1em}\nsvg{background:#fff;border:1px solid #ddd}.legend span{display:inline-block;margin-right:1em}.sw{display:inline-block;width:12px;height:12px;margin-right:4px;vertical-align:middle}";

@@ -1,8 +1,8 @@
 //! What the table cells say: Table I's `mean (points)` or the failure, and the wide table's
 //! columns and values (shared by Markdown, CSV and HTML).
 
+use crate::order::find;
 use crate::row::Row;
-use crate::table::order::find;
 use crate::text::one_line;
 
 /// Table I cell text: `mean m (points)` or the failure.

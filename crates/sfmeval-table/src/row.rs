@@ -1,5 +1,5 @@
-//! One run's row of the comparison tables: its record, its evaluation's numbers (written by
-//! `report`, read by the tables, the page and the sweep).
+//! One run's row of the comparison tables: its record, its evaluation's numbers (built by
+//! `run::evaluated_row`, read by the tables, the runner's page and sweep, and the web page).
 
 use serde::{Deserialize, Serialize};
 

@@ -2,13 +2,24 @@
 
 use std::collections::BTreeSet;
 
-use crate::adapters::BUILTIN;
 use crate::row::Row;
+
+/// The runner's built-in pipelines, in table order (the runner's adapters have these names).
+pub const BUILTIN_PIPELINES: [&str; 8] = [
+    "colmap",
+    "pycolmap",
+    "pycolmap-global",
+    "theia",
+    "theia-incremental",
+    "openmvg",
+    "openmvg-global",
+    "visualsfm",
+];
 
 /// Pipelines in table order: built-ins first (their fixed order), then others by name.
 pub fn pipeline_order(rows: &[Row]) -> Vec<String> {
     let names: BTreeSet<&str> = rows.iter().map(|r| r.pipeline.as_str()).collect();
-    let mut out: Vec<String> = BUILTIN
+    let mut out: Vec<String> = BUILTIN_PIPELINES
         .iter()
         .filter(|b| names.contains(*b))
         .map(|s| s.to_string())
@@ -16,7 +27,7 @@ pub fn pipeline_order(rows: &[Row]) -> Vec<String> {
     out.extend(
         names
             .iter()
-            .filter(|n| !BUILTIN.contains(*n))
+            .filter(|n| !BUILTIN_PIPELINES.contains(*n))
             .map(|s| s.to_string()),
     );
     out

@@ -1,0 +1,18 @@
+//! The comparison tables of `sfmeval-runner report` as text, with no filesystem: a run's
+//! record (`run.json`), its row built from the record and its `sfmeval.report/2`, and Table I
+//! and the wide table as Markdown and CSV. The runner writes these strings to files; the page
+//! (through the wasm bindings) builds the same strings from the same runs, so both say the same
+//! thing byte for byte.
+
+pub mod cells;
+pub mod csv;
+pub mod order;
+pub mod row;
+pub mod run;
+pub mod tables;
+pub mod text;
+
+pub use order::BUILTIN_PIPELINES;
+pub use row::{Prf, Row};
+pub use run::{RunFacts, Status};
+pub use tables::{Tables, summary_json, tables};

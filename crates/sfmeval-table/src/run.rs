@@ -1,0 +1,207 @@
+//! What a run's `run.json` (`sfmeval.run/1`, written by `sfmeval-runner run`) tells the tables:
+//! how the run ended, its tool, images, points and resources; and the row built from it and its
+//! evaluation.
+
+use serde::{Deserialize, Serialize};
+use sfmeval::report::Report;
+
+use crate::row::{Prf, Row};
+
+/// Schema id of run.json.
+pub const RUN_SCHEMA: &str = "sfmeval.run/1";
+
+/// How a run ended.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Status {
+    /// The tool produced a model; sparse.ply and cameras.json are written.
+    Ok,
+    /// A command failed or its output could not be read.
+    Failed,
+    /// The run hit its timeout.
+    Timeout,
+    /// The tool is not installed here.
+    NotInstalled,
+}
+
+impl Status {
+    /// `ok`, `failed`, `timeout`, `not installed`.
+    pub fn label(self) -> &'static str {
+        match self {
+            Status::Ok => "ok",
+            Status::Failed => "failed",
+            Status::Timeout => "timeout",
+            Status::NotInstalled => "not installed",
+        }
+    }
+}
+
+/// The fields of `run.json` the tables use (the runner's full record has more; unknown fields
+/// are ignored when parsing).
+#[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
+pub struct RunFacts {
+    /// Dataset name (first folder level).
+    pub dataset: String,
+    /// Pipeline name (second folder level).
+    pub pipeline: String,
+    /// Tool name.
+    pub tool: String,
+    /// Tool version (as the tool reports it).
+    pub version: Option<String>,
+    /// Outcome.
+    pub status: Status,
+    /// Why it did not succeed.
+    pub reason: Option<String>,
+    /// Wall-clock seconds of the tool's commands.
+    pub wall_seconds: f64,
+    /// User + system CPU seconds of the tool's commands.
+    pub cpu_seconds: f64,
+    /// Peak resident memory of the largest process, bytes.
+    pub peak_memory_bytes: u64,
+    /// Images in the dataset.
+    pub images_total: usize,
+    /// Images with a pose in the model.
+    pub images_registered: usize,
+    /// 3D points of the model.
+    pub points: usize,
+}
+
+impl RunFacts {
+    /// Parses `run.json` text; errors say which field is wrong.
+    pub fn parse(text: &str) -> Result<RunFacts, serde_json::Error> {
+        serde_json::from_str(text)
+    }
+}
+
+/// The report file of a run, relative to the table folder: `reports/<dataset>/<pipeline>.json`.
+pub fn report_path(dataset: &str, pipeline: &str) -> String {
+    format!("reports/{dataset}/{pipeline}.json")
+}
+
+/// A run's row before evaluation: what `run.json` says.
+pub fn base_row(rec: &RunFacts) -> Row {
+    Row {
+        dataset: rec.dataset.clone(),
+        pipeline: rec.pipeline.clone(),
+        tool: rec.tool.clone(),
+        version: rec.version.clone(),
+        status: rec.status.label().to_string(),
+        reason: rec.reason.clone(),
+        images_total: rec.images_total,
+        images_registered: rec.images_registered,
+        points: rec.points as u64,
+        wall_seconds: rec.wall_seconds,
+        cpu_seconds: rec.cpu_seconds,
+        peak_memory_mb: rec.peak_memory_bytes as f64 / 1e6,
+        mean: None,
+        median: None,
+        rms: None,
+        completeness_mean: None,
+        thresholds: Vec::new(),
+        rotation_median_deg: None,
+        center_median: None,
+        center_median_percent: None,
+        center_max_percent: None,
+        cdf: Vec::new(),
+        report: None,
+    }
+}
+
+/// Adds an evaluation's numbers to a row: accuracy, completeness, P/R/F, camera errors.
+pub fn fill_row(row: &mut Row, r: &Report) {
+    let a = &r.accuracy.stats;
+    row.points = r.inputs.reconstruction.points;
+    row.mean = Some(a.mean);
+    row.median = Some(a.median);
+    row.rms = Some(a.rms);
+    row.completeness_mean = Some(r.completeness.stats.mean);
+    row.thresholds = r
+        .thresholds
+        .iter()
+        .map(|t| Prf {
+            tau: t.tau,
+            tau_percent_of_diagonal: t.tau_percent_of_diagonal,
+            precision: t.precision,
+            recall: t.recall,
+            f_score: t.f_score,
+        })
+        .collect();
+    if let Some(c) = &r.cameras {
+        let c = &c.errors;
+        row.rotation_median_deg = Some(c.rotation_error_deg.median);
+        row.center_median = Some(c.center_error.median);
+        row.center_median_percent = Some(c.center_error_percent.median);
+        row.center_max_percent = Some(c.center_error_percent.max);
+        row.images_registered = c.registered;
+    }
+}
+
+/// Points of the cumulative distribution of `distances` (non-finite ones dropped): 201
+/// quantiles `(distance, share)`, none for no distance.
+pub fn cdf_points(distances: &[f64]) -> Vec<(f64, f64)> {
+    let mut d: Vec<f64> = distances
+        .iter()
+        .copied()
+        .filter(|x| x.is_finite())
+        .collect();
+    if d.is_empty() {
+        return Vec::new();
+    }
+    d.sort_by(f64::total_cmp);
+    let n = d.len();
+    (0..=200)
+        .map(|k| {
+            let i = ((k as f64 / 200.0) * (n - 1) as f64).round() as usize;
+            (d[i.min(n - 1)], (i + 1) as f64 / n as f64)
+        })
+        .collect()
+}
+
+/// The row of an evaluated run: [`base_row`], [`fill_row`], the cumulative distribution of the
+/// kept points' distances and the report path.
+pub fn evaluated_row(rec: &RunFacts, report: &Report, kept_distances: &[f64]) -> Row {
+    let mut row = base_row(rec);
+    fill_row(&mut row, report);
+    row.cdf = cdf_points(kept_distances);
+    row.report = Some(report_path(&rec.dataset, &rec.pipeline));
+    row
+}
+
+#[cfg(test)]
+#[allow(clippy::unwrap_used, clippy::expect_used)]
+mod tests {
+    use super::*;
+
+    const RUN: &str = r#"{"schema":"sfmeval.run/1","dataset":"statue","dataset_dir":"/d","pipeline":"colmap","kind":"colmap","tool":"colmap","version":"3.9","status":"not_installed","reason":"no colmap","command":[],"options":{},"wall_seconds":1.5,"cpu_seconds":2.0,"peak_memory_bytes":2500000,"exit_status":null,"images_total":36,"images_registered":0,"points":0,"models":0,"started_unix":0,"finished_unix":1,"log":"log.txt","steps":[],"warnings":[]}"#;
+
+    #[test]
+    fn parses_run_json_and_builds_the_base_row() {
+        let f = RunFacts::parse(RUN).unwrap();
+        assert_eq!(f.status, Status::NotInstalled);
+        let r = base_row(&f);
+        assert_eq!(r.status, "not installed");
+        assert_eq!(r.peak_memory_mb, 2.5);
+        assert_eq!((r.images_total, r.points), (36, 0));
+        assert!(r.mean.is_none() && r.report.is_none());
+    }
+
+    #[test]
+    fn run_json_errors_name_the_field() {
+        let e = RunFacts::parse(r#"{"dataset":"x"}"#)
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("missing field"), "{e}");
+        let bad = RUN.replace("\"not_installed\"", "\"maybe\"");
+        assert!(RunFacts::parse(&bad).is_err());
+    }
+
+    #[test]
+    fn cdf_has_201_quantiles_and_drops_non_finite() {
+        assert!(cdf_points(&[f64::NAN]).is_empty());
+        let c = cdf_points(&[3.0, 1.0, f64::INFINITY, 2.0]);
+        assert_eq!(c.len(), 201);
+        assert_eq!(c[0], (1.0, 1.0 / 3.0));
+        assert_eq!(c[200], (3.0, 1.0));
+        assert_eq!(c[100], (2.0, 2.0 / 3.0));
+    }
+}

@@ -1,0 +1,251 @@
+// The page's Compare section in Chromium: a runner runs folder and its dataset's ground truth go
+// in; the table, its exports and every report must be what `sfmeval-runner report` wrote for the
+// same folder, byte for byte; sorting, best marks, overlaid curves, the side-by-side viewer and
+// the camera frusta are checked too.
+// Usage: node compare.mjs --url URL --runs RUNS --dataset DATASET --table RUNNER_TABLE
+//          --cli target/release/sfmeval --out DIR
+// Prints one "ok NAME" / "FAILED NAME: why" line per check; exits 1 when one failed.
+import { chromium } from 'playwright-core';
+import { execFileSync } from 'node:child_process';
+import { readFileSync, mkdirSync, readdirSync, writeFileSync } from 'node:fs';
+import { join, resolve } from 'node:path';
+
+const args = Object.fromEntries(process.argv.slice(2).reduce((a, v, i, all) => (v.startsWith('--') ? [...a, [v.slice(2), all[i + 1]]] : a), []));
+const [runs, dataset, table, cli, out] = ['runs', 'dataset', 'table', 'cli', 'out'].map((k) => resolve(args[k]));
+mkdirSync(out, { recursive: true });
+const origin = new URL(args.url).origin;
+
+let failed = 0;
+const check = (name, ok, why = '') => {
+  if (ok) console.log(`ok ${name}`);
+  else { failed++; console.log(`FAILED ${name}: ${why}`); }
+};
+function firstDiff(a, b) {
+  const x = a.split('\n'), y = b.split('\n');
+  const i = x.findIndex((l, k) => l !== y[k]);
+  return i < 0 ? (x.length === y.length ? 'equal' : 'lengths differ') : `line ${i + 1}: ${x[i]} vs ${y[i]}`;
+}
+
+const browser = await chromium.launch({
+  executablePath: process.env.CHROMIUM || '/usr/bin/chromium',
+  args: ['--use-angle=swiftshader', '--enable-unsafe-swiftshader', '--no-sandbox', '--disable-gpu', '--disable-dev-shm-usage'],
+});
+const context = await browser.newContext({ acceptDownloads: true, viewport: { width: 1400, height: 900 } });
+const page = await context.newPage();
+const requests = [];
+context.on('request', (r) => requests.push(r.url()));
+const consoleErrors = [];
+page.on('console', (m) => { if (m.type() === 'error') consoleErrors.push(m.text()); });
+page.on('pageerror', (e) => consoleErrors.push(String(e)));
+
+async function downloadText(sel) {
+  const [dl] = await Promise.all([page.waitForEvent('download'), page.click(sel)]);
+  const p = join(out, `compare-${dl.suggestedFilename()}`);
+  await dl.saveAs(p);
+  return readFileSync(p, 'utf8');
+}
+const tableRows = () => page.$$eval('#cmp-table tbody tr', (trs) => trs.map((tr) => ({
+  pipeline: tr.dataset.pipeline,
+  cells: Object.fromEntries([...tr.querySelectorAll('td')].map((td) => [td.dataset.k, { v: td.dataset.v === undefined ? null : Number(td.dataset.v), best: td.dataset.best === '1', text: td.textContent }])),
+})));
+
+try {
+  await page.goto(args.url);
+  await page.waitForFunction(() => document.body.dataset.ready === '1', null, { timeout: 60000 });
+  await page.setInputFiles('#file-gt', join(dataset, 'ground_truth.glb'));
+  await page.waitForFunction(() => /triangles/.test(document.getElementById('info-gt').textContent));
+  await page.setInputFiles('#file-cams', join(dataset, 'cameras.json'));
+  await page.waitForFunction(() => /images/.test(document.getElementById('info-cams').textContent));
+
+  // 1. the runs folder through the folder input: one row per run.json
+  await page.setInputFiles('#dir-runs', runs);
+  const info = await page.textContent('#info-runs');
+  const pipelines = readdirSync(join(runs, 'statue')).sort();
+  check('compare-recognises-runs', info.includes(`${pipelines.length} reconstructions (${pipelines.length} runner runs)`), info);
+  check('compare-ready', await page.isEnabled('#compare'), 'Compare button disabled');
+  const t0 = Date.now();
+  await page.click('#compare');
+  await page.waitForFunction(() => document.body.dataset.compared || document.getElementById('error').textContent, null, { timeout: 300000 });
+  const err = await page.textContent('#error');
+  if (err) throw new Error(`page error: ${err}`);
+  console.log(`note: compared ${pipelines.length} runs in ${((Date.now() - t0) / 1000).toFixed(1)} s`);
+  let rows = await tableRows();
+  check('compare-table-rows', rows.length === pipelines.length && rows.map((r) => r.pipeline).join() === pipelines.join(), JSON.stringify(rows.map((r) => r.pipeline)));
+
+  // 2. exports: the runner's files, byte for byte
+  for (const [sel, file] of [['#cmp-dl-table-md', 'table.md'], ['#cmp-dl-table1-md', 'table1.md'], ['#cmp-dl-table1-csv', 'table1.csv'], ['#cmp-dl-runs-csv', 'runs.csv']]) {
+    const got = await downloadText(sel);
+    const want = readFileSync(join(table, file), 'utf8');
+    check(`compare-export-${file}-equals-runner`, got === want, firstDiff(got, want));
+  }
+  const summary = await page.evaluate(() => window.sfmeval.compare.tables.summary_json);
+  check('compare-summary-json-equals-runner', summary === readFileSync(join(table, 'summary.json'), 'utf8'), firstDiff(summary, readFileSync(join(table, 'summary.json'), 'utf8')));
+
+  // 3. every report: the runner's reports/<dataset>/<pipeline>.json, and `sfmeval eval` on the
+  //    same model folder with the same flags (only the reconstruction's name differs: the CLI
+  //    names it by the folder, the runner and the page "<dataset>/<pipeline>")
+  const reports = await page.evaluate(() => window.sfmeval.compare.entries.map((e) => [e.row.pipeline, e.reportJson]));
+  for (const [p, json] of reports.filter(([, j]) => j)) {
+    const runner = readFileSync(join(table, 'reports', 'statue', `${p}.json`), 'utf8');
+    check(`compare-report-${p}-equals-runner`, json === runner, firstDiff(json, runner));
+    const file = join(out, `compare-cli-${p}.json`);
+    execFileSync(cli, ['eval', '--dataset', dataset, '--recon', join(runs, 'statue', p, 'model'), '--quiet', '--report', file]);
+    const cliRaw = readFileSync(file, 'utf8');
+    const named = '"reconstruction": {\n      "name": "model",';
+    // (the name also starts the reader's notes: "model: removed 36 point(s) ...")
+    const cliText = cliRaw.replace(named, `"reconstruction": {\n      "name": "statue/${p}",`).replaceAll('"model: ', `"statue/${p}: `);
+    check(`compare-report-${p}-cli-names-the-folder`, cliText !== cliRaw, cliRaw.slice(0, 200));
+    check(`compare-report-${p}-equals-cli`, json === cliText, firstDiff(json, cliText));
+  }
+
+  // 4. best marks: lowest mean, highest F, most registered images
+  rows = await tableRows();
+  const bestOf = (k, pick) => {
+    const vals = rows.map((r) => r.cells[k].v).filter((v) => v != null);
+    const b = pick(...vals);
+    return rows.every((r) => r.cells[k].best === (r.cells[k].v === b)) && rows.some((r) => r.cells[k].best);
+  };
+  check('compare-best-mean-is-lowest', bestOf('mean', Math.min), JSON.stringify(rows.map((r) => r.cells.mean)));
+  check('compare-best-f-is-highest', bestOf('f0', Math.max) && bestOf('f2', Math.max), JSON.stringify(rows.map((r) => r.cells.f0)));
+  check('compare-best-registered', bestOf('registered', Math.max), JSON.stringify(rows.map((r) => r.cells.registered)));
+  const headers = await page.$$eval('#cmp-table thead th', (ths) => ths.map((t) => t.dataset.k));
+  const want = ['pipeline', 'registered', 'points', 'min', 'max', 'mean', 'median', 'std', 'completeness', 'f0', 'f1', 'f2', 'ate', 'status'];
+  check('compare-columns', headers.join() === want.join(), headers.join());
+
+  // 5. sorting: mean ascending, then descending
+  await page.click('#cmp-table button.sort[data-k="mean"]');
+  // (a run that failed has no mean: last either way)
+  let means = (await tableRows()).map((r) => r.cells.mean.v).filter((v) => v != null);
+  check('compare-sort-ascending', means.every((v, i) => i === 0 || means[i - 1] <= v), means.join());
+  await page.click('#cmp-table button.sort[data-k="mean"]');
+  means = (await tableRows()).map((r) => r.cells.mean.v).filter((v) => v != null);
+  check('compare-sort-descending', means.every((v, i) => i === 0 || means[i - 1] >= v) && means[0] > means[means.length - 1], means.join());
+
+  // 6. the curves: precision, recall and F of every reconstruction on one plot
+  const okRuns = pipelines.filter((p) => JSON.parse(readFileSync(join(runs, 'statue', p, 'run.json'), 'utf8')).status === 'ok');
+  check('compare-has-a-failed-run', okRuns.length >= 2 && okRuns.length < pipelines.length, okRuns.join());
+  const failedRow = rows.find((r) => !okRuns.includes(r.pipeline));
+  check('compare-failed-run-row', failedRow && failedRow.cells.status.text === 'failed' && failedRow.cells.mean.v == null, JSON.stringify(failedRow));
+  const series = Number(await page.getAttribute('#cmp-curves', 'data-series'));
+  check('compare-curves-overlaid', series === 3 * okRuns.length, `${series} series for ${okRuns.length} evaluated runs`);
+
+  // 7. the viewer: the model with cameras in view A: one frustum per registered image, GT ones
+  //    too, coloured by centre error (the largest error at the yellow end, the smallest darker)
+  const withCams = rows.find((r) => r.cells.ate.v != null);
+  const idx = await page.evaluate((p) => window.sfmeval.compare.entries.findIndex((e) => e.row.pipeline === p), withCams.pipeline);
+  await page.selectOption('#cmp-view-a', String(idx));
+  const cams = await page.evaluate(() => window.sfmevalViewer.cameraCounts());
+  const entry = await page.evaluate((i) => { const e = window.sfmeval.compare.entries[i]; return { registered: e.row.images_registered, gt: e.report.cameras.ground_truth, errors: e.report.cameras.images.map((m) => [m.estimated_name, m.center_error]), p95: e.report.cameras.center_error.percentiles.p95, names: e.cameras.estErrors ? Array.from(e.cameras.estErrors) : [] }; }, idx);
+  check('frusta-estimated-count', cams.estCams && cams.estCams.count === entry.registered && entry.registered > 0, JSON.stringify({ cams: cams.estCams && cams.estCams.count, entry: entry.registered }));
+  check('frusta-gt-count', cams.gtCams && cams.gtCams.count === entry.gt, JSON.stringify(cams.gtCams && cams.gtCams.count));
+  if (cams.estCams && cams.estCams.colors) {
+    const col = cams.estCams.colors;
+    const errs = entry.names; // per drawn camera, its centre error
+    const lum = (i) => 0.3 * col[3 * i] + 0.59 * col[3 * i + 1] + 0.11 * col[3 * i + 2];
+    const order = errs.map((e, i) => [e, i]).sort((a, b) => a[0] - b[0]);
+    const lo = order[0][1], hi = order[order.length - 1][1];
+    // viridis brightens with the value: the colours sort as the errors do
+    const monotone = order.every(([, i], k) => k === 0 || lum(order[k - 1][1]) <= lum(i) + 1e-9);
+    check('frusta-colour-follows-centre-error', monotone && lum(hi) > lum(lo) + 50 && errs.every(Number.isFinite),
+      JSON.stringify({ lo: [errs[lo], col.slice(3 * lo, 3 * lo + 3)], hi: [errs[hi], col.slice(3 * hi, 3 * hi + 3)] }));
+  } else check('frusta-colour-follows-centre-error', false, 'no colours');
+  await page.uncheck('#show-est-cams');
+  const hidden = await page.evaluate(() => window.sfmevalViewer.cameraCounts());
+  check('frusta-toggle', hidden.estCams.visible === false && hidden.gtCams.visible === true, JSON.stringify(hidden));
+  await page.check('#show-est-cams');
+  await page.waitForTimeout(300);
+  await page.locator('#viewer').screenshot({ path: join(out, 'compare-frusta.png') });
+
+  // 8. side by side: a second viewer with another reconstruction, same viewpoint
+  const other = await page.evaluate((i) => window.sfmeval.compare.entries.findIndex((e, k) => k !== i && e.pointsInGt), idx);
+  await page.selectOption('#cmp-view-b', String(other));
+  await page.waitForTimeout(500);
+  const side = await page.evaluate(() => {
+    const a = document.getElementById('view3d').getBoundingClientRect();
+    const bEl = document.getElementById('view3d-b');
+    if (!bEl) return null;
+    const b = bEl.getBoundingClientRect();
+    const v2 = window.sfmevalViewer2;
+    return { a: [a.left, a.width, a.height], b: [b.left, b.width, b.height], points: v2.points ? v2.points.geometry.attributes.position.count : 0,
+      same: v2.camera.position.distanceTo(window.sfmevalViewer.camera.position) < 1e-9 };
+  });
+  const otherPoints = await page.evaluate((i) => window.sfmeval.compare.entries[i].pointsInGt.length / 3, other);
+  check('side-by-side-viewers', side && side.b[0] >= side.a[0] + side.a[1] - 2 && side.b[1] > 200 && side.points === otherPoints && side.same, JSON.stringify({ side, otherPoints }));
+  // the second canvas draws something
+  const shot = await page.locator('#view3d-b').screenshot({ path: join(out, 'compare-side-b.png') });
+  check('side-by-side-draws', shot.length > 5000, `${shot.length} bytes`);
+  await page.screenshot({ path: join(out, 'compare.png') });
+  await page.selectOption('#cmp-view-b', '');
+  const single = await page.evaluate(() => document.getElementById('viewer2').hidden);
+  check('side-by-side-off', single === true, String(single));
+
+  // 9. loose files: one row each, named by the file; reports equal `sfmeval eval` on that file
+  const root = resolve(new URL('../..', import.meta.url).pathname);
+  const loose = [join(root, 'tests/fixtures/global/pycolmap_points3D.ply'), join(root, 'data/demo/sparse.ply')];
+  const broken = join(out, 'broken.ply');
+  writeFileSync(broken, 'ply\nformat ascii 1.0\nelement vertex 2\nproperty float x\nend_header\n1\n');
+  await page.setInputFiles('#file-runs', [...loose, broken]);
+  const before = Number(await page.evaluate(() => document.body.dataset.compared));
+  await page.click('#compare');
+  await page.waitForFunction((n) => Number(document.body.dataset.compared) > n, before, { timeout: 300000 });
+  const looseRows = (await tableRows()).map((r) => r.pipeline).sort();
+  check('compare-loose-files-rows', looseRows.join() === 'broken.ply,pycolmap_points3D.ply,sparse.ply', looseRows.join());
+  // a file that cannot be read: its row says so, the others are evaluated, the banner names it
+  const brokenRow = (await tableRows()).find((r) => r.pipeline === 'broken.ply');
+  const banner = await page.textContent('#error');
+  check('compare-unreadable-file-row', brokenRow && brokenRow.cells.status.text === 'evaluation failed' && /broken\.ply/.test(banner) && /1 of 3 could not be evaluated/.test(banner),
+    JSON.stringify({ status: brokenRow && brokenRow.cells.status.text, banner }));
+  await page.click('#banner-close');
+  const looseReports = await page.evaluate(() => window.sfmeval.compare.entries.map((e) => [e.row.pipeline, e.reportJson]));
+  for (const [name, json] of looseReports.filter(([, j]) => j)) {
+    const file = join(out, `compare-cli-${name}.json`);
+    execFileSync(cli, ['eval', '--gt', join(dataset, 'ground_truth.glb'), '--gt-cameras', join(dataset, 'cameras.json'), '--recon', loose.find((f) => f.endsWith(`/${name}`)), '--quiet', '--report', file]);
+    const want = readFileSync(file, 'utf8');
+    check(`compare-loose-report-${name}-equals-cli`, json === want, firstDiff(json, want));
+  }
+
+  // 10. the runs folder dropped on the drop zone: the page walks the folder entries. Playwright
+  //     cannot drop a real folder, so the drop event carries entries (the FileSystemEntry
+  //     interface: isFile/isDirectory, file(), createReader().readEntries()) over the files the
+  //     folder input picked; the page's own walk, grouping and evaluation do the rest.
+  await page.setInputFiles('#dir-runs', runs);
+  await page.setInputFiles('#file-runs', loose);
+  await page.evaluate(() => {
+    const picked = [...document.getElementById('dir-runs').files];
+    const root = { name: picked[0].webkitRelativePath.split('/')[0], dirs: new Map(), files: [] };
+    for (const f of picked) {
+      let node = root;
+      for (const p of f.webkitRelativePath.split('/').slice(1, -1)) {
+        if (!node.dirs.has(p)) node.dirs.set(p, { name: p, dirs: new Map(), files: [] });
+        node = node.dirs.get(p);
+      }
+      node.files.push(f);
+    }
+    const fileEntry = (f) => ({ isFile: true, isDirectory: false, name: f.name, file: (res) => res(f) });
+    const dirEntry = (n) => ({
+      isFile: false, isDirectory: true, name: n.name,
+      createReader() {
+        let given = false;
+        return { readEntries(res) { res(given ? [] : [...[...n.dirs.values()].map(dirEntry), ...n.files.map(fileEntry)]); given = true; } };
+      },
+    });
+    const ev = new Event('drop', { bubbles: true, cancelable: true });
+    Object.defineProperty(ev, 'dataTransfer', { value: { items: [{ webkitGetAsEntry: () => dirEntry(root) }], files: [] } });
+    document.getElementById('drop-runs').dispatchEvent(ev);
+  });
+  await page.waitForFunction((n) => document.getElementById('info-runs').textContent.startsWith(`${n} reconstructions (${n} runner runs)`), pipelines.length, { timeout: 10000 })
+    .then(() => check('compare-drop-folder-recognised', true), async () => check('compare-drop-folder-recognised', false, await page.textContent('#info-runs')));
+  const beforeDrop = Number(await page.evaluate(() => document.body.dataset.compared));
+  await page.click('#compare');
+  await page.waitForFunction((n) => Number(document.body.dataset.compared) > n || document.getElementById('error').textContent, beforeDrop, { timeout: 300000 });
+  const droppedMd = await downloadText('#cmp-dl-table-md');
+  check('compare-drop-folder-table-equals-runner', droppedMd === readFileSync(join(table, 'table.md'), 'utf8'), firstDiff(droppedMd, readFileSync(join(table, 'table.md'), 'utf8')));
+
+  check('compare-no-request-leaves-origin', requests.every((u) => u.startsWith(origin) || u.startsWith('blob:') || u.startsWith('data:')), requests.filter((u) => !u.startsWith(origin)).join(' '));
+  check('compare-no-console-errors', consoleErrors.length === 0, consoleErrors.join(' | '));
+} catch (e) {
+  check('compare-run', false, e.stack || String(e));
+} finally {
+  await browser.close();
+}
+process.exit(failed ? 1 : 0);

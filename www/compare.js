@@ -1,0 +1,399 @@
+// Compare: several reconstructions against the one loaded ground truth (indexed once in the
+// worker). A runner `runs/` folder (`<dataset>/<pipeline>/run.json` or `<pipeline>/run.json`)
+// becomes one row per run, evaluated as `sfmeval-runner report` evaluates it (`auto` alignment,
+// the Measure section's τ, samples and seed); loose files and model folders become one row
+// each. The table, its exports (the runner's own table text, from the same Rust code), the
+// overlaid P/R/F curves and the viewers' choice of reconstruction live here.
+import uPlot from 'uplot';
+import { Viewer } from './viewer.js';
+
+const $ = (id) => document.getElementById(id);
+const esc = (s) => String(s).replace(/[&<>"]/g, (c) => ({ '&': '&amp;', '<': '&lt;', '>': '&gt;', '"': '&quot;' }[c]));
+
+/** Files the runner evaluates in a run folder: `model/` (else `sparse.ply`). */
+const MODEL_EXT = /\.(bin|txt|nvm|out|json|ply)$/i;
+
+/**
+ * Groups picked or dropped files (with `webkitRelativePath`-like names) into the items to
+ * compare: `{name, dataset, runJson (File|null), files: {relName: File}}`. A folder holding
+ * `run.json` files is a runs folder: each run folder is one item named by its pipeline, with
+ * its `model/` files (or `sparse.ply`); otherwise each top-level model folder is one item, and
+ * each loose file (no folder) is one item named by the file.
+ */
+export function groupItems(fileList) {
+  const files = Array.from(fileList).map((f) => ({ f, path: (f.webkitRelativePath || f.name).replace(/^\/+/, '') }));
+  const runs = files.filter((x) => x.path.split('/').pop() === 'run.json' && x.path.includes('/'));
+  const items = [];
+  if (runs.length) {
+    for (const r of runs) {
+      const dir = r.path.slice(0, -'run.json'.length); // ends with '/'
+      const inRun = files.filter((x) => x.path.startsWith(dir) && x.path !== r.path);
+      const model = {};
+      for (const x of inRun) {
+        const rel = x.path.slice(dir.length);
+        if (rel.startsWith('model/') && MODEL_EXT.test(rel)) model[rel.slice('model/'.length)] = x.f;
+      }
+      if (!Object.keys(model).length) {
+        const ply = inRun.find((x) => x.path.slice(dir.length) === 'sparse.ply');
+        if (ply) model['sparse.ply'] = ply.f;
+      }
+      const parts = dir.split('/').filter(Boolean);
+      items.push({ pipeline: parts[parts.length - 1], runJson: r.f, files: model, path: dir });
+    }
+  } else {
+    const byFolder = new Map();
+    for (const x of files) {
+      const parts = x.path.split('/');
+      if (parts.length === 1) { items.push({ pipeline: x.f.name, runJson: null, files: { [x.f.name]: x.f }, path: x.path }); continue; }
+      // a picked folder: its sub-folders are the models (or the folder itself is one model)
+      const key = parts.length > 2 ? parts.slice(0, 2).join('/') : parts[0];
+      if (!byFolder.has(key)) byFolder.set(key, {});
+      byFolder.get(key)[parts.slice(key.split('/').length).join('/')] = x.f;
+    }
+    for (const [key, map] of byFolder) {
+      const m = Object.fromEntries(Object.entries(map).filter(([n]) => MODEL_EXT.test(n)));
+      if (Object.keys(m).length) items.push({ pipeline: key.split('/').pop(), runJson: null, files: m, path: `${key}/` });
+    }
+  }
+  items.sort((a, b) => (a.path < b.path ? -1 : a.path > b.path ? 1 : 0));
+  return items;
+}
+
+/** The comparison table's columns: key, header, value of an entry, and which end is best. */
+function columns(entries) {
+  const nt = Math.max(0, ...entries.map((e) => (e.report ? e.report.thresholds.length : 0)));
+  const first = entries.find((e) => e.report);
+  const acc = (k) => (e) => (e.report ? e.report.accuracy[k] : null);
+  const cols = [
+    { key: 'pipeline', head: 'pipeline', val: (e) => e.row.pipeline, text: true },
+    { key: 'registered', head: 'registered / total', val: (e) => e.row.images_registered, show: (e) => `${e.row.images_registered}/${e.row.images_total}`, best: 'max' },
+    { key: 'points', head: 'points', val: (e) => (e.report ? e.row.points : null), best: 'max' },
+    { key: 'min', head: 'min', val: acc('min'), best: 'min' },
+    { key: 'max', head: 'max', val: acc('max'), best: 'min' },
+    { key: 'mean', head: 'mean', val: acc('mean'), best: 'min' },
+    { key: 'median', head: 'median', val: acc('median'), best: 'min' },
+    { key: 'std', head: 'std', val: acc('std'), best: 'min' },
+    { key: 'completeness', head: 'completeness (mean)', val: (e) => e.row.completeness_mean, best: 'min' },
+  ];
+  for (let k = 0; k < nt; k++) {
+    const pct = first ? Number(first.report.thresholds[k].tau_percent_of_diagonal.toFixed(6)) : k;
+    cols.push({ key: `f${k}`, head: `F@${pct}%`, val: (e) => (e.report && e.report.thresholds[k] ? e.report.thresholds[k].f_score : null), best: 'max' });
+  }
+  cols.push({ key: 'ate', head: 'pose ATE', val: (e) => (e.report && e.report.cameras ? e.report.cameras.ate_rmse : null), best: 'min' });
+  cols.push({ key: 'status', head: 'status', val: (e) => e.row.status, text: true });
+  return cols;
+}
+
+const fmt = (v) => {
+  if (v == null || Number.isNaN(v)) return '—';
+  if (Number.isInteger(v)) return String(v);
+  const a = Math.abs(v);
+  return a !== 0 && (a < 1e-3 || a >= 1e5) ? v.toExponential(3) : v.toPrecision(4);
+};
+
+/** Draws the P/R/F curves of every entry over one τ axis; returns the uPlot. */
+function curves(el, entries) {
+  const ok = entries.filter((e) => e.kept);
+  el.innerHTML = '';
+  if (!ok.length) return null;
+  const tauMax = Math.max(...ok.map((e) => Math.max(...e.report.thresholds.map((t) => t.tau)))) * 1.5 || 1;
+  const n = 200;
+  const xs = [];
+  const below = (s, tau, total) => {
+    let lo = 0, hi = s.length;
+    while (lo < hi) { const m = (lo + hi) >> 1; if (s[m] < tau) lo = m + 1; else hi = m; }
+    return total ? lo / total : 0;
+  };
+  for (let i = 0; i <= n; i++) xs.push((tauMax * i) / n);
+  const data = [xs];
+  const series = [{ label: 'τ' }];
+  ok.forEach((e, j) => {
+    const hue = Math.round((360 * j) / ok.length);
+    const p = xs.map((t) => below(e.kept, t, e.kept.length));
+    const r = xs.map((t) => below(e.comp, t, e.comp.length));
+    const f = p.map((pv, i) => (pv + r[i] > 0 ? (2 * pv * r[i]) / (pv + r[i]) : 0));
+    data.push(p, r, f);
+    series.push({ label: `${e.row.pipeline} P`, stroke: `hsl(${hue},70%,60%)`, width: 1, dash: [6, 4] },
+      { label: `${e.row.pipeline} R`, stroke: `hsl(${hue},70%,60%)`, width: 1, dash: [2, 3] },
+      { label: `${e.row.pipeline} F`, stroke: `hsl(${hue},70%,60%)`, width: 2 });
+  });
+  const plot = new uPlot({
+    width: Math.max(300, el.clientWidth || 500), height: 220, legend: { live: false },
+    scales: { x: { time: false }, y: { range: [0, 1] } }, axes: [{ label: 'τ' }, {}], series,
+  }, data, el);
+  el.dataset.series = String(series.length - 1);
+  return plot;
+}
+
+/**
+ * Sets up the compare section. `call` talks to the worker, `viewer` is the page's viewer,
+ * `options()` the Measure section's options, `showError(msg, target)` the banner and
+ * `download(name, data, type)` saves a file.
+ */
+export function setupCompare({ call, viewer, measureOptions, showError, download, gtName, onProgress }) {
+  const state = { items: [], entries: [], sort: null, tables: null, viewer2: null };
+  const info = $('info-runs');
+  const setItems = (items) => {
+    state.items = items;
+    const runs = items.filter((i) => i.runJson).length;
+    info.textContent = items.length
+      ? `${items.length} reconstruction${items.length === 1 ? '' : 's'}${runs ? ` (${runs} runner run${runs === 1 ? '' : 's'})` : ''}: ${items.map((i) => i.pipeline).join(', ')}`
+      : '—';
+    info.classList.toggle('error', false);
+    $('compare').disabled = !items.length;
+  };
+  const fail = (msg) => {
+    info.textContent = msg;
+    info.classList.add('error');
+    showError(msg, 'file-runs');
+  };
+  const take = (files) => {
+    const items = groupItems(files);
+    if (!items.length) fail('compare: no reconstruction found (a runs folder needs <pipeline>/run.json; a model folder its model files)');
+    else setItems(items);
+  };
+  $('file-runs').addEventListener('change', (e) => take(e.target.files));
+  $('dir-runs').addEventListener('change', (e) => take(e.target.files));
+  const zone = $('drop-runs');
+  zone.addEventListener('dragover', (e) => { e.preventDefault(); zone.classList.add('over'); });
+  zone.addEventListener('dragleave', () => zone.classList.remove('over'));
+  zone.addEventListener('drop', async (e) => {
+    e.preventDefault();
+    zone.classList.remove('over');
+    const entries = Array.from(e.dataTransfer.items || []).map((i) => i.webkitGetAsEntry && i.webkitGetAsEntry()).filter(Boolean);
+    try {
+      const files = [];
+      for (const en of entries) files.push(...(await entryFiles(en, '')));
+      take(files.length ? files : e.dataTransfer.files);
+    } catch (err) { fail(`compare: ${err.message}`); }
+  });
+
+  async function run() {
+    if (!state.items.length) return;
+    const name = gtName();
+    if (!name) { fail('compare: load the ground truth first (section 1)'); return; }
+    $('compare').disabled = true;
+    showError('');
+    const entries = [];
+    const problems = [];
+    const base = measureOptions();
+    const options = { tau: base.tau, tau_percent_of_diagonal: base.tau_percent_of_diagonal, samples: base.samples, seed: base.seed, align: 'auto' };
+    try {
+      for (const [k, it] of state.items.entries()) {
+        $('compare-status').textContent = `evaluating ${k + 1}/${state.items.length}: ${it.pipeline}…`;
+        const runText = it.runJson ? await it.runJson.text() : null;
+        let run = null;
+        if (runText) {
+          try { run = JSON.parse(runText); } catch (err) { throw new Error(`${it.path}run.json: ${err.message}`); }
+        }
+        if (run && run.status !== 'ok') {
+          const { row } = await call('runRowOnly', { runJson: runText });
+          entries.push({ row, report: null, path: it.path });
+          continue;
+        }
+        const files = {};
+        const transfer = [];
+        for (const [n, f] of Object.entries(it.files)) { const b = await f.arrayBuffer(); files[n] = b; transfer.push(b); }
+        const recName = run ? `${run.dataset}/${run.pipeline}` : it.pipeline;
+        try {
+          if (!transfer.length) throw new Error('no model files (model/ or sparse.ply)');
+          const r = await call('compareRun', { files, name: recName, runJson: runText, dataset: name, options }, transfer);
+          entries.push({ ...r, report: JSON.parse(r.reportJson), path: it.path });
+        } catch (err) {
+          // as the runner: the run stays in the table, "evaluation failed" with the reason
+          problems.push(`${it.path}: ${err.message}`);
+          const record = runText ?? JSON.stringify({
+            dataset: name, pipeline: it.pipeline, tool: 'file', version: null, status: 'failed', reason: null,
+            wall_seconds: 0, cpu_seconds: 0, peak_memory_bytes: 0, images_total: 0, images_registered: 0, points: 0,
+          });
+          const { row } = await call('runRowOnly', { runJson: record });
+          entries.push({ row: { ...row, status: 'evaluation failed', reason: err.message }, report: null, path: it.path });
+        }
+      }
+      state.entries = entries;
+      const { tables } = await call('comparisonTables', { rows: entries.map((e) => e.row) });
+      state.tables = tables;
+      render();
+      $('compare-status').textContent = `compared ${entries.length} reconstruction${entries.length === 1 ? '' : 's'}${problems.length ? ` (${problems.length} could not be evaluated)` : ''}`;
+      if (problems.length) {
+        showError(`compare: ${problems.length} of ${entries.length} could not be evaluated (marked "evaluation failed" in the table): ${problems.join('; ')}`, 'file-runs');
+      }
+      document.body.dataset.compared = String(Number(document.body.dataset.compared || 0) + 1);
+    } catch (err) {
+      fail(`compare failed: ${err.message}`);
+      $('compare-status').textContent = '✗ compare failed: see the message at the top';
+    } finally {
+      $('compare').disabled = !state.items.length;
+      if (onProgress) onProgress(null);
+    }
+  }
+  $('compare').onclick = run;
+
+  function render() {
+    $('compare-results').hidden = false;
+    const cols = columns(state.entries);
+    let order = state.entries.map((_, i) => i);
+    if (state.sort) {
+      const c = cols.find((x) => x.key === state.sort.key);
+      if (c) {
+        const v = (i) => c.val(state.entries[i]);
+        order.sort((a, b) => {
+          const x = v(a), y = v(b);
+          if (x == null && y == null) return a - b;
+          if (x == null) return 1;
+          if (y == null) return -1;
+          const d = c.text ? String(x).localeCompare(String(y)) : x - y;
+          return (state.sort.dir === 'asc' ? d : -d) || a - b;
+        });
+      }
+    }
+    const best = {};
+    for (const c of cols) {
+      if (!c.best) continue;
+      const vals = state.entries.map((e) => c.val(e)).filter((v) => v != null && Number.isFinite(v));
+      if (vals.length > 1) best[c.key] = c.best === 'min' ? Math.min(...vals) : Math.max(...vals);
+    }
+    let h = '<table id="cmp-table"><thead><tr>';
+    for (const c of cols) {
+      const s = state.sort && state.sort.key === c.key ? state.sort.dir : null;
+      h += `<th data-k="${c.key}" aria-sort="${s === 'asc' ? 'ascending' : s === 'desc' ? 'descending' : 'none'}"><button class="sort small" data-k="${c.key}" title="sort by ${esc(c.head)}${c.best ? ` (best: ${c.best === 'min' ? 'lowest' : 'highest'})` : ''}">${esc(c.head)}${s === 'asc' ? ' ▲' : s === 'desc' ? ' ▼' : ''}</button></th>`;
+    }
+    h += '</tr></thead><tbody>';
+    for (const i of order) {
+      const e = state.entries[i];
+      h += `<tr data-i="${i}" data-pipeline="${esc(e.row.pipeline)}">`;
+      for (const c of cols) {
+        const v = c.val(e);
+        const isBest = c.key in best && v === best[c.key];
+        const text = c.show ? c.show(e) : c.text ? v : fmt(v);
+        h += `<td data-k="${c.key}"${c.text ? ' class="text"' : ''}${isBest ? ' data-best="1" class="best" title="best of this column"' : ''}${v != null && !c.text ? ` data-v="${v}"` : ''}>${esc(text)}${isBest ? ' ★' : ''}</td>`;
+      }
+      h += '</tr>';
+    }
+    h += '</tbody></table>';
+    $('cmp-table-wrap').innerHTML = h;
+    for (const b of document.querySelectorAll('#cmp-table button.sort')) {
+      b.onclick = () => {
+        const k = b.dataset.k;
+        state.sort = state.sort && state.sort.key === k ? { key: k, dir: state.sort.dir === 'asc' ? 'desc' : 'asc' } : { key: k, dir: 'asc' };
+        render();
+        const again = document.querySelector(`#cmp-table button.sort[data-k="${k}"]`);
+        if (again) again.focus();
+      };
+    }
+    curves($('cmp-curves'), state.entries);
+    // viewer choices
+    for (const id of ['cmp-view-a', 'cmp-view-b']) {
+      const sel = $(id);
+      const keep = sel.value;
+      sel.innerHTML = (id === 'cmp-view-b' ? '<option value="">—</option>' : '')
+        + state.entries.map((e, i) => (e.pointsInGt ? `<option value="${i}">${esc(e.row.pipeline)}</option>` : '')).join('');
+      if ([...sel.options].some((o) => o.value === keep)) sel.value = keep;
+    }
+    showIn(viewer, $('cmp-view-a').value);
+    updateSide();
+  }
+
+  function showIn(v, value) {
+    const e = state.entries[Number(value)];
+    if (value === '' || !e || !e.pointsInGt) return;
+    v.setPoints(e.pointsInGt, $('heat') && $('heat').checked ? e.colors : null);
+    drawCameras(v, e.cameras);
+    // the first time cameras are shown here, frame them (they stand well outside the object)
+    if (e.cameras && e.cameras.gtPoses && !v.framedCameras) { v.fitCameras(); v.framedCameras = true; }
+  }
+  function updateSide() {
+    const b = $('cmp-view-b').value;
+    const center = $('viewer');
+    if (b === '') {
+      center.classList.remove('split');
+      if (state.viewer2) state.viewer2.container.hidden = true;
+      return;
+    }
+    center.classList.add('split');
+    if (!state.viewer2) {
+      const box = document.createElement('div');
+      box.id = 'viewer2';
+      center.appendChild(box);
+      state.viewer2 = new Viewer(box);
+      state.viewer2.renderer.domElement.id = 'view3d-b';
+      // the two views look from the same place
+      const sync = (from, to) => from.orbit.addEventListener('change', () => {
+        if (sync.busy) return;
+        sync.busy = true;
+        to.camera.position.copy(from.camera.position);
+        to.orbit.target.copy(from.orbit.target);
+        to.orbit.update();
+        sync.busy = false;
+      });
+      sync(viewer, state.viewer2);
+      sync(state.viewer2, viewer);
+      window.sfmevalViewer2 = state.viewer2;
+    }
+    state.viewer2.container.hidden = false;
+    const gtv = viewer.gtMesh;
+    if (gtv && state.viewer2.gtSource !== gtv) {
+      state.viewer2.setGroundTruth(gtv.geometry.attributes.position.array, gtv.geometry.index ? gtv.geometry.index.array : new Uint32Array(0), gtBounds(viewer));
+      state.viewer2.gtSource = gtv;
+    }
+    state.viewer2.resize();
+    viewer.resize();
+    showIn(state.viewer2, b);
+    state.viewer2.camera.position.copy(viewer.camera.position);
+    state.viewer2.orbit.target.copy(viewer.orbit.target);
+    state.viewer2.orbit.update();
+  }
+  $('cmp-view-a').addEventListener('change', () => showIn(viewer, $('cmp-view-a').value));
+  $('cmp-view-b').addEventListener('change', updateSide);
+
+  for (const [id, key, name, type] of [
+    ['cmp-dl-table-md', 'table_md', 'table.md', 'text/markdown'],
+    ['cmp-dl-table1-md', 'table1_md', 'table1.md', 'text/markdown'],
+    ['cmp-dl-table1-csv', 'table1_csv', 'table1.csv', 'text/csv'],
+    ['cmp-dl-runs-csv', 'runs_csv', 'runs.csv', 'text/csv'],
+  ]) {
+    $(id).onclick = () => { if (state.tables) download(name, state.tables[key], type); };
+  }
+  $('cmp-dl-reports').onclick = () => {
+    // one report per evaluated run, named as the runner's reports/<dataset>/<pipeline>.json
+    for (const e of state.entries) if (e.reportJson) download(`${e.row.dataset}.${e.row.pipeline}.report.json`, e.reportJson, 'application/json');
+  };
+  return state;
+}
+
+/** The ground truth's bounds as `setGroundTruth` wants them, from the viewer's offset/diag. */
+function gtBounds(v) {
+  const g = v.gtMesh.geometry;
+  g.computeBoundingBox();
+  const b = g.boundingBox;
+  return [b.min.x, b.min.y, b.min.z, b.max.x, b.max.y, b.max.z];
+}
+
+/** The ground-truth (white) and estimated (coloured by centre error) frusta of an evaluation. */
+export function drawCameras(v, cams) {
+  if (!cams) { v.setCameras('gtCams', null); v.setCameras('estCams', null); return; }
+  v.setCameras('gtCams', cams.gtPoses, null, 0xe0e0e0);
+  v.setCameras('estCams', cams.estPoses, cams.estColors);
+  const gtBox = document.getElementById('show-gt-cams');
+  const estBox = document.getElementById('show-est-cams');
+  if (gtBox) v.setVisible('gtCams', gtBox.checked);
+  if (estBox) v.setVisible('estCams', estBox.checked);
+}
+
+/** The files under a dropped entry (file or folder), named by their path from the drop. */
+async function entryFiles(entry, prefix) {
+  if (entry.isFile) {
+    const f = await new Promise((res, rej) => entry.file(res, rej));
+    const out = new File([f], f.name);
+    Object.defineProperty(out, 'webkitRelativePath', { value: `${prefix}${f.name}` });
+    return [out];
+  }
+  const out = [];
+  const reader = entry.createReader();
+  for (;;) {
+    const batch = await new Promise((res, rej) => reader.readEntries(res, rej));
+    if (!batch.length) break;
+    for (const c of batch) out.push(...(await entryFiles(c, `${prefix}${entry.name}/`)));
+  }
+  return out;
+}
