@@ -66,13 +66,14 @@ def _collection(context, name):
 
 
 def gt_from_recon(obj):
-    """The object's alignment (float64 4×4): the exact one stored at the last alignment while the
-    object's (float32) matrix still holds it, else the matrix the user gave it."""
+    """The object's alignment (float64 4×4): the exact one stored at the last alignment while
+    the object's matrix still holds it (Blender keeps the matrix as float32 location, rotation
+    and scale: ~1e-7 off), else the matrix the user gave it by moving the object."""
     m = np.array(obj.matrix_basis, dtype=float)
     stored = obj.get(PROP_T)
     if stored is not None:
         s = np.array(list(stored), dtype=float).reshape(4, 4)
-        if np.array_equal(s.astype(np.float32), m.astype(np.float32)):
+        if np.allclose(s, m, rtol=1e-5, atol=1e-6 * max(1.0, np.abs(s[:3, 3]).max())):
             return s
     return m
 
@@ -174,7 +175,8 @@ def crop_file(context):
                              % (obj.name, obj.type))
         m = GLTF_FROM_BLENDER @ np.array(obj.matrix_world, dtype=float)
         volume = cropmod.volume_from_matrix(kind, m, lo, hi)
-    maxd = c.max_distance if c.use_max_distance else None
+    # the value as typed (the property is float32: 0.05 would be 0.05000000074505806)
+    maxd = float("%.7g" % c.max_distance) if c.use_max_distance else None
     if volume is None and maxd is None:
         if os.path.exists(path):
             os.remove(path)
