@@ -5,6 +5,7 @@ argv: ZIP DATASET MODE(run|premade) OUT_JSON SFMEVAL RUNNER"""
 
 import json
 import math
+import os
 import sys
 
 import bpy  # noqa: I001 (bpy first: it makes bmesh and mathutils importable)
@@ -85,6 +86,30 @@ res["cameras"] = {n: len([o for o in c.recons[n].object.children if o.type == "C
                   for n in ok}
 res["first_eval"] = call(bpy.ops.sfmeval.compare_evaluate)
 res["first_reports"] = {n: json.load(open(c.recons[n].report)) for n in ok}
+
+# 8b. Any file the CLI reads: the first run's COLMAP text model, imported as a file.
+c.import_path = os.path.join(ds, "runs", os.path.basename(ds), ok[0], "model")
+res["file_import"] = call(bpy.ops.sfmeval.compare_import_file)
+fitem = c.recons[ok[0] + "-model"]
+res["file_row"] = [fitem.status, fitem.message]
+if fitem.object:
+    res["file_co"] = [v.co[:] for v in fitem.object.data.vertices]
+    res["file_stored"] = list(fitem.object["sfmeval_gt_from_recon"])
+
+# 11b. The ground truth as a scene object: the dataset's GLB imported, then exported by the
+# add-on (no crop this time).
+before_objs = set(bpy.data.objects)
+if not hasattr(np, "bool"):  # Debian's Blender 3.4 glTF importer uses np.bool (numpy < 1.24)
+    np.bool = bool
+bpy.ops.import_scene.gltf(filepath=os.path.join(ds, "ground_truth.glb"))
+gt_obj = [o for o in bpy.data.objects if o not in before_objs and o.type == "MESH"][0]
+c.gt_source, c.gt_object = "OBJECT", gt_obj
+c.crop_object, c.use_max_distance = None, False
+res["gt_object_eval"] = call(bpy.ops.sfmeval.compare_evaluate)
+res["gt_object_reports"] = {n: json.load(open(c.recons[n].report)) for n in ok}
+c.gt_source = "DATASET"
+res["gt_dataset_eval"] = call(bpy.ops.sfmeval.compare_evaluate)
+res["gt_dataset_reports"] = {n: json.load(open(c.recons[n].report)) for n in ok}
 
 # 9a. Delete every 7th point of the first reconstruction in Edit Mode (bmesh, as a user would).
 first = ok[0]

@@ -253,6 +253,26 @@ def _check(res, ds, bins, tmp_path, ran):
         assert float(row[head.index("%s.mean_m" % p)]) == acc["mean"]
         assert md in res["table_text"]
     assert " bad |" in md and "failed: " in md
+    # a COLMAP model folder imported as a file: its points3D.txt in the reconstruction's frame
+    assert res["file_row"][0] == "imported", res["file_row"]
+    with open(os.path.join(base, "pycolmap", "model", "points3D.txt")) as f:
+        xyz = np.array([[float(v) for v in line.split()[1:4]] for line in f
+                        if line.strip() and not line.startswith("#")])
+    co = np.array(res["file_co"])
+    assert co.shape == xyz.shape
+    assert np.allclose(np.sort(co, axis=0), np.sort(xyz, axis=0), atol=1e-5)
+    # the ground truth as a scene object (exported to compare/gt_scene.glb): the same numbers
+    # as the dataset's GLB, without the crop
+    assert res["gt_object_eval"] == res["gt_dataset_eval"] == ["FINISHED"]
+    for p in REAL:
+        rep = res["gt_object_reports"][p]
+        assert rep["inputs"]["ground_truth"]["name"] == "gt_scene.glb"
+        assert rep["crop"]["kind"] == "none"
+        ref = res["gt_dataset_reports"][p]
+        assert ref["inputs"]["ground_truth"]["name"] == "ground_truth.glb"
+        assert rep["inputs"]["ground_truth"]["triangles"] == \
+            ref["inputs"]["ground_truth"]["triangles"]
+        assert rep["accuracy"]["mean"] == pytest.approx(ref["accuracy"]["mean"], rel=1e-5)
 
 
 @pytest.mark.parametrize("blender", ["bpy", "debian"])

@@ -88,6 +88,15 @@ def align(sfmeval, dataset, recon, work, mode="auto", start=None, recon_cameras=
         return json.load(f)
 
 
+def rotation_scale_change(a, b):
+    """(degrees, relative scale change) from similarity `a` to `b` (4×4)."""
+    a, b = np.asarray(a, float), np.asarray(b, float)
+    sa, sb = np.cbrt(np.linalg.det(a[:3, :3])), np.cbrt(np.linalg.det(b[:3, :3]))
+    r = (a[:3, :3] / sa).T @ (b[:3, :3] / sb)
+    c = min(1.0, max(-1.0, (np.trace(r) - 1) / 2))
+    return float(np.degrees(np.arccos(c))), float(sb / sa - 1)
+
+
 def eval_argv(sfmeval, dataset, points, transform, report, recon_cameras=None, crop=None,
               csv_out=None, gt=None):
     """The ``sfmeval eval`` command of the panel's numbers (also what a user types to get them)."""

@@ -298,6 +298,8 @@ class SFMEVAL_OT_compare_import_file(bpy.types.Operator):
             return _fail(self, context, str(exc))
         path = os.path.normpath(bpy.path.abspath(c.import_path))
         name = os.path.splitext(os.path.basename(path))[0] or "recon"
+        if os.path.isdir(path):  # run/model, sparse/0: the parent names it
+            name = "%s-%s" % (os.path.basename(os.path.dirname(path)), name)
         item = _row(context, name)
         item.source = path
         _import(context, sfmeval, item, path)
