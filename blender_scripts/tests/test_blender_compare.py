@@ -322,3 +322,34 @@ def test_table1_is_the_runners_format(bpy_result, bins, tmp_path):
     md, csv_text = ev.table1(name, ev.table_order(rows[::-1], [x["name"] for x in listed]))
     assert md.encode() == (table / "table1.md").read_bytes()
     assert csv_text.encode() == (table / "table1.csv").read_bytes()
+
+
+def test_cancel_ends_the_runner_and_its_tools(tiny, bins, tmp_path):
+    """The panel's Cancel (run.Job.cancel) ends sfmeval-runner and the tool it started in a
+    process group of its own (a custom pipeline sleeping 60 s), within seconds."""
+    import time
+    sys.path.insert(0, BLENDER_SCRIPTS)
+    from sfmeval_blender.compare import run as runmod
+    ds = _dataset_copy(tiny, tmp_path / "tiny")
+    argv = runmod.run_command(bins["runner"], ds, str(tmp_path / "runs"), "slow", 600, "exif")
+    job = runmod.Job(argv + ["--custom", "slow=sleep 61; echo {out}"])
+    sleeper = None
+    deadline = time.monotonic() + 20
+    while sleeper is None and time.monotonic() < deadline:
+        for pid in os.listdir("/proc"):
+            try:
+                with open("/proc/%s/cmdline" % pid, "rb") as f:
+                    if f.read().split(b"\0")[:2] == [b"sleep", b"61"]:
+                        sleeper = int(pid)
+            except OSError:
+                pass
+        time.sleep(0.1)
+    assert sleeper is not None, job.poll()
+    assert os.getpgid(sleeper) != job.proc.pid, "the tool should be in a group of its own"
+    t0 = time.monotonic()
+    job.cancel()
+    lines, rc = job.poll()
+    assert rc is not None and time.monotonic() - t0 < 10
+    time.sleep(0.2)
+    assert not os.path.exists("/proc/%d" % sleeper) or \
+        open("/proc/%d/stat" % sleeper).read().split(") ")[1].startswith("Z"), "sleep survived"
