@@ -82,6 +82,8 @@ res["rows"] = {r.name: [r.status, r.message] for r in c.recons}
 ok = [r.name for r in c.recons if r.object]
 res["ok"] = ok
 res["imported_vertices"] = {n: len(c.recons[n].object.data.vertices) for n in ok}
+res["display"] = {n: [c.recons[n].object.get("sfmeval_display"),
+                      [m.type for m in c.recons[n].object.modifiers]] for n in ok}
 res["cameras"] = {n: len([o for o in c.recons[n].object.children if o.type == "CAMERA"])
                   for n in ok}
 res["first_eval"] = call(bpy.ops.sfmeval.compare_evaluate)
@@ -149,6 +151,8 @@ P = np.eye(4)
 P[:3, :3] = 1.02 * (np.eye(3) + math.sin(a) * K + (1 - math.cos(a)) * K @ K)
 obj.matrix_basis = Matrix((P @ auto).tolist())
 res["start"] = (P @ auto).tolist()
+from sfmeval_blender.compare.blender import gt_from_recon  # noqa: E402
+res["start_seen"] = gt_from_recon(obj).tolist()  # what Refine starts from: the moved object
 res["align_refine"] = call(bpy.ops.sfmeval.compare_align, mode="icp")
 res["refined"] = np.array(list(obj["sfmeval_gt_from_recon"])).reshape(4, 4).tolist()
 

@@ -69,12 +69,15 @@ def _collection(context, name):
 def gt_from_recon(obj):
     """The object's alignment (float64 4×4): the exact one stored at the last alignment while
     the object's matrix still holds it (Blender keeps the matrix as float32 location, rotation
-    and scale: ~1e-7 off), else the matrix the user gave it by moving the object."""
+    and scale: ~1e-6 off; a move smaller than 0.001°, 1e-5 in scale and
+    translation is taken as no move), else the matrix the user gave it by moving the object."""
     m = np.array(obj.matrix_basis, dtype=float)
     stored = obj.get(PROP_T)
     if stored is not None:
         s = np.array(list(stored), dtype=float).reshape(4, 4)
-        if np.allclose(s, m, rtol=1e-5, atol=1e-6 * max(1.0, np.abs(s[:3, 3]).max())):
+        deg, dscale = ev.rotation_scale_change(s, m)
+        dt = np.linalg.norm(s[:3, 3] - m[:3, 3])
+        if deg < 1e-3 and abs(dscale) < 1e-5 and dt < 1e-5 * max(1.0, np.linalg.norm(s[:3, 3])):
             return s
     return m
 
@@ -103,9 +106,54 @@ def new_points_object(context, name, points, cameras_json=None):
     coll.objects.link(obj)
     obj.parent = gt_frame(context)
     obj.matrix_parent_inverse.identity()
+    if len(pts):
+        size = float(np.linalg.norm(pts.max(0) - pts.min(0)))
+        obj["sfmeval_display"] = show_as_points(obj, max(size, 1e-9) * 0.002)
     if cameras_json and os.path.isfile(cameras_json):
         add_cameras(coll, obj, cameras_json)
     return obj
+
+
+def _points_material():
+    """Material showing the ``sfmeval_color`` attribute (Material Preview / Rendered)."""
+    mat = bpy.data.materials.get("sfmeval points")
+    if mat is not None:
+        return mat
+    mat = bpy.data.materials.new("sfmeval points")
+    mat.use_nodes = True
+    nt = mat.node_tree
+    bsdf = next(n for n in nt.nodes if n.type == "BSDF_PRINCIPLED")
+    attr = nt.nodes.new("ShaderNodeAttribute")
+    attr.attribute_name = "sfmeval_color"
+    nt.links.new(attr.outputs["Color"], bsdf.inputs["Base Color"])
+    return mat
+
+
+def show_as_points(obj, radius):
+    """A geometry-nodes modifier drawing the loose vertices as points of `radius` (the mesh,
+    which the evaluation reads, is unchanged). Returns an error text, or "" when done."""
+    try:
+        ng = bpy.data.node_groups.new("sfmeval points", "GeometryNodeTree")
+        if hasattr(ng, "interface"):  # Blender 4+
+            ng.interface.new_socket("Geometry", in_out="INPUT", socket_type="NodeSocketGeometry")
+            ng.interface.new_socket("Geometry", in_out="OUTPUT", socket_type="NodeSocketGeometry")
+        else:  # Blender 3.x
+            ng.inputs.new("NodeSocketGeometry", "Geometry")
+            ng.outputs.new("NodeSocketGeometry", "Geometry")
+        gi = ng.nodes.new("NodeGroupInput")
+        go = ng.nodes.new("NodeGroupOutput")
+        m2p = ng.nodes.new("GeometryNodeMeshToPoints")
+        m2p.inputs["Radius"].default_value = radius
+        sm = ng.nodes.new("GeometryNodeSetMaterial")
+        sm.inputs["Material"].default_value = _points_material()
+        ng.links.new(gi.outputs[0], m2p.inputs["Mesh"])
+        ng.links.new(m2p.outputs["Points"], sm.inputs["Geometry"])
+        ng.links.new(sm.outputs["Geometry"], go.inputs[0])
+        mod = obj.modifiers.new("sfmeval points", "NODES")
+        mod.node_group = ng
+        return ""
+    except Exception as exc:  # display only: never fail the import for it
+        return "points display: %s" % exc
 
 
 def add_cameras(coll, parent, path):
