@@ -357,3 +357,32 @@ def test_cancel_ends_the_runner_and_its_tools(tiny, bins, tmp_path):
     time.sleep(0.2)
     assert not os.path.exists("/proc/%d" % sleeper) or \
         open("/proc/%d/stat" % sleeper).read().split(") ")[1].startswith("Z"), "sleep survived"
+
+
+def test_binaries_are_found_in_preferences_path_or_target_release(bins, tmp_path, monkeypatch):
+    """tools.find: the preferences' path first (a wrong one is an error naming it, not a
+    fallback), then PATH, then target/release of a repository above the working directory."""
+    sys.path.insert(0, BLENDER_SCRIPTS)
+    from sfmeval_blender.compare import tools
+    assert tools.find("sfmeval", bins["sfmeval"]) == os.path.abspath(bins["sfmeval"])
+    with pytest.raises(tools.ToolMissing, match="/nope/sfmeval.*cargo build --release -p "
+                                                "sfmeval-cli"):
+        tools.find("sfmeval", "/nope/sfmeval")
+    fake = tmp_path / "bin" / "sfmeval-runner"
+    fake.parent.mkdir()
+    fake.write_text("#!/bin/sh\n")
+    fake.chmod(0o755)
+    monkeypatch.setenv("PATH", str(fake.parent))
+    assert tools.find("sfmeval-runner") == str(fake)
+    # nothing on PATH: a repository's target/release above the working directory
+    repo = tmp_path / "repo"
+    (repo / "target" / "release").mkdir(parents=True)
+    (repo / "sub").mkdir()
+    shutil.copy(bins["sfmeval"], repo / "target" / "release" / "sfmeval")
+    monkeypatch.setenv("PATH", "/nonexistent")
+    monkeypatch.chdir(repo / "sub")
+    assert tools.find("sfmeval") == str(repo / "target" / "release" / "sfmeval")
+    monkeypatch.setattr(tools, "_repo_candidates", lambda extra: iter(()))
+    with pytest.raises(tools.ToolMissing, match="not found on PATH.*cargo build --release -p "
+                                                "sfmeval-runner"):
+        tools.find("sfmeval-runner")

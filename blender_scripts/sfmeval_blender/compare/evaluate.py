@@ -195,11 +195,12 @@ def table_order(rows, builtin):
     return known + sorted((r for r in rows if r[0] not in builtin), key=lambda r: r[0])
 
 
-def table1(dataset_name, rows):
+def table1(dataset_name, rows, alignment="`auto` alignment"):
     """(markdown, csv) of Table I for one dataset, byte-for-byte in the runner's format
     (native_runner/src/table/mod.rs `write_tables`).
 
-    `rows`: [(pipeline, mean or None, points, status, reason)] in column order."""
+    `rows`: [(pipeline, mean or None, points, status, reason)] in column order; `alignment`
+    names the alignment in the caption (the runner's: "`auto` alignment")."""
     head = "| dataset |" + "".join(" %s |" % p for p, *_ in rows)
     head += "\n|---|" + "---:|" * len(rows) + "\n"
     cells = []
@@ -212,8 +213,9 @@ def table1(dataset_name, rows):
             cells.append(why if why.startswith(status) else "%s: %s" % (status, why))
     body = "| %s |" % dataset_name + "".join(" %s |" % c for c in cells) + "\n"
     md = ("# Table I: mean distance to the ground truth (m) and number of points\n\nEach cell: "
-          "mean reconstruction → ground-truth distance in metres (after `auto` alignment), and "
-          "in parentheses the number of points; failed runs show why.\n\n" + head + body)
+          "mean reconstruction → ground-truth distance in metres (after %s), and "
+          "in parentheses the number of points; failed runs show why.\n\n" % alignment
+          + head + body)
     header = ["dataset"]
     for p, *_ in rows:
         header += ["%s.mean_m" % p, "%s.points" % p, "%s.status" % p]

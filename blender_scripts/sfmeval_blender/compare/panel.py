@@ -383,7 +383,8 @@ class SFMEVAL_OT_compare_evaluate(bpy.types.Operator):
             # Table I counts the points given to the evaluation, as the runner's does
             rows.append((item.name, s["mean"], s["input_points"] or 0, "ok", ""))
         rows = ev.table_order(rows, [p.name for p in c.pipelines])
-        md, csv_text = ev.table1(os.path.basename(ds), rows)
+        md, csv_text = ev.table1(os.path.basename(ds), rows,
+                                 alignment="the alignment of each object in Blender")
         out = work_dir(context)
         os.makedirs(out, exist_ok=True)
         for name, text in (("table1.md", md), ("table1.csv", csv_text)):
