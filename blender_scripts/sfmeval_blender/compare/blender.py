@@ -30,7 +30,8 @@ def dataset_dir(context):
     """The dataset folder: the one set in the Compare panel, else the generator's output."""
     c = context.scene.sfmeval_compare
     d = c.dataset_dir or context.scene.sfmeval.out_dir
-    return os.path.normpath(bpy.path.abspath(d)) if d else ""
+    # absolute: the runner is given absolute folders
+    return os.path.abspath(bpy.path.abspath(d)) if d else ""
 
 
 def work_dir(context, name=None):

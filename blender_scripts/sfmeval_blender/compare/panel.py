@@ -99,7 +99,7 @@ class SFMEVAL_PG_compare(bpy.types.PropertyGroup):
 def runs_dir(context):
     c = context.scene.sfmeval_compare
     if c.runs_dir:
-        return os.path.normpath(bpy.path.abspath(c.runs_dir))
+        return os.path.abspath(bpy.path.abspath(c.runs_dir))
     return os.path.join(dataset_dir(context), "runs")
 
 
@@ -173,7 +173,18 @@ class SFMEVAL_OT_compare_run(bpy.types.Operator):
         return {"RUNNING_MODAL"}
 
     def _step(self, context):
-        """One poll; False when every queued run has ended."""
+        """One poll; False when every queued run has ended. An unexpected error ends the
+        batch with a message (and the runner), never a stuck "running" state."""
+        try:
+            return self._poll(context)
+        except Exception as exc:
+            if self._job is not None:
+                self._job.cancel()
+            context.scene.sfmeval_compare.message = "run stopped: %s" % exc
+            _STATE["running"] = False
+            return False
+
+    def _poll(self, context):
         c = context.scene.sfmeval_compare
         if self._job is None:
             if not self._queue:
