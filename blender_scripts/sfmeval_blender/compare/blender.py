@@ -109,7 +109,7 @@ def new_points_object(context, name, points, cameras_json=None):
     obj.matrix_parent_inverse.identity()
     if len(pts):
         size = float(np.linalg.norm(pts.max(0) - pts.min(0)))
-        obj["sfmeval_display"] = show_as_points(obj, max(size, 1e-9) * 0.002)
+        obj["sfmeval_display"] = show_as_points(obj, max(size, 1e-9) * 0.004)
     if cameras_json and os.path.isfile(cameras_json):
         add_cameras(coll, obj, cameras_json)
     return obj
@@ -283,6 +283,8 @@ def paint(obj, distances, status, clip):
     else:  # pragma: no cover
         col = mesh.attributes.new("sfmeval_color", "FLOAT_COLOR", "POINT")
     col.data.foreach_set("color", rgba.ravel())
+    if hasattr(mesh.color_attributes, "active_color"):
+        mesh.color_attributes.active_color = col  # Solid shading, Color: Attribute
     mesh.update()
 
 

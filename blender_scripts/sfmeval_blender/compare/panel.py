@@ -477,24 +477,19 @@ class SFMEVAL_PT_compare(bpy.types.Panel):
         if c.gt_source == "OBJECT":
             box.prop(c, "gt_object")
         box.operator("sfmeval.compare_evaluate")
-        cols = ["pipeline", "reg/img", "points", "min", "max", "mean", "median", "std",
-                "compl.", "F@1%", "ATE"]
-        grid = box.grid_flow(row_major=True, columns=len(cols), even_columns=False)
-        for h in cols:
-            grid.label(text=h)
+        # one small block per reconstruction (an 11-column grid does not fit the sidebar)
         for r in c.recons:
             s = json.loads(r.summary) if r.summary else {}
             if not s:
-                grid.label(text=r.name)
-                for _ in cols[1:]:
-                    grid.label(text="")
                 continue
-            vals = [r.name, "%s/%s" % (_fmt(s["registered"]), _fmt(s["images"])),
-                    _fmt(s["points"])] + [_fmt(s[k]) for k in
-                                          ("min", "max", "mean", "median", "std",
-                                           "completeness", "f1", "ate")]
-            for v in vals:
-                grid.label(text=v)
+            col = box.box().column(align=True)
+            col.label(text=r.name)
+            col.label(text="%s/%s images, %s points" % (_fmt(s["registered"]), _fmt(s["images"]),
+                                                        _fmt(s["points"])))
+            col.label(text="min %s  max %s" % (_fmt(s["min"]), _fmt(s["max"])))
+            col.label(text="mean %s  median %s" % (_fmt(s["mean"]), _fmt(s["median"])))
+            col.label(text="std %s  compl. %s" % (_fmt(s["std"]), _fmt(s["completeness"])))
+            col.label(text="F@1%% %s  ATE %s" % (_fmt(s["f1"]), _fmt(s["ate"])))
         for r in c.recons:
             if r.message:
                 box.label(text="%s: %s" % (r.name, r.message[:200]), icon="ERROR")
