@@ -3,7 +3,8 @@
 One package for both front ends:
 
 * the Blender add-on (``register()`` / ``unregister()``; panel in the 3D view sidebar, tab
-  "sfmeval"), installed from the zip that ``blender_scripts/build_addon.py`` builds;
+  "sfmeval"), installed from the zip that ``blender_scripts/build_addon.py`` builds, with a
+  second panel "Compare pipelines" (``compare/``: run, import, cut away, align, evaluate);
 * the headless generator (``blender_scripts/generate.py`` or ``python -m sfmeval_blender``).
 
 Modules without bpy (``config``, ``geometry``, ``exif``, ``shapes``, ``tomlmini``) import

@@ -13,6 +13,7 @@ from bpy.props import (BoolProperty, CollectionProperty, EnumProperty, FloatProp
 
 from . import config as cfgmod
 from . import steps
+from .compare import panel as compare_panel
 
 _BUILTINS = [(n, n.capitalize(), "built-in procedural %s" % n) for n in cfgmod.BUILTIN_OBJECTS]
 
@@ -463,11 +464,13 @@ def register():
     if _init_defaults not in bpy.app.handlers.load_post:
         bpy.app.handlers.load_post.append(_init_defaults)
     bpy.app.timers.register(_init_defaults, first_interval=0.2)
+    compare_panel.register()
 
 
 def unregister():
     if _init_defaults in bpy.app.handlers.load_post:
         bpy.app.handlers.load_post.remove(_init_defaults)
+    compare_panel.unregister()
     del bpy.types.Scene.sfmeval
     for cls in reversed(CLASSES):
         bpy.utils.unregister_class(cls)

@@ -43,7 +43,7 @@ pub enum Command {
     /// render a variant per value, run the pipelines, plot every metric against it.
     Sweep(SweepArgs),
     /// List the pipelines and whether each is installed here.
-    Pipelines(ToolArgs),
+    Pipelines(PipelinesArgs),
 }
 
 /// Where the tools are, and the custom pipelines.
@@ -62,6 +62,18 @@ pub struct ToolArgs {
     /// A custom pipeline: NAME='COMMAND with {images} and {out}' (repeatable; see README).
     #[arg(long = "custom", value_name = "NAME=COMMAND")]
     pub customs: Vec<String>,
+}
+
+/// Arguments of `pipelines`.
+#[derive(Args)]
+pub struct PipelinesArgs {
+    /// Print a JSON array `[{"name", "installed", "detail"}]` (detail: the version when
+    /// installed, else why not) instead of the text table.
+    #[arg(long)]
+    pub json: bool,
+    /// Where the tools are.
+    #[command(flatten)]
+    pub tools: ToolArgs,
 }
 
 /// How the runs of a batch execute: shared by `run`, `table1` and `sweep`.

@@ -4,7 +4,7 @@
 use anyhow::Result;
 
 use crate::adapters::{self, Availability};
-use crate::args::{MergeArgs, ReportCmd, RunArgs, ToolArgs};
+use crate::args::{MergeArgs, PipelinesArgs, ReportCmd, RunArgs};
 use crate::dataset::Dataset;
 use crate::env::make_env;
 use crate::pipelines::{parse_customs, parse_list};
@@ -67,22 +67,85 @@ pub fn report(a: &ReportCmd) -> Result<()> {
     Ok(())
 }
 
-/// `pipelines`: every built-in and custom pipeline, installed or not.
-pub fn pipelines(a: &ToolArgs) -> Result<()> {
+/// One pipeline of `pipelines --json`.
+#[derive(serde::Serialize, Debug, PartialEq)]
+pub struct PipelineStatus {
+    /// Pipeline name (what `run --pipelines` takes).
+    pub name: String,
+    /// Whether its tool is installed here.
+    pub installed: bool,
+    /// The tool's version when installed, else why it is not.
+    pub detail: String,
+}
+
+/// `pipelines`: every built-in and custom pipeline, installed or not (a text table, or JSON
+/// with `--json`).
+pub fn pipelines(a: &PipelinesArgs) -> Result<()> {
+    let list = pipeline_statuses(&a.tools)?;
+    if a.json {
+        println!("{}", serde_json::to_string_pretty(&list)?);
+    } else {
+        for p in &list {
+            let state = if p.installed {
+                "installed"
+            } else {
+                "missing  "
+            };
+            println!("{:18} {state}  {}", p.name, p.detail);
+        }
+    }
+    Ok(())
+}
+
+/// The built-in and custom pipelines with their availability.
+pub fn pipeline_statuses(a: &crate::args::ToolArgs) -> Result<Vec<PipelineStatus>> {
     let customs = parse_customs(&a.customs)?;
     let tmp = std::env::temp_dir().join(format!("sfmeval-runner-{}", std::process::id()));
     let env = make_env(a, &tmp)?;
+    let mut out = Vec::new();
     for name in adapters::BUILTIN
         .iter()
         .map(|s| s.to_string())
         .chain(customs.keys().cloned())
     {
         let ad = adapters::adapter(&name, &name, &customs)?;
-        match ad.availability(&env) {
-            Availability::Installed(v) => println!("{name:18} installed  {v}"),
-            Availability::Missing(r) => println!("{name:18} missing    {r}"),
-        }
+        let (installed, detail) = match ad.availability(&env) {
+            Availability::Installed(v) => (true, v),
+            Availability::Missing(r) => (false, r),
+        };
+        out.push(PipelineStatus {
+            name,
+            installed,
+            detail,
+        });
     }
     let _ = std::fs::remove_dir_all(&tmp);
-    Ok(())
+    Ok(out)
+}
+
+#[cfg(test)]
+#[allow(clippy::unwrap_used, clippy::expect_used)]
+mod tests {
+    use super::*;
+    use crate::args::ToolArgs;
+
+    #[test]
+    fn pipeline_statuses_json() {
+        let tools = ToolArgs {
+            python: None,
+            colmap: "/nonexistent/colmap".into(),
+            visualsfm: "/nonexistent/VisualSFM".into(),
+            customs: vec!["mine=/bin/true {images} {out}".into()],
+        };
+        let list = pipeline_statuses(&tools).unwrap();
+        let names: Vec<_> = list.iter().map(|p| p.name.as_str()).collect();
+        assert_eq!(names.len(), adapters::BUILTIN.len() + 1);
+        assert_eq!(names.last(), Some(&"mine"));
+        let colmap = list.iter().find(|p| p.name == "colmap").unwrap();
+        assert!(!colmap.installed, "{colmap:?}");
+        assert!(colmap.detail.contains("/nonexistent/colmap"), "{colmap:?}");
+        let v: serde_json::Value = serde_json::to_value(&list).unwrap();
+        assert_eq!(v[0]["name"], "colmap");
+        assert!(v[0]["installed"].is_boolean() && v[0]["detail"].is_string());
+    }
 }

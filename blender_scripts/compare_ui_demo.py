@@ -1,0 +1,106 @@
+"""The Compare pipelines panel in a real Blender window (manual check and the README picture):
+the run operator runs modally (timers keep firing while the pipelines run), then import, crop,
+evaluate, and a screenshot of the window.
+
+    xvfb-run -s "-screen 0 1600x1500x24" blender --factory-startup -noaudio \\
+        --window-geometry 0 0 1600 1500 EMPTY.blend -P blender_scripts/compare_ui_demo.py -- \\
+        ZIP DATASET SFMEVAL RUNNER OUT.png
+
+EMPTY.blend: any saved startup file (a file on the command line skips the splash screen).
+DATASET is a rendered dataset; pycolmap-global is run on it (into DATASET/runs/) and every run
+folder there is imported. Prints "UI ticks during the run: N" (N > 0: Blender stayed usable).
+"""
+
+import sys
+import time
+
+import bpy
+
+argv = sys.argv[sys.argv.index("--") + 1:]
+zip_path, ds, sfmeval_bin, runner_bin, png = argv
+bpy.ops.preferences.addon_install(filepath=zip_path, overwrite=True)
+bpy.ops.preferences.addon_enable(module="sfmeval_blender")
+prefs = bpy.context.preferences.addons["sfmeval_blender"].preferences
+prefs.sfmeval_path, prefs.runner_path = sfmeval_bin, runner_bin
+from sfmeval_blender.compare import panel as cpanel  # noqa: E402
+
+# the dataset panel closed, so the comparison fits the window
+gen = bpy.types.SFMEVAL_PT_panel
+bpy.utils.unregister_class(gen)
+gen.bl_options = {"DEFAULT_CLOSED"}
+bpy.utils.register_class(gen)
+ticks = []
+state = {"phase": "start", "t0": 0.0}
+
+
+def view3d():
+    win = bpy.context.window_manager.windows[0]
+    area = next(a for a in win.screen.areas if a.type == "VIEW_3D")
+    region = next(r for r in area.regions if r.type == "WINDOW")
+    return win, area, region
+
+
+def tick():
+    try:
+        return _tick()
+    except Exception:
+        import traceback
+        traceback.print_exc()
+        bpy.ops.wm.quit_blender()
+
+
+def _tick():
+    scene = bpy.context.scene
+    c = scene.sfmeval_compare
+    win, area, region = view3d()
+    with bpy.context.temp_override(window=win, area=area, region=region, scene=scene):
+        if state["phase"] == "start":
+            for name in ("Cube", "Light"):
+                if name in bpy.data.objects:
+                    bpy.data.objects.remove(bpy.data.objects[name])
+            c.dataset_dir = ds
+            area.spaces.active.show_region_ui = True
+            # the sidebar's sfmeval tab: the other tabs' panels are unregistered for the picture
+            for cls in list(bpy.types.Panel.__subclasses__()):
+                if (getattr(cls, "bl_space_type", "") == "VIEW_3D"
+                        and getattr(cls, "bl_region_type", "") == "UI"
+                        and getattr(cls, "bl_category", "") != "sfmeval"
+                        and not cls.__name__.startswith("SFMEVAL")):
+                    try:
+                        bpy.utils.unregister_class(cls)
+                    except RuntimeError:
+                        pass
+            bpy.ops.sfmeval.compare_pipelines()
+            c.pipelines["pycolmap-global"].selected = True
+            c.intrinsics = "known"
+            bpy.ops.sfmeval.compare_run("INVOKE_DEFAULT")
+            state.update(phase="running", t0=time.monotonic())
+            return 0.5
+        if state["phase"] == "running":
+            if cpanel._STATE["running"]:
+                ticks.append(c.pipelines["pycolmap-global"].elapsed)
+                return 0.5
+            print("UI ticks during the run: %d, state %s, %.1f s" % (
+                len(ticks), c.pipelines["pycolmap-global"].state,
+                c.pipelines["pycolmap-global"].elapsed))
+            bpy.ops.sfmeval.compare_import_runs()
+            bpy.ops.sfmeval.compare_add_crop(kind="CUBE")
+            c.crop_object.scale = (0.45, 0.45, 0.5)
+            c.use_max_distance, c.max_distance = True, 0.05
+            bpy.ops.sfmeval.compare_evaluate()
+            shading = area.spaces.active.shading
+            shading.type, shading.color_type = "SOLID", "VERTEX"
+            for o in bpy.context.view_layer.objects:
+                o.select_set(o.name in ("pycolmap", "pycolmap-global"))
+            bpy.ops.view3d.view_selected()
+            for o in bpy.context.view_layer.objects:
+                o.select_set(False)
+            state["phase"] = "shoot"
+            return 3.0
+        bpy.ops.screen.screenshot(filepath=png)
+        print("screenshot", png)
+        bpy.ops.wm.quit_blender()
+    return None
+
+
+bpy.app.timers.register(tick, first_interval=2.0)

@@ -1,0 +1,378 @@
+"""The bpy side of steps 8–11: reconstructions as objects, their measurement, the crop file.
+
+A dataset's ground-truth frame is glTF's (Y up, docs/dataset.md); Blender's world is Z up. Every
+imported reconstruction is parented to one empty, "sfmeval GT frame", whose matrix is
+blender_from_gltf, so a points object's own matrix (``matrix_basis``) IS the alignment
+gt_from_recon and its mesh holds the points in the reconstruction's frame, as the file has them.
+Moving, rotating or scaling the object changes the alignment; deleting vertices in Edit Mode
+removes points from the evaluation.
+"""
+
+import json
+import os
+
+import bpy
+import numpy as np
+from mathutils import Matrix
+
+from . import crop as cropmod
+from . import evaluate as ev
+from . import plyio
+
+GT_FRAME = "sfmeval GT frame"
+# glTF = (x, z, -y) of Blender (geometry.blender_to_gltf)
+GLTF_FROM_BLENDER = np.array([[1, 0, 0, 0], [0, 0, 1, 0], [0, -1, 0, 0], [0, 0, 0, 1]], float)
+PROP_T = "sfmeval_gt_from_recon"
+REFINE_ROUNDS = 6
+
+
+def dataset_dir(context):
+    """The dataset folder: the one set in the Compare panel, else the generator's output."""
+    c = context.scene.sfmeval_compare
+    d = c.dataset_dir or context.scene.sfmeval.out_dir
+    # absolute: the runner is given absolute folders
+    return os.path.abspath(bpy.path.abspath(d)) if d else ""
+
+
+def work_dir(context, name=None):
+    """``<dataset>/compare[/<name>]``: everything the add-on writes (points, reports, crop)."""
+    d = os.path.join(dataset_dir(context), "compare")
+    return os.path.join(d, name) if name else d
+
+
+def require_dataset(context):
+    d = dataset_dir(context)
+    if not d or not os.path.isfile(os.path.join(d, "cameras.json")):
+        raise ValueError("no dataset at '%s' (no cameras.json): generate one (steps 1–6) or set "
+                         "the dataset folder in Compare pipelines" % d)
+    return d
+
+
+def gt_frame(context):
+    """The empty carrying blender_from_gltf (made once, in the scene's main collection)."""
+    obj = bpy.data.objects.get(GT_FRAME)
+    if obj is None:
+        obj = bpy.data.objects.new(GT_FRAME, None)
+        obj.empty_display_size = 0.1
+        context.scene.collection.objects.link(obj)
+    obj.matrix_world = Matrix(np.linalg.inv(GLTF_FROM_BLENDER).tolist())
+    return obj
+
+
+def _collection(context, name):
+    coll = bpy.data.collections.get(name)
+    if coll is None:
+        coll = bpy.data.collections.new(name)
+        context.scene.collection.children.link(coll)
+    return coll
+
+
+def gt_from_recon(obj):
+    """The object's alignment (float64 4×4): the exact one stored at the last alignment while
+    the object's matrix still holds it (Blender keeps the matrix as float32 location, rotation
+    and scale: ~1e-6 off; a move smaller than 0.001°, 1e-5 in scale and
+    translation is taken as no move), else the matrix the user gave it by moving the object."""
+    m = np.array(obj.matrix_basis, dtype=float)
+    stored = obj.get(PROP_T)
+    if stored is not None:
+        s = np.array(list(stored), dtype=float).reshape(4, 4)
+        deg, dscale = ev.rotation_scale_change(s, m)
+        dt = np.linalg.norm(s[:3, 3] - m[:3, 3])
+        if deg < 1e-3 and abs(dscale) < 1e-5 and dt < 1e-5 * max(1.0, np.linalg.norm(s[:3, 3])):
+            return s
+    return m
+
+
+def set_gt_from_recon(obj, m):
+    m = np.asarray(m, dtype=float).reshape(4, 4)
+    obj.matrix_basis = Matrix(m.tolist())
+    obj[PROP_T] = m.reshape(-1).tolist()
+
+
+def new_points_object(context, name, points, cameras_json=None):
+    """A collection `name` with the points object `name` (mesh of loose vertices in the
+    reconstruction's frame) under the GT frame, and the estimated cameras as its children."""
+    coll = _collection(context, "sfmeval " + name)
+    old = bpy.data.objects.get(name)
+    if old is not None:
+        for child in list(old.children):
+            bpy.data.objects.remove(child, do_unlink=True)
+        bpy.data.objects.remove(old, do_unlink=True)
+    mesh = bpy.data.meshes.new(name)
+    pts = np.asarray(points, dtype=np.float32).reshape(-1, 3)
+    mesh.vertices.add(len(pts))
+    mesh.vertices.foreach_set("co", pts.ravel())
+    mesh.update()
+    obj = bpy.data.objects.new(name, mesh)
+    coll.objects.link(obj)
+    obj.parent = gt_frame(context)
+    obj.matrix_parent_inverse.identity()
+    if len(pts):
+        size = float(np.linalg.norm(pts.max(0) - pts.min(0)))
+        obj["sfmeval_display"] = show_as_points(obj, max(size, 1e-9) * 0.004)
+    if cameras_json and os.path.isfile(cameras_json):
+        add_cameras(coll, obj, cameras_json)
+    return obj
+
+
+def _points_material():
+    """Material showing the ``sfmeval_color`` attribute (Material Preview / Rendered)."""
+    mat = bpy.data.materials.get("sfmeval points")
+    if mat is not None:
+        return mat
+    mat = bpy.data.materials.new("sfmeval points")
+    mat.use_nodes = True
+    nt = mat.node_tree
+    bsdf = next(n for n in nt.nodes if n.type == "BSDF_PRINCIPLED")
+    attr = nt.nodes.new("ShaderNodeAttribute")
+    attr.attribute_name = "sfmeval_color"
+    nt.links.new(attr.outputs["Color"], bsdf.inputs["Base Color"])
+    return mat
+
+
+def show_as_points(obj, radius):
+    """A geometry-nodes modifier drawing the loose vertices as points of `radius` (the mesh,
+    which the evaluation reads, is unchanged). Returns an error text, or "" when done."""
+    try:
+        ng = bpy.data.node_groups.new("sfmeval points", "GeometryNodeTree")
+        if hasattr(ng, "interface"):  # Blender 4+
+            ng.interface.new_socket("Geometry", in_out="INPUT", socket_type="NodeSocketGeometry")
+            ng.interface.new_socket("Geometry", in_out="OUTPUT", socket_type="NodeSocketGeometry")
+        else:  # Blender 3.x
+            ng.inputs.new("NodeSocketGeometry", "Geometry")
+            ng.outputs.new("NodeSocketGeometry", "Geometry")
+        gi = ng.nodes.new("NodeGroupInput")
+        go = ng.nodes.new("NodeGroupOutput")
+        m2p = ng.nodes.new("GeometryNodeMeshToPoints")
+        m2p.inputs["Radius"].default_value = radius
+        sm = ng.nodes.new("GeometryNodeSetMaterial")
+        sm.inputs["Material"].default_value = _points_material()
+        ng.links.new(gi.outputs[0], m2p.inputs["Mesh"])
+        ng.links.new(m2p.outputs["Points"], sm.inputs["Geometry"])
+        ng.links.new(sm.outputs["Geometry"], go.inputs[0])
+        mod = obj.modifiers.new("sfmeval points", "NODES")
+        mod.node_group = ng
+        return ""
+    except Exception as exc:  # display only: never fail the import for it
+        return "points display: %s" % exc
+
+
+def add_cameras(coll, parent, path):
+    """The cameras of an ``sfmeval.cameras/1`` file as camera objects parented to `parent`
+    (poses in the reconstruction's frame: they follow the alignment)."""
+    with open(path) as f:
+        doc = json.load(f)
+    cams = {c.get("id", i): c for i, c in enumerate(doc.get("cameras", []))}
+    flip = np.diag([1.0, -1.0, -1.0])  # COLMAP camera (z forward, y down) → Blender's
+    for im in doc.get("images", []):
+        pose = im.get("cam_from_world")
+        if not pose:
+            continue
+        R = np.array(pose["rotation"], float)
+        t = np.array(pose["translation"], float)
+        m = np.eye(4)
+        m[:3, :3] = R.T @ flip
+        m[:3, 3] = -R.T @ t
+        cam = cams.get(im.get("camera_id"), next(iter(cams.values()), None))
+        data = bpy.data.cameras.new("%s %s" % (parent.name, im.get("name", "")))
+        if cam and cam.get("width"):
+            data.sensor_fit = "HORIZONTAL"
+            data.sensor_width = 36.0
+            data.lens = cam["fx"] * 36.0 / cam["width"]
+        data.display_size = 0.05
+        obj = bpy.data.objects.new(data.name, data)
+        coll.objects.link(obj)
+        obj.parent = parent
+        obj.matrix_parent_inverse.identity()
+        obj.matrix_basis = Matrix(m.tolist())
+
+
+def leave_edit_mode(obj):
+    """Back to Object Mode (the Edit Mode deletions are applied to the mesh)."""
+    if obj.mode == "EDIT":
+        bpy.context.view_layer.objects.active = obj
+        bpy.ops.object.mode_set(mode="OBJECT")
+
+
+def kept_points(obj):
+    """The vertices left in the object's mesh (recon frame, float64), Edit Mode deletions
+    included (the object leaves Edit Mode)."""
+    leave_edit_mode(obj)
+    mesh = obj.data
+    co = np.empty(len(mesh.vertices) * 3, dtype=np.float32)
+    mesh.vertices.foreach_get("co", co)
+    return co.reshape(-1, 3).astype(np.float64)
+
+
+def crop_file(context):
+    """Writes ``<dataset>/compare/crop.json`` from the crop object and the max distance; returns
+    its path, or None (and removes a stale file) when there is no crop."""
+    c = context.scene.sfmeval_compare
+    path = os.path.join(work_dir(context), "crop.json")
+    volume = None
+    obj = c.crop_object
+    if obj is not None:
+        if obj.type == "EMPTY":
+            kind = "sphere" if obj.empty_display_type == "SPHERE" else "box"
+            s = obj.empty_display_size
+            lo, hi = (-s, -s, -s), (s, s, s)
+        elif obj.type == "MESH":
+            kind = "sphere" if obj.get("sfmeval_crop") == "sphere" else "box"
+            bb = np.array([list(v) for v in obj.bound_box])
+            lo, hi = bb.min(0), bb.max(0)
+        else:
+            raise ValueError("crop object '%s' is a %s: use an empty (cube or sphere) or a mesh"
+                             % (obj.name, obj.type))
+        m = GLTF_FROM_BLENDER @ np.array(obj.matrix_world, dtype=float)
+        volume = cropmod.volume_from_matrix(kind, m, lo, hi)
+    # the value as typed (the property is float32: 0.05 would be 0.05000000074505806)
+    maxd = float("%.7g" % c.max_distance) if c.use_max_distance else None
+    if volume is None and maxd is None:
+        if os.path.exists(path):
+            os.remove(path)
+        return None
+    os.makedirs(os.path.dirname(path), exist_ok=True)
+    with open(path, "w") as f:
+        f.write(cropmod.crop_json(volume, maxd))
+    return path
+
+
+def gt_override(context):
+    """``--gt`` when the ground truth is a scene object: exported to ``compare/gt_scene.glb`` in
+    the dataset's frame (glTF, Y up), as steps.export_gt does."""
+    c = context.scene.sfmeval_compare
+    if c.gt_source != "OBJECT":
+        return None
+    obj = c.gt_object
+    if obj is None or obj.type != "MESH":
+        raise ValueError("ground truth 'scene object' needs a mesh object chosen in the panel")
+    path = os.path.join(work_dir(context), "gt_scene.glb")
+    os.makedirs(os.path.dirname(path), exist_ok=True)
+    from .. import compat
+    prev = list(context.selected_objects)
+    for o in prev:
+        o.select_set(False)
+    obj.select_set(True)
+    op = bpy.ops.export_scene.gltf
+    op(**compat.op_kwargs(op, filepath=path, export_format="GLB", use_selection=True,
+                          export_apply=True, export_yup=True, export_materials="NONE",
+                          export_cameras=False, export_lights=False, export_animations=False))
+    obj.select_set(False)
+    for o in prev:
+        o.select_set(True)
+    return path
+
+
+def paint(obj, distances, status, clip):
+    """`distance` point attribute and the viridis colours (``sfmeval_color``, float RGBA = the
+    CLI's bytes / 255; points the crop drops are grey)."""
+    mesh = obj.data
+    n = len(mesh.vertices)
+    for name in ("distance", "sfmeval_color"):
+        a = mesh.attributes.get(name)
+        if a is not None:
+            mesh.attributes.remove(a)
+    d = mesh.attributes.new("distance", "FLOAT", "POINT")
+    d.data.foreach_set("value", np.asarray(distances, dtype=np.float32))
+    rgb = ev.distance_colors(distances, clip).astype(np.float32) / 255.0
+    kept = np.array([s == "kept" for s in status])
+    rgb[~kept] = 0.5
+    rgba = np.concatenate([rgb, np.ones((n, 1), np.float32)], axis=1)
+    if hasattr(mesh, "color_attributes"):
+        col = mesh.color_attributes.new("sfmeval_color", "FLOAT_COLOR", "POINT")
+    else:  # pragma: no cover
+        col = mesh.attributes.new("sfmeval_color", "FLOAT_COLOR", "POINT")
+    col.data.foreach_set("color", rgba.ravel())
+    if hasattr(mesh.color_attributes, "active_color"):
+        mesh.color_attributes.active_color = col  # Solid shading, Color: Attribute
+    mesh.update()
+
+
+def align_item(context, sfmeval, item, mode):
+    """Aligns a reconstruction's kept points: `mode` "auto" (cameras / global, then ICP) or
+    "icp" from the object's current matrix (Refine). Sets the object's matrix."""
+    obj = item.object
+    ds = require_dataset(context)
+    work = work_dir(context, item.name)
+    os.makedirs(work, exist_ok=True)
+    pts = os.path.join(work, "points.ply")
+    plyio.write_points(pts, kept_points(obj))
+    gt = gt_override(context)
+    cams = item.cameras_source or None
+    if mode != "icp":
+        a = ev.align(sfmeval, ds, pts, work, mode=mode, recon_cameras=cams, gt=gt)
+    else:
+        # One ICP run stops when a step is small; on a sparse cloud that can leave it ~0.06°
+        # short of its fixed point. Refine restarts it from its own answer until it stays put.
+        start = gt_from_recon(obj)
+        for _ in range(REFINE_ROUNDS):
+            a = ev.align(sfmeval, ds, pts, work, mode="icp", start=start, recon_cameras=cams,
+                         gt=gt)
+            end = np.array(a["gt_from_recon"], float)
+            deg, ds_rel = ev.rotation_scale_change(start, end)
+            start = end
+            if deg < 1e-3 and abs(ds_rel) < 1e-6:
+                break
+    set_gt_from_recon(obj, a["gt_from_recon"])
+    return a
+
+
+def measure_item(context, sfmeval, item, crop=None, gt=None):
+    """Evaluates the object's kept points with its matrix as the alignment (``sfmeval eval
+    --align given``), the crop file and the run's cameras; paints the points; returns the
+    report. Files: compare/<name>/{points.ply, gt_from_recon.txt, report.json, distances.csv}."""
+    obj = item.object
+    ds = require_dataset(context)
+    work = work_dir(context, item.name)
+    os.makedirs(work, exist_ok=True)
+    pts = os.path.join(work, "points.ply")
+    plyio.write_points(pts, kept_points(obj))
+    tpath = os.path.join(work, "gt_from_recon.txt")
+    ev.write_transform(tpath, gt_from_recon(obj))
+    rep, dist, status = ev.evaluate(sfmeval, ds, pts, tpath, os.path.join(work, "report.json"),
+                                    recon_cameras=item.cameras_source or None, crop=crop,
+                                    csv_out=os.path.join(work, "distances.csv"), gt=gt)
+    if len(dist) != len(obj.data.vertices):
+        raise ev.CliError("%s: the CLI measured %d points of %d (camera-centre points removed?)"
+                          % (pts, len(dist), len(obj.data.vertices)))
+    paint(obj, dist, status, ev.color_clip(rep))
+    return rep
+
+
+def import_source(context, sfmeval, name, source, run_dir=None):
+    """Imports a reconstruction: a run folder (its sparse.ply, model/ and cameras.json) or any
+    file the CLI reads. Aligns it automatically; returns the points object."""
+    ds = require_dataset(context)
+    work = work_dir(context, name)
+    os.makedirs(work, exist_ok=True)
+    cameras_source, cameras_json = None, None
+    if run_dir:
+        recon = os.path.join(run_dir, "sparse.ply")
+        if os.path.isdir(os.path.join(run_dir, "model")):
+            cameras_source = os.path.join(run_dir, "model")
+        cameras_json = os.path.join(run_dir, "cameras.json")
+    else:
+        recon = source
+    if not os.path.exists(recon):
+        raise ValueError("%s does not exist" % recon)
+    gt = gt_override(context)
+    if recon.lower().endswith(".ply"):
+        points = plyio.read_vertices(recon)
+        a = ev.align(sfmeval, ds, recon, work, recon_cameras=cameras_source, gt=gt)
+    else:
+        # Any other format: the CLI reads it; its points come back in the GT frame (--csv),
+        # mapped into the reconstruction's frame by the inverse alignment.
+        a = ev.align(sfmeval, ds, recon, work, gt=gt)
+        t = os.path.join(work, "gt_from_recon.txt")
+        ev.write_transform(t, a["gt_from_recon"])
+        csv_out = os.path.join(work, "distances.csv")
+        ev.evaluate(sfmeval, ds, recon, t, os.path.join(work, "report.json"), csv_out=csv_out,
+                    gt=gt)
+        g = ev.points_in_gt(csv_out)
+        inv = np.linalg.inv(np.array(a["gt_from_recon"], float))
+        points = g @ inv[:3, :3].T + inv[:3, 3]
+        cameras_source = recon
+    obj = new_points_object(context, name, points, cameras_json)
+    set_gt_from_recon(obj, a["gt_from_recon"])
+    obj["sfmeval_source"] = recon
+    return obj, cameras_source

@@ -1,0 +1,389 @@
+"""Steps 7–11 of the add-on ("Compare pipelines"), headless in both Blenders, checked against
+the `sfmeval` CLI run by the test itself.
+
+One tiny dataset (24 views, 640×360, 4 spp) is rendered per session. In PyPI bpy (Blender 5)
+the operator runs two real pipelines (pycolmap, pycolmap-global) through `sfmeval-runner`;
+Debian's Blender 3.4 imports those same run folders (pre-made by the bpy test, to stay in the CI
+budget) and does the rest of the workflow itself. Beside the real runs: a failed run (a custom
+pipeline that exits 1, run by the real runner) and a corrupt one (a truncated sparse.ply).
+"""
+
+import json
+import math
+import os
+import shutil
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+from blender_testlib import BLENDER_SCRIPTS, REPO, have_bpy, run_generate
+
+SCRIPT = os.path.join(os.path.dirname(os.path.abspath(__file__)), "blender_compare_script.py")
+TINY = ["--preset", "small", "--set", "render.samples=4", "--set", "outputs.depth=false",
+        "--set", "views.orbits=[{elevation_deg=20.0,count=12},"
+                 "{elevation_deg=45.0,count=12,azimuth_offset_deg=10.0}]"]
+GLTF_FROM_BLENDER = np.array([[1, 0, 0], [0, 0, 1], [0, -1, 0]], float)
+REAL = ["pycolmap", "pycolmap-global"]
+
+
+def _bin(env, name, package):
+    b = os.environ.get(env)
+    if b:
+        assert os.path.isfile(b), b
+        return b
+    subprocess.run(["cargo", "build", "--release", "-p", package], cwd=REPO, check=True)
+    return os.path.join(REPO, "target", "release", name)
+
+
+@pytest.fixture(scope="module")
+def bins():
+    return {"sfmeval": _bin("SFMEVAL_BIN", "sfmeval", "sfmeval-cli"),
+            "runner": _bin("SFMEVAL_RUNNER_BIN", "sfmeval-runner", "sfmeval-runner")}
+
+
+@pytest.fixture(scope="module")
+def tiny(tmp_path_factory):
+    assert have_bpy(), "PyPI bpy is not installed: cannot render the test dataset"
+    out = str(tmp_path_factory.mktemp("compare") / "tiny")
+    proc = run_generate(TINY + ["--out", out])
+    assert proc.returncode == 0, proc.stdout[-3000:] + proc.stderr[-3000:]
+    sys.stderr.write("\n[compare] tiny dataset rendered in %.0f s\n" % proc.seconds)
+    return out
+
+
+@pytest.fixture(scope="module")
+def addon_zip(tmp_path_factory):
+    out = tmp_path_factory.mktemp("dist")
+    proc = subprocess.run([sys.executable, os.path.join(BLENDER_SCRIPTS, "build_addon.py"),
+                           "--out", str(out)], capture_output=True, text=True, check=True)
+    return proc.stdout.strip()
+
+
+def _dataset_copy(tiny, dest):
+    shutil.copytree(tiny, dest, ignore=shutil.ignore_patterns("runs", "compare"))
+    return str(dest)
+
+
+def _add_bad_runs(bins, ds):
+    """A real failed run (custom pipeline `bad` exits 1) and a corrupt one (`zz-corrupt`: a
+    run.json saying ok, a truncated sparse.ply)."""
+    runs = os.path.join(ds, "runs")
+    proc = subprocess.run([bins["runner"], "run", "--datasets", ds, "--out", runs,
+                           "--pipelines", "bad", "--custom", "bad=false {images} {out}"],
+                          capture_output=True, text=True)
+    assert proc.returncode == 0, proc.stderr
+    base = os.path.join(runs, os.path.basename(ds))
+    with open(os.path.join(base, "bad", "run.json")) as f:
+        rec = json.load(f)
+    assert rec["status"] == "failed", rec
+    rec.update(status="ok", reason=None, pipeline="zz-corrupt")
+    os.makedirs(os.path.join(base, "zz-corrupt"))
+    with open(os.path.join(base, "zz-corrupt", "run.json"), "w") as f:
+        json.dump(rec, f)
+    with open(os.path.join(base, "zz-corrupt", "sparse.ply"), "wb") as f:
+        f.write(b"ply\nformat binary_little_endian 1.0\nelement vertex 1000\nproperty float x\n"
+                b"property float y\nproperty float z\nend_header\n" + b"\0" * 10)
+    return rec
+
+
+def _run_script(tmp_path, blender, addon_zip, ds, mode, bins):
+    out = str(tmp_path / "result.json")
+    env = dict(os.environ, BLENDER_USER_SCRIPTS=str(tmp_path / "user_scripts"),
+               BLENDER_USER_CONFIG=str(tmp_path / "user_config"))
+    args = [addon_zip, ds, mode, out, bins["sfmeval"], bins["runner"]]
+    if blender == "bpy":
+        cmd = [sys.executable, SCRIPT] + args
+    else:
+        exe = shutil.which("blender")
+        assert exe, "Debian blender not installed (apt-get install blender python3-numpy)"
+        cmd = [exe, "-b", "--factory-startup", "-noaudio", "--python-exit-code", "1",
+               "-P", SCRIPT, "--"] + args
+    proc = subprocess.run(cmd, capture_output=True, text=True, env=env, timeout=900)
+    assert proc.returncode == 0 and "COMPARE DONE" in proc.stdout, \
+        proc.stdout[-4000:] + proc.stderr[-4000:]
+    with open(out) as f:
+        return json.load(f)
+
+
+@pytest.fixture(scope="module")
+def bpy_result(tmp_path_factory, tiny, addon_zip, bins):
+    tmp = tmp_path_factory.mktemp("bpy")
+    ds = _dataset_copy(tiny, tmp / "tiny")
+    _add_bad_runs(bins, ds)
+    return ds, _run_script(tmp, "bpy", addon_zip, ds, "run", bins)
+
+
+def _eval(bins, ds, item, tmp_path):
+    """The test's own `sfmeval eval` on the add-on's points and crop file, with the object's
+    alignment written by the test."""
+    t = tmp_path / "transform.txt"
+    m = np.array(item["stored"]).reshape(4, 4)
+    t.write_text("".join(" ".join(repr(float(v)) for v in row) + "\n" for row in m))
+    work = os.path.dirname(item["report"])
+    mine = tmp_path / "report.json"
+    csv = tmp_path / "d.csv"
+    colored = tmp_path / "colored.ply"
+    argv = [bins["sfmeval"], "eval", "--dataset", ds, "--recon", os.path.join(work, "points.ply"),
+            "--recon-cameras", item["cameras_source"], "--crop",
+            os.path.join(ds, "compare", "crop.json"), "--align", "given", "--transform", str(t),
+            "--report", str(mine), "--csv", str(csv), "--colored", str(colored), "--quiet"]
+    subprocess.run(argv, check=True, capture_output=True)
+    import csv as csvmod
+    with open(csv, newline="") as f:
+        rows = list(csvmod.DictReader(f))
+    return mine, rows, colored
+
+
+def _read_ply(path):
+    import trimesh
+    return trimesh.load(str(path), process=False)
+
+
+def _check(res, ds, bins, tmp_path, ran):
+    base = os.path.join(ds, "runs", os.path.basename(ds))
+    # a missing binary: a message naming it and what to build, in the panel
+    assert "/nonexistent/sfmeval-runner" in res["missing_runner_msg"]
+    assert "cargo build --release -p sfmeval-runner" in res["missing_runner_msg"]
+    assert "cargo build --release -p sfmeval-cli" in res["missing_sfmeval_msg"]
+    assert any("/nonexistent/sfmeval " in x or x.startswith("sfmeval: ")
+               for x in res["missing_labels"]), res["missing_labels"]
+    if ran:
+        assert res["pipelines"]["pycolmap"] and res["pipelines"]["pycolmap-global"]
+        for p in REAL:
+            state, elapsed, msg = res["states"][p]
+            assert state == "ok" and elapsed > 0, (p, state, msg)
+            with open(os.path.join(base, p, "run.json")) as f:
+                rec = json.load(f)
+            assert rec["schema"] == "sfmeval.run/1" and rec["status"] == "ok"
+            assert rec["options"]["intrinsics"] == "known", rec["options"]
+        assert "sfmeval-runner run --datasets" in res["log"] and "ok in" in res["log"]
+    # a failed run and a corrupt file: a row each with the reason; the real rows are there
+    assert res["ok"] == REAL
+    for p in REAL:  # drawn as points (geometry nodes), the mesh itself untouched
+        assert res["display"][p] == ["", ["NODES"]], res["display"][p]
+    assert res["rows"]["bad"][0] == "failed" and "exit" in res["rows"]["bad"][1]
+    assert res["rows"]["zz-corrupt"][0] == "failed"
+    assert os.path.join("zz-corrupt", "sparse.ply") in res["rows"]["zz-corrupt"][1]
+    # imported vertex count = the report's count = the points of sparse.ply (trimesh)
+    for p in REAL:
+        n = len(_read_ply(os.path.join(base, p, "sparse.ply")).vertices)
+        assert res["imported_vertices"][p] == n
+        assert res["first_reports"][p]["inputs"]["reconstruction"]["points"] == n
+        with open(os.path.join(base, p, "cameras.json")) as f:
+            assert res["cameras"][p] == len(json.load(f)["images"])
+    # Edit Mode deletions: the mesh, the exported PLY and the report lose exactly those points
+    first = res["items"]["pycolmap"]
+    assert first["vertices"] == res["imported_vertices"]["pycolmap"] - res["deleted"]
+    kept = np.array(res["kept_expected"], np.float32)
+    assert np.array_equal(np.array(first["co"], np.float32), kept)
+    exported = _read_ply(os.path.join(os.path.dirname(first["report"]), "points.ply")).vertices
+    assert np.array_equal(np.asarray(exported, np.float32), kept)
+    # the crop file is the box as placed: centre, axes and half sizes in the glTF frame
+    with open(os.path.join(ds, "compare", "crop.json")) as f:
+        crop = json.load(f)
+    M = np.array(res["crop_matrix"])
+    vol = crop["volume"]
+    assert crop["schema"] == "sfmeval.crop/1" and crop["max_distance"] == pytest.approx(0.05)
+    assert vol["kind"] == "oriented_box"
+    assert np.allclose(vol["center"], GLTF_FROM_BLENDER @ M[:3, 3], atol=1e-7)
+    scale = np.linalg.norm(M[:3, :3], axis=0)
+    assert np.allclose(vol["half_extents"], scale, atol=1e-7)
+    assert np.allclose(vol["rotation"], GLTF_FROM_BLENDER @ (M[:3, :3] / scale), atol=1e-7)
+    # Refine (ICP) from 3° and 2 % off converges to the automatic answer
+    auto, start, ref = (np.array(res[k]) for k in ("auto", "start", "refined"))
+
+    def angle_scale(a, b):
+        sa, sb = np.cbrt(np.linalg.det(a[:3, :3])), np.cbrt(np.linalg.det(b[:3, :3]))
+        r = (a[:3, :3] / sa).T @ (b[:3, :3] / sb)
+        return math.degrees(math.acos(min(1.0, (np.trace(r) - 1) / 2))), sb / sa - 1
+
+    assert np.allclose(res["start_seen"], start, rtol=1e-5, atol=1e-5)
+    a0, s0 = angle_scale(auto, start)
+    assert a0 == pytest.approx(3.0, abs=0.01) and s0 == pytest.approx(0.02, abs=1e-6)
+    a1, s1 = angle_scale(auto, ref)
+    assert a1 < 0.05 and abs(s1) < 0.0005, (a1, s1)
+    # per reconstruction: matrix, report, colours, panel numbers = the CLI's
+    B = np.eye(4)
+    B[:3, :3] = GLTF_FROM_BLENDER.T
+    for p in REAL:
+        item = res["items"][p]
+        with open(item["report"], "rb") as f:
+            raw = f.read()
+        rep = json.loads(raw)
+        T = np.array(rep["alignment"]["gt_from_recon"])
+        assert rep["alignment"]["method"] == "given"
+        # the CLI takes the given matrix as the nearest similarity (≈ 1e-7 here)
+        assert np.allclose(np.array(item["stored"]).reshape(4, 4), T, rtol=1e-6, atol=1e-6)
+        # Blender keeps the matrix as float32 location, Euler rotation and scale (~3e-6 here)
+        assert np.allclose(item["matrix_basis"], T, rtol=1e-5, atol=1e-5)
+        assert np.allclose(item["matrix_world"], B @ T, rtol=1e-5, atol=1e-5)
+        assert rep["inputs"]["reconstruction"]["points"] == item["vertices"]
+        assert rep["crop"]["kind"] == "oriented_box+max_distance"
+        assert rep["crop"]["discarded_outside_volume"] > 0, rep["crop"]
+        sub = tmp_path / p
+        sub.mkdir()
+        mine, rows, colored = _eval(bins, ds, item, sub)
+        assert mine.read_bytes() == raw, "the add-on's report differs from the CLI's"
+        d = np.array([float(r["distance"]) for r in rows])
+        kept_mask = np.array([r["status"] == "kept" for r in rows])
+        assert len(d) == item["vertices"]
+        assert np.array_equal(np.array(item["distance"], np.float32), d.astype(np.float32))
+        col = np.array(item["color"])
+        cli = _read_ply(colored)
+        cli_rgb = np.asarray(cli.visual.vertex_colors)[:, :3]
+        assert kept_mask.sum() == len(cli_rgb) == rep["crop"]["kept"]
+        assert np.array_equal(np.round(col[kept_mask, :3] * 255).astype(int), cli_rgb)
+        assert np.all(col[~kept_mask, :3] == 0.5)
+        s = item["summary"]
+        acc = rep["accuracy"]
+        assert (s["min"], s["max"], s["mean"], s["median"], s["std"]) == \
+            (acc["min"], acc["max"], acc["mean"], acc["median"], acc["std"])
+        assert s["points"] == rep["crop"]["kept"] and s["images"] == 24
+        assert s["registered"] == rep["cameras"]["registered"]
+        assert s["completeness"] == rep["completeness"]["mean"]
+        assert s["ate"] == rep["cameras"]["ate_rmse"]
+        f1 = [t for t in rep["thresholds"] if t["tau_percent_of_diagonal"] == 1.0][0]
+        assert s["f1"] == f1["f_score"]
+        assert p in res["labels"]
+        assert any(x.startswith("mean %.4g " % acc["mean"]) for x in res["labels"])
+        # Table I (file and text block): this report's mean and point count
+        with open(os.path.join(ds, "compare", "table1.md"), encoding="utf-8") as f:
+            md = f.read()
+        assert "%.6f (%d)" % (acc["mean"], rep["inputs"]["reconstruction"]["points"]) in md
+        with open(os.path.join(ds, "compare", "table1.csv"), encoding="utf-8") as f:
+            csv_rows = f.read().splitlines()
+        head, row = csv_rows[0].split(","), csv_rows[1].split(",")
+        assert float(row[head.index("%s.mean_m" % p)]) == acc["mean"]
+        assert md in res["table_text"]
+    assert " bad |" in md and "failed: " in md
+    # a COLMAP model folder imported as a file: its points3D.txt in the reconstruction's frame
+    assert res["file_row"][0] == "imported", res["file_row"]
+    with open(os.path.join(base, "pycolmap", "model", "points3D.txt")) as f:
+        xyz = np.array([[float(v) for v in line.split()[1:4]] for line in f
+                        if line.strip() and not line.startswith("#")])
+    co = np.array(res["file_co"])
+    assert co.shape == xyz.shape
+    assert np.allclose(np.sort(co, axis=0), np.sort(xyz, axis=0), atol=1e-5)
+    # the ground truth as a scene object (exported to compare/gt_scene.glb): the same numbers
+    # as the dataset's GLB, without the crop
+    assert res["gt_object_eval"] == res["gt_dataset_eval"] == ["FINISHED"]
+    for p in REAL:
+        rep = res["gt_object_reports"][p]
+        assert rep["inputs"]["ground_truth"]["name"] == "gt_scene.glb"
+        assert rep["crop"]["kind"] == "none"
+        ref = res["gt_dataset_reports"][p]
+        assert ref["inputs"]["ground_truth"]["name"] == "ground_truth.glb"
+        assert rep["inputs"]["ground_truth"]["triangles"] == \
+            ref["inputs"]["ground_truth"]["triangles"]
+        assert rep["accuracy"]["mean"] == pytest.approx(ref["accuracy"]["mean"], rel=1e-5)
+
+
+@pytest.mark.parametrize("blender", ["bpy", "debian"])
+def test_compare_pipelines_workflow(blender, bpy_result, tiny, addon_zip, bins, tmp_path):
+    if blender == "bpy":
+        ds, res = bpy_result
+        _check(res, ds, bins, tmp_path, ran=True)
+        return
+    # Blender 3.4: the bpy test's run folders (pre-made), the workflow from the import on
+    src_ds, _ = bpy_result
+    ds = _dataset_copy(tiny, tmp_path / "tiny")
+    shutil.copytree(os.path.join(src_ds, "runs", os.path.basename(src_ds)),
+                    os.path.join(ds, "runs", "tiny"))
+    res = _run_script(tmp_path, "debian", addon_zip, ds, "premade", bins)
+    assert res["blender"].startswith("3."), res["blender"]
+    _check(res, ds, bins, tmp_path, ran=False)
+
+
+def test_table1_is_the_runners_format(bpy_result, bins, tmp_path):
+    """The add-on's Table I writer, given the rows of `sfmeval-runner report`'s own reports,
+    writes table1.md and table1.csv byte for byte as the runner does (ok and failed runs)."""
+    sys.path.insert(0, BLENDER_SCRIPTS)
+    from sfmeval_blender.compare import evaluate as ev
+    src_ds, _ = bpy_result
+    name = os.path.basename(src_ds)
+    runs = tmp_path / "runs"
+    for p in REAL + ["bad"]:
+        shutil.copytree(os.path.join(src_ds, "runs", name, p), runs / name / p)
+    table = tmp_path / "table"
+    proc = subprocess.run([bins["runner"], "report", str(runs), "--out", str(table),
+                           "--datasets", src_ds, "--samples", "20000"],
+                          capture_output=True, text=True)
+    assert proc.returncode == 0, proc.stderr
+    rows = []
+    for p in REAL + ["bad"]:
+        with open(runs / name / p / "run.json") as f:
+            rec = json.load(f)
+        if rec["status"] == "ok":
+            with open(table / "reports" / name / ("%s.json" % p)) as f:
+                rep = json.load(f)
+            rows.append((p, rep["accuracy"]["mean"], rep["inputs"]["reconstruction"]["points"],
+                         "ok", ""))
+        else:
+            rows.append((p, None, 0, rec["status"], rec["reason"]))
+    listed = json.loads(subprocess.run([bins["runner"], "pipelines", "--json"],
+                                       capture_output=True, text=True, check=True).stdout)
+    md, csv_text = ev.table1(name, ev.table_order(rows[::-1], [x["name"] for x in listed]))
+    assert md.encode() == (table / "table1.md").read_bytes()
+    assert csv_text.encode() == (table / "table1.csv").read_bytes()
+
+
+def test_cancel_ends_the_runner_and_its_tools(tiny, bins, tmp_path):
+    """The panel's Cancel (run.Job.cancel) ends sfmeval-runner and the tool it started in a
+    process group of its own (a custom pipeline sleeping 60 s), within seconds."""
+    import time
+    sys.path.insert(0, BLENDER_SCRIPTS)
+    from sfmeval_blender.compare import run as runmod
+    ds = _dataset_copy(tiny, tmp_path / "tiny")
+    argv = runmod.run_command(bins["runner"], ds, str(tmp_path / "runs"), "slow", 600, "exif")
+    job = runmod.Job(argv + ["--custom", "slow=sleep 61; echo {out}"])
+    sleeper = None
+    deadline = time.monotonic() + 20
+    while sleeper is None and time.monotonic() < deadline:
+        for pid in os.listdir("/proc"):
+            try:
+                with open("/proc/%s/cmdline" % pid, "rb") as f:
+                    if f.read().split(b"\0")[:2] == [b"sleep", b"61"]:
+                        sleeper = int(pid)
+            except OSError:
+                pass
+        time.sleep(0.1)
+    assert sleeper is not None, job.poll()
+    assert os.getpgid(sleeper) != job.proc.pid, "the tool should be in a group of its own"
+    t0 = time.monotonic()
+    job.cancel()
+    lines, rc = job.poll()
+    assert rc is not None and time.monotonic() - t0 < 10
+    time.sleep(0.2)
+    assert not os.path.exists("/proc/%d" % sleeper) or \
+        open("/proc/%d/stat" % sleeper).read().split(") ")[1].startswith("Z"), "sleep survived"
+
+
+def test_binaries_are_found_in_preferences_path_or_target_release(bins, tmp_path, monkeypatch):
+    """tools.find: the preferences' path first (a wrong one is an error naming it, not a
+    fallback), then PATH, then target/release of a repository above the working directory."""
+    sys.path.insert(0, BLENDER_SCRIPTS)
+    from sfmeval_blender.compare import tools
+    assert tools.find("sfmeval", bins["sfmeval"]) == os.path.abspath(bins["sfmeval"])
+    with pytest.raises(tools.ToolMissing, match="/nope/sfmeval.*cargo build --release -p "
+                                                "sfmeval-cli"):
+        tools.find("sfmeval", "/nope/sfmeval")
+    fake = tmp_path / "bin" / "sfmeval-runner"
+    fake.parent.mkdir()
+    fake.write_text("#!/bin/sh\n")
+    fake.chmod(0o755)
+    monkeypatch.setenv("PATH", str(fake.parent))
+    assert tools.find("sfmeval-runner") == str(fake)
+    # nothing on PATH: a repository's target/release above the working directory
+    repo = tmp_path / "repo"
+    (repo / "target" / "release").mkdir(parents=True)
+    (repo / "sub").mkdir()
+    shutil.copy(bins["sfmeval"], repo / "target" / "release" / "sfmeval")
+    monkeypatch.setenv("PATH", "/nonexistent")
+    monkeypatch.chdir(repo / "sub")
+    assert tools.find("sfmeval") == str(repo / "target" / "release" / "sfmeval")
+    monkeypatch.setattr(tools, "_repo_candidates", lambda extra: iter(()))
+    with pytest.raises(tools.ToolMissing, match="not found on PATH.*cargo build --release -p "
+                                                "sfmeval-runner"):
+        tools.find("sfmeval-runner")
