@@ -1,7 +1,7 @@
 //! The subcommands without a module of their own — `run`, `merge`, `report`, `pipelines`:
 //! each turns its arguments into the library calls and prints one summary line.
 
-use anyhow::Result;
+use anyhow::{Context, Result};
 
 use crate::adapters::{self, Availability};
 use crate::args::{MergeArgs, PipelinesArgs, ReportCmd, RunArgs};
@@ -19,8 +19,12 @@ pub fn run(a: &RunArgs) -> Result<()> {
         .iter()
         .map(|d| Dataset::open(d))
         .collect::<Result<_>>()?;
-    let opts = a.batch.batch_options(&a.out)?;
-    let env = make_env(&a.batch.tools, &a.out)?;
+    // Absolute: the tools run inside their run folders, so a relative OUT (and the adapter
+    // scripts installed under it) would resolve against the wrong folder.
+    let out = std::path::absolute(&a.out)
+        .with_context(|| format!("output folder {}", a.out.display()))?;
+    let opts = a.batch.batch_options(&out)?;
+    let env = make_env(&a.batch.tools, &out)?;
     let t = std::time::Instant::now();
     let s = crate::run::run_batch(&datasets, &specs, &customs, &env, &opts)?;
     eprintln!(

@@ -289,3 +289,19 @@ def test_bad_arguments_fail_clearly(runner_bin, small_dataset, tmp_path):
     p = run_cli(runner_bin, "run", "--datasets", small_dataset, "--pipelines", "openmvg",
                 "--shard", "2/2", "--out", tmp_path, check=False)
     assert p.returncode == 1 and "--shard" in p.stderr
+
+
+def test_relative_paths_run_from_any_folder(runner_bin, small_dataset, tmp_path):
+    """`run --datasets dev --out dev/runs` typed in a shell: the Python adapters start from the
+    run folder, so their script path must not stay relative to where the user stood. The run is
+    cut short by a 2 s timeout; what is checked is that the adapter script was found."""
+    os.symlink(small_dataset, tmp_path / "dev")
+    env = dict(os.environ, SFMEVAL_PYTHON=sys.executable)
+    proc = subprocess.run([runner_bin, "run", "--datasets", "dev", "--pipelines", "pycolmap",
+                           "--timeout", "2", "--out", "dev-runs"], cwd=tmp_path, env=env,
+                          stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    assert proc.returncode == 0, proc.stderr
+    rec = load(tmp_path / "dev-runs" / "dev" / "pycolmap" / "run.json")
+    script = rec["command"][0].split()[1]
+    assert os.path.isabs(script) and os.path.isfile(script), rec["command"]
+    assert "can't open file" not in (rec["reason"] or ""), rec["reason"]
