@@ -974,6 +974,14 @@ updateRunButton();
 const compare = setupCompare({
   call, viewer, measureOptions: options, showError, download,
   gtName: () => (state.gt ? state.gt.name : null),
+  setRunning: (b) => {
+    if (b && (state.running || state.restoring)) return false;
+    state.running = b;
+    if (b) setRunNote('Comparing: progress below; Cancel stops it.');
+    else { hideProgress(); if (!state.restoring) setRunNote(''); }
+    updateRunButton();
+    return true;
+  },
 });
 // for tests and scripting
 window.sfmeval = { compare, state, call, currentCrop, cropText, prAt, reportNotes, matrixText, alignedTransform };

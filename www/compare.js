@@ -128,9 +128,10 @@ function curves(el, entries) {
 /**
  * Sets up the compare section. `call` talks to the worker, `viewer` is the page's viewer,
  * `options()` the Measure section's options, `showError(msg, target)` the banner and
- * `download(name, data, type)` saves a file.
+ * `download(name, data, type)` saves a file, `setRunning(b)` tells the page a compare is under way
+ * (progress bar and Cancel in the action bar) and returns false when another run already is.
  */
-export function setupCompare({ call, viewer, measureOptions, showError, download, gtName, onProgress }) {
+export function setupCompare({ call, viewer, measureOptions, showError, download, gtName, setRunning }) {
   const state = { items: [], entries: [], sort: null, tables: null, viewer2: null };
   const info = $('info-runs');
   const setItems = (items) => {
@@ -172,6 +173,7 @@ export function setupCompare({ call, viewer, measureOptions, showError, download
     if (!state.items.length) return;
     const name = gtName();
     if (!name) { fail('compare: load the ground truth first (section 1)'); return; }
+    if (!setRunning(true)) { fail('compare: wait for the evaluation under way to end (or cancel it)'); return; }
     $('compare').disabled = true;
     showError('');
     const entries = [];
@@ -200,6 +202,7 @@ export function setupCompare({ call, viewer, measureOptions, showError, download
           const r = await call('compareRun', { files, name: recName, runJson: runText, dataset: name, options }, transfer);
           entries.push({ ...r, report: JSON.parse(r.reportJson), path: it.path });
         } catch (err) {
+          if (err.name === 'Cancelled') throw err;
           // as the runner: the run stays in the table, "evaluation failed" with the reason
           problems.push(`${it.path}: ${err.message}`);
           const record = runText ?? JSON.stringify({
@@ -220,11 +223,15 @@ export function setupCompare({ call, viewer, measureOptions, showError, download
       }
       document.body.dataset.compared = String(Number(document.body.dataset.compared || 0) + 1);
     } catch (err) {
-      fail(`compare failed: ${err.message}`);
-      $('compare-status').textContent = '✗ compare failed: see the message at the top';
+      if (err.name === 'Cancelled') {
+        $('compare-status').textContent = 'compare cancelled (press Compare to run it again)';
+      } else {
+        fail(`compare failed: ${err.message}`);
+        $('compare-status').textContent = '✗ compare failed: see the message at the top';
+      }
     } finally {
       $('compare').disabled = !state.items.length;
-      if (onProgress) onProgress(null);
+      setRunning(false);
     }
   }
   $('compare').onclick = run;

@@ -204,6 +204,32 @@ try {
     check(`compare-loose-report-${name}-equals-cli`, json === want, firstDiff(json, want));
   }
 
+  // a compare under way shows the progress bar and the action bar's Cancel, which stops it:
+  // no table change, no error, and the page compares again afterwards (step 10). 8M samples
+  // make each evaluation last seconds, so Cancel lands mid-run.
+  await page.fill('#samples', '8000000');
+  const comparedBefore = await page.evaluate(() => document.body.dataset.compared);
+  const cancelledBefore = Number(await page.evaluate(() => document.body.dataset.cancelled || 0));
+  await page.click('#compare');
+  await page.waitForFunction(() => !document.getElementById('cancel').hidden
+    && getComputedStyle(document.getElementById('progress')).display !== 'none', null, { timeout: 30000 });
+  const during = await page.evaluate(() => ({
+    run: document.getElementById('run').disabled,
+    status: document.getElementById('compare-status').textContent,
+    cancelInView: (() => { const r = document.getElementById('cancel').getBoundingClientRect(); return r.bottom <= innerHeight && r.top >= 0; })(),
+  }));
+  check('compare-progress-and-cancel-in-view', during.run && /^evaluating \d\/3/.test(during.status) && during.cancelInView, JSON.stringify(during));
+  await page.click('#cancel');
+  await page.waitForFunction((n) => Number(document.body.dataset.cancelled || 0) > n, cancelledBefore, { timeout: 60000 });
+  const after = await page.evaluate(() => ({
+    status: document.getElementById('compare-status').textContent,
+    error: document.getElementById('error').textContent,
+    compared: document.body.dataset.compared,
+    cancelHidden: document.getElementById('cancel').hidden,
+  }));
+  check('compare-cancelled', /cancelled/.test(after.status) && !after.error && after.compared === comparedBefore && after.cancelHidden, JSON.stringify(after));
+  await page.fill('#samples', '1000000');
+
   // 10. the runs folder dropped on the drop zone: the page walks the folder entries. Playwright
   //     cannot drop a real folder, so the drop event carries entries (the FileSystemEntry
   //     interface: isFile/isDirectory, file(), createReader().readEntries()) over the files the
