@@ -113,9 +113,12 @@ if cargo build --release --locked -p sfmeval-runner >"$log/runner.log" 2>&1 &&
     --custom "sparse-colmap=cp '$ROOT/data/demo/sparse/'*.txt {out}/" \
     --custom "pycolmap-ply=cp '$fx/pycolmap_points3D.ply' {out}/" \
     --custom "theia-ply=cp '$fx/theia_points.ply' {out}/" >>"$log/runner.log" 2>&1 &&
-  ./target/release/sfmeval-runner report "$cmp/runs" --out "$cmp/table" >>"$log/runner.log" 2>&1; then
+  ./target/release/sfmeval-runner report "$cmp/runs" --out "$cmp/table" >>"$log/runner.log" 2>&1 &&
+  printf '{"schema": "sfmeval.crop/1", "volume": {"kind": "sphere", "center": [0, 0.1, 0], "radius": 0.45}, "max_distance": 0.02}\n' >"$cmp/crop.json" &&
+  ./target/release/sfmeval-runner report "$cmp/runs" --crop "$cmp/crop.json" --out "$cmp/table-crop" >>"$log/runner.log" 2>&1; then
   node tests/browser/compare.mjs --url "http://127.0.0.1:$port/" --runs "$cmp/runs" --dataset "$cmp/statue" \
-    --table "$cmp/table" --cli target/release/sfmeval --out "$out" >"$log/compare.log" 2>&1
+    --table "$cmp/table" --cli target/release/sfmeval --out "$out" \
+    --crop "$cmp/crop.json" --table-crop "$cmp/table-crop" >"$log/compare.log" 2>&1
   count compare "$log/compare.log" $?
 else
   fail "compare: making the runs folder" "$log/runner.log"

@@ -179,7 +179,7 @@ export function setupCompare({ call, viewer, measureOptions, showError, download
     const entries = [];
     const problems = [];
     const base = measureOptions();
-    const options = { tau: base.tau, tau_percent_of_diagonal: base.tau_percent_of_diagonal, samples: base.samples, seed: base.seed, align: 'auto' };
+    const options = { tau: base.tau, tau_percent_of_diagonal: base.tau_percent_of_diagonal, samples: base.samples, seed: base.seed, crop: base.crop, align: 'auto' };
     try {
       for (const [k, it] of state.items.entries()) {
         $('compare-status').textContent = `evaluating ${k + 1}/${state.items.length}: ${it.pipeline}…`;

@@ -3,7 +3,7 @@
 // same folder, byte for byte; sorting, best marks, overlaid curves, the side-by-side viewer and
 // the camera frusta are checked too.
 // Usage: node compare.mjs --url URL --runs RUNS --dataset DATASET --table RUNNER_TABLE
-//          --cli target/release/sfmeval --out DIR
+//          --cli target/release/sfmeval --out DIR --crop crop.json --table-crop TABLE_WITH_CROP
 // Prints one "ok NAME" / "FAILED NAME: why" line per check; exits 1 when one failed.
 import { chromium } from 'playwright-core';
 import { execFileSync } from 'node:child_process';
@@ -11,7 +11,7 @@ import { readFileSync, mkdirSync, readdirSync, writeFileSync } from 'node:fs';
 import { join, resolve } from 'node:path';
 
 const args = Object.fromEntries(process.argv.slice(2).reduce((a, v, i, all) => (v.startsWith('--') ? [...a, [v.slice(2), all[i + 1]]] : a), []));
-const [runs, dataset, table, cli, out] = ['runs', 'dataset', 'table', 'cli', 'out'].map((k) => resolve(args[k]));
+const [runs, dataset, table, cli, out, cropFile, tableCrop] = ['runs', 'dataset', 'table', 'cli', 'out', 'crop', 'table-crop'].map((k) => resolve(args[k]));
 mkdirSync(out, { recursive: true });
 const origin = new URL(args.url).origin;
 
@@ -266,6 +266,19 @@ try {
   await page.waitForFunction((n) => Number(document.body.dataset.compared) > n || document.getElementById('error').textContent, beforeDrop, { timeout: 300000 });
   const droppedMd = await downloadText('#cmp-dl-table-md');
   check('compare-drop-folder-table-equals-runner', droppedMd === readFileSync(join(table, 'table.md'), 'utf8'), firstDiff(droppedMd, readFileSync(join(table, 'table.md'), 'utf8')));
+
+  // 11. the section 3 crop applies to every reconstruction, as `sfmeval-runner report --crop`
+  //     (the same crop file, imported through the page's crop import)
+  await page.setInputFiles('#crop-import', cropFile);
+  await page.waitForFunction(() => document.getElementById('max-distance').value !== '', null, { timeout: 10000 });
+  const beforeCrop = Number(await page.evaluate(() => document.body.dataset.compared));
+  await page.click('#compare');
+  await page.waitForFunction((n) => Number(document.body.dataset.compared) > n || document.getElementById('error').textContent, beforeCrop, { timeout: 300000 });
+  for (const [sel, file] of [['#cmp-dl-table-md', 'table.md'], ['#cmp-dl-runs-csv', 'runs.csv']]) {
+    const got = await downloadText(sel);
+    const want = readFileSync(join(tableCrop, file), 'utf8');
+    check(`compare-cropped-${file}-equals-runner-crop`, got === want && got !== readFileSync(join(table, file), 'utf8'), firstDiff(got, want));
+  }
 
   check('compare-no-request-leaves-origin', requests.every((u) => u.startsWith(origin) || u.startsWith('blob:') || u.startsWith('data:')), requests.filter((u) => !u.startsWith(origin)).join(' '));
   check('compare-no-console-errors', consoleErrors.length === 0, consoleErrors.join(' | '));
