@@ -301,9 +301,21 @@ export function setupCompare({ call, viewer, measureOptions, showError, download
     updateSide();
   }
 
+  /** A caption in the corner of a viewer naming the reconstruction it shows. */
+  function label(v, text) {
+    let el = v.container.querySelector(':scope > .view-label');
+    if (!el) {
+      el = document.createElement('div');
+      el.className = 'view-label';
+      v.container.appendChild(el);
+    }
+    el.textContent = text;
+    el.hidden = !text;
+  }
   function showIn(v, value) {
     const e = state.entries[Number(value)];
     if (value === '' || !e || !e.pointsInGt) return;
+    label(v, e.row.pipeline);
     v.setPoints(e.pointsInGt, $('heat') && $('heat').checked ? e.colors : null);
     drawCameras(v, e.cameras);
     // the first time cameras are shown here, frame them (they stand well outside the object)

@@ -171,6 +171,22 @@ try {
   });
   const otherPoints = await page.evaluate((i) => window.sfmeval.compare.entries[i].pointsInGt.length / 3, other);
   check('side-by-side-viewers', side && side.b[0] >= side.a[0] + side.a[1] - 2 && side.b[1] > 200 && side.points === otherPoints && side.same, JSON.stringify({ side, otherPoints }));
+  // each half names what it shows; the tools stay inside the left half, none cut off
+  const layout = await page.evaluate(() => {
+    const box = (el) => el.getBoundingClientRect();
+    const a = box(document.getElementById('view3d'));
+    const tools = document.getElementById('viewer-tools');
+    const inside = [...tools.querySelectorAll('label, button')].every((el) => { const r = box(el); return r.left >= a.left && r.right <= a.left + a.width; });
+    return {
+      labelA: document.querySelector('#viewer > .view-label').textContent,
+      labelB: document.querySelector('#viewer2 > .view-label').textContent,
+      labelAInLeft: box(document.querySelector('#viewer > .view-label')).right <= a.left + a.width,
+      toolsInLeft: box(tools).right <= a.left + a.width && inside,
+    };
+  });
+  const names = await page.evaluate(([i, j]) => [i, j].map((k) => window.sfmeval.compare.entries[k].row.pipeline), [idx, other]);
+  check('side-by-side-labels', layout.labelA === names[0] && layout.labelB === names[1] && layout.labelAInLeft, JSON.stringify({ layout, names }));
+  check('side-by-side-tools-in-left-half', layout.toolsInLeft, JSON.stringify(layout));
   // the second canvas draws something
   const shot = await page.locator('#view3d-b').screenshot({ path: join(out, 'compare-side-b.png') });
   check('side-by-side-draws', shot.length > 5000, `${shot.length} bytes`);
