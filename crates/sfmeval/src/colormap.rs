@@ -14,7 +14,7 @@ const VIRIDIS: [[u8; 3]; 9] = [
 ];
 
 /// Colour of `t` in [0, 1] (clamped; NaN maps to the top colour).
-pub fn viridis(t: f64) -> [u8; 3] {
+pub(crate) fn viridis(t: f64) -> [u8; 3] {
     let t = if t.is_nan() { 1.0 } else { t.clamp(0.0, 1.0) };
     let x = t * (VIRIDIS.len() - 1) as f64;
     let i = (x.floor() as usize).min(VIRIDIS.len() - 2);

@@ -138,7 +138,7 @@ pub struct Crop {
 }
 
 /// Schema id of crop files.
-pub const CROP_SCHEMA: &str = "sfmeval.crop/1";
+pub(crate) const CROP_SCHEMA: &str = "sfmeval.crop/1";
 
 impl Crop {
     /// Parses a crop file.
@@ -179,7 +179,7 @@ impl Crop {
 
     /// Whether `p` is inside the volume (true without a volume).
     #[inline]
-    pub fn in_volume(&self, p: Point3) -> bool {
+    pub(crate) fn in_volume(&self, p: Point3) -> bool {
         self.volume.as_ref().is_none_or(|v| v.contains(p))
     }
 

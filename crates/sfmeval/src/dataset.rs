@@ -16,11 +16,11 @@ use crate::prepared::PreparedGroundTruth;
 use crate::progress::Progress;
 
 /// The ground truth's file inside a dataset folder.
-pub const GROUND_TRUTH_FILE: &str = "ground_truth.glb";
+pub(crate) const GROUND_TRUTH_FILE: &str = "ground_truth.glb";
 /// The ground-truth cameras inside a dataset folder.
 pub const CAMERAS_FILE: &str = "cameras.json";
 /// The folder of depth maps (`<image stem>.npy`) inside a dataset folder.
-pub const DEPTH_DIR: &str = "depth";
+pub(crate) const DEPTH_DIR: &str = "depth";
 
 /// Where an optional part of the ground truth comes from.
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -199,7 +199,12 @@ impl Dataset {
 
     /// Indexes the geometry and draws `samples` completeness samples with `seed`, unless that
     /// was done already with the same two.
-    pub fn prepare(&mut self, samples: usize, seed: u64, progress: &dyn Progress) -> Result<()> {
+    pub(crate) fn prepare(
+        &mut self,
+        samples: usize,
+        seed: u64,
+        progress: &dyn Progress,
+    ) -> Result<()> {
         if self
             .prepared
             .as_ref()
@@ -214,7 +219,7 @@ impl Dataset {
         Ok(())
     }
 
-    /// The prepared index, after [`Self::prepare`].
+    /// The prepared index, once [`crate::pipeline::run`] has prepared it.
     pub fn prepared(&self) -> Option<&PreparedGroundTruth> {
         self.prepared.as_ref()
     }

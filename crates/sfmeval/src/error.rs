@@ -97,7 +97,7 @@ pub enum Error {
     },
     /// A finite value that makes no sense or lies beyond what the core can measure: a zero or
     /// huge image width, a negative focal length, a rotation that is not one, a coordinate
-    /// beyond [`crate::geometry::MAX_COORDINATE`]. Names the item (`camera 3`, `image 'a.jpg'`,
+    /// beyond ±1e50. Names the item (`camera 3`, `image 'a.jpg'`,
     /// `vertex #12`) and the field; front ends add the file name.
     #[error("{format}: {item}: {field} {problem}")]
     OutOfRange {
@@ -221,7 +221,7 @@ impl Error {
     }
 
     /// This error, as an error in the file `file` playing `role`.
-    pub fn in_file(self, role: &'static str, file: impl Into<String>) -> Self {
+    pub(crate) fn in_file(self, role: &'static str, file: impl Into<String>) -> Self {
         Error::InFile {
             role,
             file: file.into(),

@@ -14,7 +14,7 @@ pub type Point3 = [f64; 3];
 /// to four or six coordinates (`(2·10⁵⁰)⁶ ≈ 6·10³⁰¹` still fits an `f64`), and sums of squares
 /// over a billion points stay finite, so no derived quantity overflows. Every finite `f32` value
 /// (≤ 3.4·10³⁸) is accepted, and no physical scene comes near: 10⁵⁰ m is 10²⁴ light years.
-pub const MAX_COORDINATE: f64 = 1e50;
+pub(crate) const MAX_COORDINATE: f64 = 1e50;
 
 /// `v` for an error message: plain for ordinary magnitudes, in exponent form otherwise.
 pub(crate) fn show(v: f64) -> String {
@@ -143,14 +143,18 @@ impl GroundTruth {
 /// Fails with [`Error::NonFinite`] if any coordinate is NaN or infinite, and with
 /// [`Error::OutOfRange`] (naming `what #index` and the axis) if one lies beyond
 /// ±[`MAX_COORDINATE`].
-pub fn check_finite(format: &'static str, what: &'static str, points: &[Point3]) -> Result<()> {
+pub(crate) fn check_finite(
+    format: &'static str,
+    what: &'static str,
+    points: &[Point3],
+) -> Result<()> {
     check_not_nan_inf(format, what, points)?;
     check_coordinate_range(format, what, points)
 }
 
 /// Fails with [`Error::OutOfRange`] on the first coordinate beyond ±[`MAX_COORDINATE`] (the
 /// coordinates must be finite).
-pub fn check_coordinate_range(
+pub(crate) fn check_coordinate_range(
     format: &'static str,
     what: &'static str,
     points: &[Point3],
@@ -212,7 +216,7 @@ pub fn dot(a: Point3, b: Point3) -> f64 {
 
 /// Cross product.
 #[inline]
-pub fn cross(a: Point3, b: Point3) -> Point3 {
+pub(crate) fn cross(a: Point3, b: Point3) -> Point3 {
     [
         a[1] * b[2] - a[2] * b[1],
         a[2] * b[0] - a[0] * b[2],
@@ -224,7 +228,7 @@ pub fn cross(a: Point3, b: Point3) -> Point3 {
 /// when the squares stay in range (bit-identical to it), else computed on the vector scaled by
 /// its largest component.
 #[inline]
-pub fn norm(a: Point3) -> f64 {
+pub(crate) fn norm(a: Point3) -> f64 {
     let d = dot(a, a);
     if d.is_finite() && d > 1e-290 {
         return d.sqrt();
@@ -247,6 +251,6 @@ fn norm_scaled(a: Point3, d: f64) -> f64 {
 
 /// Area of a triangle.
 #[inline]
-pub fn triangle_area(c: [Point3; 3]) -> f64 {
+pub(crate) fn triangle_area(c: [Point3; 3]) -> f64 {
     0.5 * norm(cross(sub(c[1], c[0]), sub(c[2], c[0])))
 }

@@ -32,7 +32,7 @@ pub struct GtView {
 
 /// The 2×2 depth neighbourhood of a sub-pixel position.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Neighbourhood {
+pub(crate) struct Neighbourhood {
     /// Depths of the four pixels (0 when background or outside the image), in the order
     /// (i0, j0), (i0+1, j0), (i0, j0+1), (i0+1, j0+1).
     pub depths: [f64; 4],
@@ -42,13 +42,13 @@ pub struct Neighbourhood {
 
 impl Neighbourhood {
     /// Whether all four pixels hold a depth.
-    pub fn complete(&self) -> bool {
+    pub(crate) fn complete(&self) -> bool {
         self.depths.iter().all(|&d| d > 0.0)
     }
 
     /// Depth interpolated bilinearly in inverse depth (exact on a plane, whose inverse depth is
     /// affine in the pixel coordinates); `None` unless all four pixels hold a depth.
-    pub fn interpolated(&self) -> Option<f64> {
+    pub(crate) fn interpolated(&self) -> Option<f64> {
         if !self.complete() {
             return None;
         }
@@ -60,7 +60,7 @@ impl Neighbourhood {
     }
 
     /// Largest minus smallest depth of the valid pixels (0 when fewer than two).
-    pub fn spread(&self) -> f64 {
+    pub(crate) fn spread(&self) -> f64 {
         let valid = self.depths.iter().filter(|&&d| d > 0.0);
         let (lo, hi) = valid.fold((f64::INFINITY, 0.0f64), |(lo, hi), &d| {
             (lo.min(d), hi.max(d))
@@ -71,14 +71,14 @@ impl Neighbourhood {
 
 impl GtView {
     /// Mean focal length in pixels.
-    pub fn focal(&self) -> f64 {
+    pub(crate) fn focal(&self) -> f64 {
         0.5 * (self.fx + self.fy)
     }
 
     /// Projects a ground-truth-frame point: `(u, v, z)` with `(u, v)` in COLMAP pixels and `z`
     /// the camera-frame depth; `None` behind the camera.
     #[inline]
-    pub fn project(&self, point_in_gt: Point3) -> Option<(f64, f64, f64)> {
+    pub(crate) fn project(&self, point_in_gt: Point3) -> Option<(f64, f64, f64)> {
         let p = self.cam_from_world.apply(point_in_gt);
         if !(p[2] > 0.0) {
             return None;
@@ -92,13 +92,13 @@ impl GtView {
 
     /// Whether `(u, v)` lies inside the image (COLMAP convention: `[0, W) × [0, H)`).
     #[inline]
-    pub fn inside(&self, u: f64, v: f64) -> bool {
+    pub(crate) fn inside(&self, u: f64, v: f64) -> bool {
         u >= 0.0 && v >= 0.0 && u < self.depth.width as f64 && v < self.depth.height as f64
     }
 
     /// The 2×2 pixel neighbourhood around `(u, v)` (pixels outside the image count as
     /// background). `None` when `(u, v)` is outside the image.
-    pub fn neighbourhood(&self, u: f64, v: f64) -> Option<Neighbourhood> {
+    pub(crate) fn neighbourhood(&self, u: f64, v: f64) -> Option<Neighbourhood> {
         if !self.inside(u, v) {
             return None;
         }
@@ -120,7 +120,7 @@ impl GtView {
     }
 
     /// The ground-truth-frame point at depth `z` on the ray through pixel position `(u, v)`.
-    pub fn back_project(&self, u: f64, v: f64, z: f64) -> Point3 {
+    pub(crate) fn back_project(&self, u: f64, v: f64, z: f64) -> Point3 {
         let cam = [z * (u - self.cx) / self.fx, z * (v - self.cy) / self.fy, z];
         let t = self.cam_from_world.translation;
         mat_t_vec(
@@ -144,7 +144,7 @@ pub fn depth_stem(image_name: &str) -> String {
 /// image name in `depth_by_stem`. Every image needs a depth map whose size is its camera's
 /// width × height; only pinhole cameras (`PINHOLE`, `SIMPLE_PINHOLE`, or models whose extra
 /// parameters are all zero) are accepted, since the depth maps are rendered without distortion.
-pub fn build_views(
+pub(crate) fn build_views(
     gt_cameras: &Reconstruction,
     depth_by_stem: &std::collections::BTreeMap<String, DepthMap>,
 ) -> Result<Vec<GtView>> {
@@ -216,7 +216,7 @@ pub(crate) mod test_scenes {
     use crate::geometry::{cross, dot, norm, sub};
 
     /// A camera at `center` looking at `target`, world up +y (OpenCV axes: y down in the image).
-    pub fn look_at(center: Point3, target: Point3) -> Rigid {
+    pub(crate) fn look_at(center: Point3, target: Point3) -> Rigid {
         let f = sub(target, center);
         let z = f.map(|v| v / norm(f));
         let up = [0.0, 1.0, 0.0];
@@ -232,7 +232,7 @@ pub(crate) mod test_scenes {
 
     /// Renders a depth map of `hit(origin, dir) -> Option<t>` (t along a unit direction) through
     /// each pixel centre.
-    pub fn render(
+    pub(crate) fn render(
         pose: Rigid,
         f: f64,
         w: usize,
@@ -270,7 +270,7 @@ pub(crate) mod test_scenes {
     }
 
     /// Ray–sphere intersection (nearest positive t).
-    pub fn sphere(center: Point3, r: f64) -> impl Fn(Point3, Point3) -> Option<f64> {
+    pub(crate) fn sphere(center: Point3, r: f64) -> impl Fn(Point3, Point3) -> Option<f64> {
         move |o, d| {
             let oc = sub(o, center);
             let b = dot(oc, d);
@@ -285,7 +285,7 @@ pub(crate) mod test_scenes {
     }
 
     /// Ray–box intersection (slab method), axis-aligned box `[lo, hi]`.
-    pub fn aabox(lo: Point3, hi: Point3) -> impl Fn(Point3, Point3) -> Option<f64> {
+    pub(crate) fn aabox(lo: Point3, hi: Point3) -> impl Fn(Point3, Point3) -> Option<f64> {
         move |o, d| {
             let (mut t0, mut t1) = (0.0f64, f64::INFINITY);
             for k in 0..3 {
@@ -303,7 +303,7 @@ pub(crate) mod test_scenes {
 
     /// Appends `x` to `rec` as a 3D point observed, by exact projection, in every view that
     /// sees it (`views[i]` belongs to `rec.images[i]`).
-    pub fn add_observed_point(rec: &mut Reconstruction, views: &[GtView], x: Point3) {
+    pub(crate) fn add_observed_point(rec: &mut Reconstruction, views: &[GtView], x: Point3) {
         let point = rec.points.len();
         let mut track = Vec::new();
         for (i, v) in views.iter().enumerate() {

@@ -2,7 +2,7 @@
 //! defines them: a distance counts when it is strictly below tau.
 
 /// Default thresholds in percent of the ground-truth diagonal when none are given.
-pub const DEFAULT_TAU_PERCENT: [f64; 3] = [0.5, 1.0, 2.0];
+pub(crate) const DEFAULT_TAU_PERCENT: [f64; 3] = [0.5, 1.0, 2.0];
 
 /// The thresholds of an evaluation, resolved once: each τ in ground-truth units, in the order
 /// given (those in ground-truth units first, then those in percent of the diagonal).
@@ -19,7 +19,7 @@ pub struct Thresholds {
 impl Thresholds {
     /// Resolves `tau` (ground-truth units) and `percent_of_diagonal`; with neither,
     /// [`DEFAULT_TAU_PERCENT`].
-    pub fn resolve(tau: &[f64], percent_of_diagonal: &[f64], diagonal: f64) -> Thresholds {
+    pub(crate) fn resolve(tau: &[f64], percent_of_diagonal: &[f64], diagonal: f64) -> Thresholds {
         let percents_used = if tau.is_empty() && percent_of_diagonal.is_empty() {
             DEFAULT_TAU_PERCENT.to_vec()
         } else {
@@ -35,13 +35,13 @@ impl Thresholds {
     }
 
     /// τ in percent of the diagonal.
-    pub fn percent_of_diagonal(&self, tau: f64) -> f64 {
+    pub(crate) fn percent_of_diagonal(&self, tau: f64) -> f64 {
         tau / self.diagonal * 100.0
     }
 }
 
 /// Share of `distances` strictly below `tau` (0 for an empty list).
-pub fn share_below(distances: &[f64], tau: f64) -> f64 {
+pub(crate) fn share_below(distances: &[f64], tau: f64) -> f64 {
     if distances.is_empty() {
         return 0.0;
     }
@@ -49,7 +49,7 @@ pub fn share_below(distances: &[f64], tau: f64) -> f64 {
 }
 
 /// Harmonic mean 2PR/(P+R), 0 when both are 0.
-pub fn f_score(precision: f64, recall: f64) -> f64 {
+pub(crate) fn f_score(precision: f64, recall: f64) -> f64 {
     if precision + recall > 0.0 {
         2.0 * precision * recall / (precision + recall)
     } else {

@@ -105,7 +105,7 @@ impl PreparedGroundTruth {
 
     /// Whether this was prepared with `samples` completeness samples drawn with `seed` (a cloud
     /// ground truth uses its own points: only the seed, which the report echoes, counts).
-    pub fn prepared_with(&self, samples: usize, seed: u64) -> bool {
+    pub(crate) fn prepared_with(&self, samples: usize, seed: u64) -> bool {
         self.sample_seed == seed && (self.requested_samples == samples || !self.is_mesh())
     }
 

@@ -12,12 +12,12 @@ use crate::pose::CamerasReport;
 use crate::stats::Statistics;
 
 /// Schema id of reports.
-pub const REPORT_SCHEMA: &str = "sfmeval.report/2";
+pub(crate) const REPORT_SCHEMA: &str = "sfmeval.report/2";
 
 /// The whole report.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Report {
-    /// Always [`REPORT_SCHEMA`].
+    /// Always `"sfmeval.report/2"`.
     pub schema: String,
     /// The program that wrote it.
     pub tool: Tool,

@@ -10,7 +10,7 @@ const BITS: u32 = 21;
 
 /// Indices of `points` sorted by their Morton code on the points' bounding box (ties by index;
 /// non-finite points last). A permutation of `0..points.len()`, deterministic.
-pub fn morton_order(points: &[Point3]) -> Vec<u32> {
+pub(crate) fn morton_order(points: &[Point3]) -> Vec<u32> {
     let mut lo = [f64::INFINITY; 3];
     let mut hi = [f64::NEG_INFINITY; 3];
     for p in points.iter().filter(|p| p.iter().all(|v| v.is_finite())) {

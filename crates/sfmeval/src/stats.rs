@@ -37,7 +37,7 @@ pub struct Histogram {
 /// How far beyond the 1st–99th percentile range (as a fraction of that range) a value may lie
 /// before the histogram stops stretching to it: a few far outliers (SfM background points)
 /// would otherwise squash every other value into the first bin.
-pub const HISTOGRAM_TAIL: f64 = 0.5;
+pub(crate) const HISTOGRAM_TAIL: f64 = 0.5;
 
 /// Statistics of a set of values. All zero when `count == 0`.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize, Default)]
@@ -66,7 +66,7 @@ pub struct Statistics {
 pub const DEFAULT_BINS: usize = 50;
 
 /// Linear-interpolated percentile `q` in [0, 100] of sorted values.
-pub fn percentile_sorted(sorted: &[f64], q: f64) -> f64 {
+pub(crate) fn percentile_sorted(sorted: &[f64], q: f64) -> f64 {
     match sorted.len() {
         0 => 0.0,
         1 => sorted[0],
@@ -89,7 +89,7 @@ pub fn percentile_sorted(sorted: &[f64], q: f64) -> f64 {
 impl Statistics {
     /// Computes the statistics of `values` (NaNs must not be present). The histogram has `bins`
     /// equal bins over `[min(0, min), max]` (`[min, max]` for signed values), except where the
-    /// tail is long: an end farther than [`HISTOGRAM_TAIL`] × (p99 − p1) beyond p99 (or below p1)
+    /// tail is long: an end farther than 0.5 × (p99 − p1) beyond p99 (or below p1)
     /// is replaced by p99 (p1), and the values beyond are counted in `overflow` (`underflow`).
     pub fn of(values: &[f64], bins: usize) -> Statistics {
         let n = values.len();
@@ -171,7 +171,7 @@ fn histogram_range(min: f64, max: f64, p1: f64, p99: f64) -> (f64, f64) {
 
 /// Histogram of values into `bins` equal bins over `[lo, hi]`; values outside are counted in
 /// `underflow` / `overflow`.
-pub fn histogram(values: &[f64], lo: f64, hi: f64, bins: usize) -> Histogram {
+pub(crate) fn histogram(values: &[f64], lo: f64, hi: f64, bins: usize) -> Histogram {
     let bins = bins.max(1);
     let width = if hi > lo {
         let w = (hi - lo) / bins as f64;

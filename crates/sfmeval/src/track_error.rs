@@ -32,20 +32,20 @@ use crate::stats::Statistics;
 use crate::transform::Similarity;
 
 /// Relative part of the depth spread that counts as a discontinuity.
-pub const DISCONTINUITY_RELATIVE: f64 = 0.005;
+pub(crate) const DISCONTINUITY_RELATIVE: f64 = 0.005;
 /// Footprint part of the depth spread that counts as a discontinuity (pixel footprints).
-pub const DISCONTINUITY_FOOTPRINTS: f64 = 6.0;
+pub(crate) const DISCONTINUITY_FOOTPRINTS: f64 = 6.0;
 /// Back-projections farther than this many median distances from the median are trimmed.
-pub const TRIM_FACTOR: f64 = 3.0;
+pub(crate) const TRIM_FACTOR: f64 = 3.0;
 /// ... but never closer than this many pixel footprints.
-pub const TRIM_FOOTPRINTS: f64 = 3.0;
+pub(crate) const TRIM_FOOTPRINTS: f64 = 3.0;
 /// Kept back-projections a point needs to be measured.
-pub const MIN_OBSERVATIONS: usize = 2;
+pub(crate) const MIN_OBSERVATIONS: usize = 2;
 
 /// How a reconstruction's `Observation::xy` relate to COLMAP pixels.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
 #[serde(rename_all = "snake_case")]
-pub enum ObservationConvention {
+pub(crate) enum ObservationConvention {
     /// Already COLMAP pixels (COLMAP, OpenMVG after the reader's +0.5, NVM from COLMAP).
     ColmapPixels,
     /// Relative to the principal point, y down (VisualSfM NVM).
@@ -56,7 +56,7 @@ pub enum ObservationConvention {
 
 impl ObservationConvention {
     /// The name written in reports.
-    pub fn name(self) -> &'static str {
+    pub(crate) fn name(self) -> &'static str {
         match self {
             ObservationConvention::ColmapPixels => "colmap_pixels",
             ObservationConvention::CenteredYDown => "centered_y_down",
@@ -65,7 +65,7 @@ impl ObservationConvention {
     }
 
     /// The convention of a model's observations, from its format (and, for NVM, the signs).
-    pub fn of(rec: &Reconstruction) -> ObservationConvention {
+    pub(crate) fn of(rec: &Reconstruction) -> ObservationConvention {
         match rec.format {
             "bundler" => ObservationConvention::CenteredYUp,
             "nvm" => {
@@ -85,7 +85,7 @@ impl ObservationConvention {
     }
 
     /// `xy` in COLMAP pixels of `view`.
-    pub fn to_pixels(self, xy: [f64; 2], view: &GtView) -> (f64, f64) {
+    pub(crate) fn to_pixels(self, xy: [f64; 2], view: &GtView) -> (f64, f64) {
         match self {
             ObservationConvention::ColmapPixels => (xy[0], xy[1]),
             ObservationConvention::CenteredYDown => (view.cx + xy[0], view.cy + xy[1]),
@@ -96,7 +96,7 @@ impl ObservationConvention {
 
 /// Why an observation gave no back-projection.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Rejection {
+pub(crate) enum Rejection {
     /// Its pixel lies outside the ground-truth image.
     OutsideImage,
     /// A pixel of its neighbourhood is background (a silhouette).
@@ -122,7 +122,7 @@ impl Rejection {
 
 /// The ground-truth surface point seen through pixel position `(u, v)` of `view`, with the
 /// pixel footprint there.
-pub fn back_project(view: &GtView, u: f64, v: f64) -> Result<(Point3, f64), Rejection> {
+pub(crate) fn back_project(view: &GtView, u: f64, v: f64) -> Result<(Point3, f64), Rejection> {
     let n = view.neighbourhood(u, v).ok_or(Rejection::OutsideImage)?;
     let d = n.interpolated().ok_or(Rejection::Background)?;
     let footprint = d / view.focal();
@@ -144,7 +144,7 @@ fn median(values: &mut [f64]) -> f64 {
 
 /// Median-seeded trimmed mean of `points` (see the module doc); `footprint` is the scale below
 /// which nothing is trimmed. Returns the mean and how many points it kept.
-pub fn robust_mean(points: &[Point3], footprint: f64) -> Option<(Point3, usize)> {
+pub(crate) fn robust_mean(points: &[Point3], footprint: f64) -> Option<(Point3, usize)> {
     if points.is_empty() {
         return None;
     }
@@ -173,7 +173,7 @@ pub fn robust_mean(points: &[Point3], footprint: f64) -> Option<(Point3, usize)>
 /// with their nearest-surface `distances` and crop `kept` flags in the same order, at the
 /// evaluation's thresholds `taus` (ground-truth units). Returns the section and a warning when
 /// no point could be measured.
-pub fn aggregate(
+pub(crate) fn aggregate(
     convention: ObservationConvention,
     outcomes: &[PointOutcome],
     distances: &[f64],
@@ -240,7 +240,7 @@ pub fn aggregate(
 
 /// The outcome for one 3D point.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
-pub struct PointOutcome {
+pub(crate) struct PointOutcome {
     /// Where the point should be (ground-truth frame), when measured.
     pub truth_in_gt: Option<Point3>,
     /// Its true error (distance of the aligned point to the truth), when measured.
@@ -260,7 +260,7 @@ type PointObservations = Vec<(usize, [f64; 2])>;
 
 /// Track errors of every 3D point of `recon` (in point order). `view_of_image[i]` is the
 /// ground-truth view of `recon.images[i]` (by name), `gt_from_recon` the alignment.
-pub fn track_errors(
+pub(crate) fn track_errors(
     recon: &Reconstruction,
     views: &[GtView],
     view_of_image: &[Option<usize>],

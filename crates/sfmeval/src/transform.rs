@@ -6,10 +6,10 @@ use crate::geometry::{MAX_COORDINATE, Point3, show};
 
 /// A transform's scale must lie in `[MIN_SCALE, MAX_SCALE]`: beyond, the reconstruction would be
 /// blown up past [`MAX_COORDINATE`] or collapsed below anything measurable.
-pub const MIN_SCALE: f64 = 1e-50;
+pub(crate) const MIN_SCALE: f64 = 1e-50;
 
 /// See [`MIN_SCALE`].
-pub const MAX_SCALE: f64 = 1e50;
+pub(crate) const MAX_SCALE: f64 = 1e50;
 
 /// A similarity `x ↦ s·R·x + t`, stored as the row-major 4×4 `[[sR, t], [0, 1]]`.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -47,7 +47,7 @@ impl Similarity {
         Similarity { matrix: m }
     }
 
-    /// Validates a 4×4 as a similarity: finite, every entry within ±[`MAX_COORDINATE`], last row
+    /// Validates a 4×4 as a similarity: finite, every entry within ±1e50, last row
     /// `0 0 0 1`, upper 3×3 = s·R with R a proper rotation (tolerance `1e-6` relative) and `s`
     /// in `[MIN_SCALE, MAX_SCALE]`.
     pub fn from_matrix(m: [[f64; 4]; 4]) -> Result<Similarity> {
@@ -171,7 +171,7 @@ impl Similarity {
     }
 
     /// The rotation R (the 3×3 part divided by the scale).
-    pub fn rotation(&self) -> [[f64; 3]; 3] {
+    pub(crate) fn rotation(&self) -> [[f64; 3]; 3] {
         let s = self.scale();
         let mut r = [[0.0; 3]; 3];
         for (i, row) in r.iter_mut().enumerate() {
@@ -183,7 +183,7 @@ impl Similarity {
     }
 
     /// The translation t.
-    pub fn translation(&self) -> Point3 {
+    pub(crate) fn translation(&self) -> Point3 {
         [self.matrix[0][3], self.matrix[1][3], self.matrix[2][3]]
     }
 
@@ -199,7 +199,8 @@ impl Similarity {
     }
 
     /// `self ∘ other` (apply `other` first).
-    pub fn compose(&self, other: &Similarity) -> Similarity {
+    #[cfg(test)]
+    pub(crate) fn compose(&self, other: &Similarity) -> Similarity {
         let mut m = [[0.0; 4]; 4];
         for (i, row) in m.iter_mut().enumerate() {
             for (j, v) in row.iter_mut().enumerate() {
@@ -210,7 +211,8 @@ impl Similarity {
     }
 
     /// The inverse similarity.
-    pub fn inverse(&self) -> Similarity {
+    #[cfg(test)]
+    pub(crate) fn inverse(&self) -> Similarity {
         let s = self.scale();
         let r = self.rotation();
         let t = self.translation();
@@ -222,11 +224,6 @@ impl Similarity {
         }
         let ti = [0, 1, 2].map(|i| -(rt[i][0] * t[0] + rt[i][1] * t[1] + rt[i][2] * t[2]) / s);
         Similarity::from_parts(1.0 / s, rt, ti)
-    }
-
-    /// True when this is exactly the identity.
-    pub fn is_identity(&self) -> bool {
-        *self == Self::IDENTITY
     }
 }
 

@@ -36,18 +36,18 @@ use crate::report::{ThresholdReport, VisibleCompletenessReport, VisibleThreshold
 use crate::stats::Statistics;
 
 /// Relative part of the depth tolerance (of the sample's depth).
-pub const RELATIVE_TOLERANCE: f64 = 0.0005;
+pub(crate) const RELATIVE_TOLERANCE: f64 = 0.0005;
 /// Pixel-footprint part of the depth tolerance (in footprints).
-pub const FOOTPRINT_TOLERANCE: f64 = 1.5;
+pub(crate) const FOOTPRINT_TOLERANCE: f64 = 1.5;
 /// Steepest depth slope accepted between neighbouring pixels, in footprints per pixel
 /// (a surface at about 70° to the view direction; steeper ones are judged by the inverse-depth
 /// interpolation alone).
-pub const MAX_SLOPE_FOOTPRINTS: f64 = 3.0;
+pub(crate) const MAX_SLOPE_FOOTPRINTS: f64 = 3.0;
 
 /// Depth slope assumed at a silhouette (a 2×2 neighbourhood with a background pixel), in
 /// footprints per pixel: the surface there turns away from the camera and its depth changes
 /// much faster than the valid pixels alone show (a sphere's limb).
-pub const RIM_SLOPE_FOOTPRINTS: f64 = 8.0;
+pub(crate) const RIM_SLOPE_FOOTPRINTS: f64 = 8.0;
 
 /// Default number of images a sample must be seen in to count as visible (two views are the
 /// least any SfM pipeline needs to triangulate a point).
@@ -67,7 +67,7 @@ pub enum SampleLabel {
 }
 
 /// Whether `view` sees `point_in_gt`.
-pub fn sees(view: &GtView, point_in_gt: Point3) -> bool {
+pub(crate) fn sees(view: &GtView, point_in_gt: Point3) -> bool {
     let Some((u, v, z)) = view.project(point_in_gt) else {
         return false;
     };
@@ -101,7 +101,7 @@ pub fn sees(view: &GtView, point_in_gt: Point3) -> bool {
 
 /// For each sample, the number of views that see it (in sample order; independent of the
 /// thread count).
-pub fn count_views(
+pub(crate) fn count_views(
     views: &[GtView],
     samples_in_gt: &[Point3],
     progress: &dyn Progress,
@@ -112,7 +112,7 @@ pub fn count_views(
 }
 
 /// Labels of samples from their view counts and their distances to the reconstruction.
-pub fn labels(
+pub(crate) fn labels(
     views: &[u32],
     completeness_distances: &[f64],
     min_views: u32,
@@ -139,7 +139,7 @@ pub fn labels(
 /// thresholds with their precision and whole-surface recall) the recall and F-score over the
 /// visible samples. `surface_area` is the whole ground-truth area when the samples cover all of
 /// it (a mesh, no crop volume). Returns the report section and a warning when nothing is visible.
-pub fn visible_completeness(
+pub(crate) fn visible_completeness(
     view_counts: &[u32],
     completeness_distances: &[f64],
     scores: &[ThresholdReport],

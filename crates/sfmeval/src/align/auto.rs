@@ -2,9 +2,10 @@
 //! pairs are given; `global` otherwise), then `icp`. A stage that fails falls back to the next
 //! possibility and the fallback stage's note names the failure, so the report never hides it.
 
+use super::global::align_global;
 use super::{
-    CameraPair, CamerasOptions, GlobalOptions, IcpOptions, PointPair, align_cameras, align_global,
-    align_points, refine_icp,
+    CameraPair, CamerasOptions, GlobalOptions, IcpOptions, PointPair, align_cameras, align_points,
+    refine_icp,
 };
 use crate::error::{Error, Result};
 use crate::geometry::Point3;
@@ -96,7 +97,7 @@ impl Default for AlignOptions {
 
 impl AlignOptions {
     /// The same seed for every stage.
-    pub fn with_seed(mut self, seed: u64) -> Self {
+    pub(crate) fn with_seed(mut self, seed: u64) -> Self {
         self.cameras.seed = seed;
         self.global.seed = seed;
         self.icp.seed = seed;
@@ -203,7 +204,7 @@ pub fn align(
 
 /// The stage notes of an alignment report as warning lines (`"alignment (icp): ..."`), for the
 /// report's `warnings`.
-pub fn stage_notes(report: &AlignmentReport) -> Vec<String> {
+pub(crate) fn stage_notes(report: &AlignmentReport) -> Vec<String> {
     report
         .stages
         .iter()

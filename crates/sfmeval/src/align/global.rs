@@ -325,7 +325,7 @@ fn lockstep(
 }
 
 /// The `global` stage: a coarse similarity from the shapes alone (see the module docs).
-pub fn align_global(
+pub(crate) fn align_global(
     gt: &PreparedGroundTruth,
     recon: &[Point3],
     opts: &GlobalOptions,

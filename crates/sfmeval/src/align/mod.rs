@@ -1,37 +1,39 @@
 //! Alignment of a reconstruction into the ground-truth frame by a similarity (rotation,
 //! translation, uniform scale), in stages that can run alone or chained:
 //!
-//! - [`mod@umeyama`]: the closed-form least-squares similarity between matched point sets;
-//! - [`ransac`] (`cameras`): matched camera centres (and orientations when the centres are
-//!   nearly collinear) inside a seeded LO-RANSAC loop;
-//! - [`points`] (`points`): user-given point pairs;
-//! - [`global`] (`global`): no correspondences at all — PCA / spread normalisation and a
+//! - [`umeyama()`]: the closed-form least-squares similarity between matched point sets;
+//! - `cameras` ([`align_cameras`]): matched camera centres (and orientations when the centres
+//!   are nearly collinear) inside a seeded LO-RANSAC loop;
+//! - `points` ([`align_points`]): user-given point pairs;
+//! - `global` ([`GlobalOptions`]): no correspondences at all — PCA / spread normalisation and a
 //!   multi-start search over rotations, each start scored by a short trimmed ICP;
-//! - [`icp`] (`icp`): trimmed, scaled ICP against the exact ground-truth surface with a
+//! - `icp` ([`refine_icp`]): trimmed, scaled ICP against the exact ground-truth surface with a
 //!   scale-collapse guard;
-//! - [`auto`]: `cameras` (or `points`, or `global`) then `icp`, with fallbacks named in the report.
+//! - `auto` ([`align()`]): `cameras` (or `points`, or `global`) then `icp`, with fallbacks named
+//!   in the report.
 //!
 //! Everything is deterministic: random choices come from a seeded ChaCha8 stream and parallel
 //! work goes through [`crate::parallel::map`], so results do not depend on the thread count.
 
-pub mod auto;
-pub mod global;
-pub mod icp;
-pub mod points;
-pub mod ransac;
-pub mod request;
-pub mod umeyama;
+mod auto;
+mod global;
+mod icp;
+mod points;
+mod ransac;
+mod request;
+mod umeyama;
 
 #[cfg(test)]
 mod tests;
 
-pub use auto::{AlignInput, AlignMethod, AlignOptions, align, stage_notes};
-pub use global::{GlobalOptions, align_global};
+pub(crate) use auto::stage_notes;
+pub use auto::{AlignInput, AlignMethod, AlignOptions, align};
+pub use global::GlobalOptions;
 pub use icp::{IcpOptions, refine_icp};
 pub use points::{PointPair, align_points, parse_point_pairs};
 pub use ransac::{CameraPair, CamerasOptions, align_cameras};
 pub use request::{AlignMode, AlignRequest};
-pub use umeyama::{umeyama, umeyama_weighted};
+pub use umeyama::umeyama;
 
 use nalgebra::{Matrix3, Vector3};
 use rand::{Rng as _, SeedableRng as _};
@@ -42,7 +44,7 @@ use crate::report::AlignmentStage;
 use crate::transform::Similarity;
 
 /// A row-major 3×3 rotation matrix.
-pub type Rotation = [[f64; 3]; 3];
+pub(crate) type Rotation = [[f64; 3]; 3];
 
 /// Builds the report entry of a stage.
 pub(crate) fn make_stage(
@@ -89,7 +91,7 @@ pub(crate) fn is_finite(p: &Point3) -> bool {
 }
 
 /// Angle in degrees between two rotations (the angle of `a·bᵀ`).
-pub fn rotation_angle_deg(a: &Rotation, b: &Rotation) -> f64 {
+pub(crate) fn rotation_angle_deg(a: &Rotation, b: &Rotation) -> f64 {
     let mut tr = 0.0;
     for i in 0..3 {
         for k in 0..3 {

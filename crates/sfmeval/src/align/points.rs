@@ -24,11 +24,11 @@ struct PairsFile {
 }
 
 /// The format name of every error about a pairs file ([`Error::concerns_point_pairs`]).
-pub const PAIRS_FORMAT: &str = crate::error::POINT_PAIRS_FORMAT;
+pub(crate) const PAIRS_FORMAT: &str = crate::error::POINT_PAIRS_FORMAT;
 
 /// Parses a point-pairs file: `{"pairs": [{"recon": [x, y, z], "gt": [x, y, z]}, ...]}`
 /// (a bare list of pairs is accepted too). Coordinates must be finite and within
-/// ±[`MAX_COORDINATE`] ([`Error::OutOfRange`] naming the pair and the side otherwise).
+/// ±1e50 ([`Error::OutOfRange`] naming the pair and the side otherwise).
 pub fn parse_point_pairs(bytes: &[u8]) -> Result<Vec<PointPair>> {
     let text =
         std::str::from_utf8(bytes).map_err(|_| Error::malformed(PAIRS_FORMAT, "not UTF-8 text"))?;

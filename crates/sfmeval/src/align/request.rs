@@ -115,7 +115,7 @@ impl AlignMode {
 
     /// The alignment stages to run (`None` for `given` and `none`): the first stage and
     /// whether ICP refines it.
-    pub fn stages(self) -> Option<(AlignMethod, bool)> {
+    pub(crate) fn stages(self) -> Option<(AlignMethod, bool)> {
         Some(match self {
             AlignMode::Auto => (AlignMethod::Auto, true),
             AlignMode::Cameras => (AlignMethod::Cameras, false),
@@ -195,17 +195,9 @@ impl AlignRequest {
         }
     }
 
-    /// A request that uses `t` as is.
-    pub fn given(t: Similarity) -> AlignRequest {
-        AlignRequest {
-            mode: AlignMode::Given,
-            transform: Some(t),
-            pairs: Vec::new(),
-        }
-    }
-
     /// A request that runs `mode`'s stages without a transform or pairs.
-    pub fn mode(mode: AlignMode) -> AlignRequest {
+    #[cfg(test)]
+    pub(crate) fn mode(mode: AlignMode) -> AlignRequest {
         AlignRequest {
             mode,
             ..AlignRequest::default()

@@ -10,7 +10,7 @@ use crate::transform::Similarity;
 
 /// Below this √(λ₂/λ₁) of the source covariance the points count as collinear: the rotation
 /// about their line is then undetermined.
-pub const COLLINEAR_RATIO: f64 = 1e-7;
+pub(crate) const COLLINEAR_RATIO: f64 = 1e-7;
 
 /// The similarity `dst ≈ s·R·src + t` minimising the sum of squared residuals; `with_scale =
 /// false` fixes `s = 1` (a rigid motion). Needs ≥ 3 finite, non-collinear pairs.
@@ -27,7 +27,7 @@ pub fn umeyama(src: &[Point3], dst: &[Point3], with_scale: bool) -> Result<Simil
 }
 
 /// [`umeyama`] with non-negative per-pair weights (`None` = all 1).
-pub fn umeyama_weighted(
+pub(crate) fn umeyama_weighted(
     src: &[Point3],
     dst: &[Point3],
     weights: Option<&[f64]>,

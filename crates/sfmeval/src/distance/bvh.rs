@@ -15,7 +15,7 @@ use parry3d_f64::shape::Triangle;
 use crate::geometry::{Point3, TriangleMesh};
 
 /// Most triangles in a leaf.
-pub const LEAF_SIZE: usize = 4;
+pub(crate) const LEAF_SIZE: usize = 4;
 
 /// Deepest tree the fixed traversal stack allows (median splits give ~log2(n / 4) + 1).
 const MAX_DEPTH: usize = 64;
@@ -46,7 +46,7 @@ impl Node {
 
 /// The closest point of the hierarchy's triangles to a query point.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Closest {
+pub(crate) struct Closest {
     /// Squared Euclidean distance.
     pub distance2: f64,
     /// The closest point.
@@ -58,7 +58,7 @@ pub struct Closest {
 }
 
 /// The hierarchy: nodes, the triangles in leaf order (vertex indices) and their input indices.
-pub struct TriangleBvh {
+pub(crate) struct TriangleBvh {
     nodes: Vec<Node>,
     vertices: Vec<Point3>,
     tris: Vec<[u32; 3]>,
@@ -80,7 +80,7 @@ fn up(v: f64) -> f32 {
 impl TriangleBvh {
     /// Builds the hierarchy by median splits of the triangle centroids along the longest axis.
     /// The mesh must be valid (vertex indices in range, finite vertices); deterministic.
-    pub fn new(mesh: &TriangleMesh) -> Self {
+    pub(crate) fn new(mesh: &TriangleMesh) -> Self {
         let centroids: Vec<Point3> = mesh
             .triangles
             .iter()
@@ -115,7 +115,8 @@ impl TriangleBvh {
     }
 
     /// Number of nodes (for tests and the memory estimate).
-    pub fn node_count(&self) -> usize {
+    #[cfg(test)]
+    pub(crate) fn node_count(&self) -> usize {
         self.nodes.len()
     }
 
@@ -130,7 +131,7 @@ impl TriangleBvh {
     }
 
     /// The exact closest surface point to `p`; `None` for an empty mesh or a non-finite `p`.
-    pub fn closest(&self, p: Point3) -> Option<Closest> {
+    pub(crate) fn closest(&self, p: Point3) -> Option<Closest> {
         if self.tris.is_empty() || !p.iter().all(|v| v.is_finite()) {
             return None;
         }

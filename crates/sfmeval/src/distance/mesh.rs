@@ -52,7 +52,7 @@ impl MeshIndex {
 
     /// Distance signed by the normal of the closest triangle (positive on the side the
     /// counter-clockwise normal points to), as CloudCompare's C2M does.
-    pub fn signed(&self, p: Point3, hit: &MeshHit) -> f64 {
+    pub(crate) fn signed(&self, p: Point3, hit: &MeshHit) -> f64 {
         // The triangle's normal, computed when asked (a stored one costs 24 bytes a triangle).
         let [a, b, c] = hit.corners;
         let n = cross(sub(b, a), sub(c, a));

@@ -1,8 +1,8 @@
 //! Distances from query points to the ground truth (mesh or cloud) and to clouds.
 
-pub mod bvh;
-pub mod cloud;
-pub mod mesh;
+mod bvh;
+mod cloud;
+mod mesh;
 
 pub use cloud::CloudIndex;
 pub use mesh::{MeshHit, MeshIndex};

@@ -108,14 +108,14 @@ fn split_glb(bytes: &[u8]) -> Result<(&[u8], Option<&[u8]>)> {
 
 /// Reads every triangle of the default scene (else scene 0, else every root node), with node
 /// transforms applied. `external` maps relative URIs of external buffers to their bytes. Uses the
-/// default [`ReadLimits`]; see [`read_gltf_with_limits`].
+/// default [`ReadLimits`].
 pub fn read_gltf(bytes: &[u8], external: &BTreeMap<String, Vec<u8>>) -> Result<GltfMesh> {
     read_gltf_with_limits(bytes, external, &ReadLimits::default())
 }
 
 /// [`read_gltf`] with explicit limits: the node graph is checked to be a tree and the expanded
 /// triangle and vertex counts are checked against `limits` before any accessor is decoded.
-pub fn read_gltf_with_limits(
+pub(crate) fn read_gltf_with_limits(
     bytes: &[u8],
     external: &BTreeMap<String, Vec<u8>>,
     limits: &ReadLimits,

@@ -109,12 +109,6 @@ impl ReadLimits {
         }
     }
 
-    /// No limit at all (tests and trusted inputs only).
-    pub const UNLIMITED: ReadLimits = ReadLimits {
-        max_triangles: u64::MAX,
-        max_vertices: u64::MAX,
-    };
-
     /// Fails with [`Error::LimitExceeded`] when a mesh of `triangles` and `vertices` is beyond
     /// the limits.
     pub fn check(&self, format: &'static str, triangles: u64, vertices: u64) -> Result<()> {

@@ -357,7 +357,7 @@ impl DepthMap {
 
     /// The depth of pixel (column `u`, row `v`); `None` outside the image.
     #[inline]
-    pub fn at(&self, u: usize, v: usize) -> Option<f64> {
+    pub(crate) fn at(&self, u: usize, v: usize) -> Option<f64> {
         if u >= self.width || v >= self.height {
             return None;
         }

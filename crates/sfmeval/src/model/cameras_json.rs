@@ -12,7 +12,7 @@ use crate::error::{Error, Result};
 const FMT: &str = "cameras.json";
 
 /// The schema id this reader accepts.
-pub const SCHEMA: &str = "sfmeval.cameras/1";
+pub(crate) const SCHEMA: &str = "sfmeval.cameras/1";
 
 #[derive(Deserialize)]
 struct File {
@@ -54,9 +54,9 @@ struct JsonPose {
     translation: [f64; 3],
 }
 
-/// Reads a `cameras.json`. The result's [`Reconstruction::warnings`] mention a non-`gltf`
-/// frame only when asked through [`frame_of`]; rotations are checked to be rotations
-/// (orthonormal, determinant +1, [`super::ROTATION_TOLERANCE`]) and cameras and poses for sense
+/// Reads a `cameras.json`. The result's [`Reconstruction::warnings`] mention a `frame` other
+/// than `gltf` or `reconstruction`; rotations are checked to be rotations (orthonormal,
+/// determinant +1, within a tolerance of 1e-4) and cameras and poses for sense
 /// ([`Reconstruction::validate`]).
 pub fn read_cameras_json(bytes: &[u8]) -> Result<Reconstruction> {
     let file: File = serde_json::from_slice(bytes).map_err(|e| {
@@ -194,7 +194,8 @@ pub fn read_cameras_json(bytes: &[u8]) -> Result<Reconstruction> {
 
 /// The `frame` field of a `cameras.json` (`gltf` for ground truth, `reconstruction` for a run),
 /// `None` when absent or unreadable.
-pub fn frame_of(bytes: &[u8]) -> Option<String> {
+#[cfg(test)]
+pub(crate) fn frame_of(bytes: &[u8]) -> Option<String> {
     let v: serde_json::Value = serde_json::from_slice(bytes).ok()?;
     v.get("frame")?.as_str().map(str::to_string)
 }

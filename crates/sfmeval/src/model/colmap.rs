@@ -1,7 +1,7 @@
 //! COLMAP sparse models, text (`cameras.txt`, `images.txt`, `points3D.txt`) and binary (`.bin`),
 //! from bytes. Accepts models written with or without `rigs`/`frames` files (COLMAP ≥ 3.12 adds
-//! them; `cameras` and `images` are unchanged, so they are ignored). [`read_colmap_folder`] takes
-//! a folder's files by relative path, finds every model in it (`sparse/0`, `sparse/1`, ...), uses
+//! them; `cameras` and `images` are unchanged, so they are ignored). The folder reader (reached
+//! through [`super::read_model_files`]) takes a folder's files by relative path, finds every model in it (`sparse/0`, `sparse/1`, ...), uses
 //! the largest and reports the others.
 //!
 //! Layouts: COLMAP `doc/format.rst`; camera models and parameter counts as pycolmap 4.2.1 lists
@@ -41,7 +41,7 @@ pub enum FocalLayout {
 }
 
 /// Every camera model of COLMAP 4 (ids 0..=17; COLMAP 3.8 stops at 10).
-pub const CAMERA_MODELS: [CameraModelInfo; 18] = {
+pub(crate) const CAMERA_MODELS: [CameraModelInfo; 18] = {
     use FocalLayout::{Double as D, None as N, Single as S};
     const fn m(
         id: i32,
@@ -79,7 +79,7 @@ pub const CAMERA_MODELS: [CameraModelInfo; 18] = {
 };
 
 /// The camera model with numeric id `id`.
-pub fn camera_model_by_id(id: i64) -> Option<&'static CameraModelInfo> {
+pub(crate) fn camera_model_by_id(id: i64) -> Option<&'static CameraModelInfo> {
     CAMERA_MODELS.iter().find(|m| i64::from(m.id) == id)
 }
 
@@ -91,7 +91,7 @@ pub fn camera_model_by_name(name: &str) -> Option<&'static CameraModelInfo> {
 }
 
 /// Builds a [`Camera`] from a COLMAP model and its parameters (count checked).
-pub fn camera_from_params(
+pub(crate) fn camera_from_params(
     format: &'static str,
     id: u64,
     model: &CameraModelInfo,
@@ -681,14 +681,14 @@ struct ModelFiles<'a> {
 /// COLMAP does); `points3D` is optional (a warning). Models under a `dense` folder (undistorted
 /// copies) are ignored when any other model exists. Returns the largest model; the others are
 /// listed in [`Reconstruction::sub_models`].
-pub fn read_colmap_folder(files: &BTreeMap<String, Vec<u8>>) -> Result<Reconstruction> {
+pub(crate) fn read_colmap_folder(files: &BTreeMap<String, Vec<u8>>) -> Result<Reconstruction> {
     let models = read_colmap_models(files)?;
     super::choose_largest(models)
 }
 
 /// Reads every COLMAP model of a folder (see [`read_colmap_folder`]), named by directory (`.`
 /// for the root), in path order.
-pub fn read_colmap_models(
+pub(crate) fn read_colmap_models(
     files: &BTreeMap<String, Vec<u8>>,
 ) -> Result<Vec<(String, Reconstruction)>> {
     let mut dirs: BTreeMap<String, ModelFiles> = BTreeMap::new();

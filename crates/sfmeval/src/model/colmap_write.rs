@@ -101,7 +101,7 @@ pub fn write_colmap_text(rec: &Reconstruction) -> BTreeMap<&'static str, String>
 }
 
 /// Unit quaternion `[w, x, y, z]` of a rotation matrix (Shepperd's method).
-pub fn quaternion(r: &[[f64; 3]; 3]) -> [f64; 4] {
+pub(crate) fn quaternion(r: &[[f64; 3]; 3]) -> [f64; 4] {
     let tr = r[0][0] + r[1][1] + r[2][2];
     let q = if tr > 0.0 {
         let s = libm::sqrt(tr + 1.0) * 2.0;

@@ -6,10 +6,11 @@
 use std::collections::BTreeMap;
 
 use super::Reconstruction;
+#[cfg(test)]
 use crate::geometry::Point3;
 
 /// The matching key of an image name: the file name without folders, extension lower-cased.
-pub fn image_key(name: &str) -> String {
+pub(crate) fn image_key(name: &str) -> String {
     let base = name.rsplit(['/', '\\']).next().unwrap_or(name).trim();
     match base.rsplit_once('.') {
         Some((stem, ext)) if !stem.is_empty() => format!("{stem}.{}", ext.to_ascii_lowercase()),
@@ -27,7 +28,7 @@ fn stem_key(name: &str) -> String {
 
 /// The result of [`match_images`].
 #[derive(Debug, Clone, PartialEq, Default)]
-pub struct ImageMatches {
+pub(crate) struct ImageMatches {
     /// `(ground-truth image index, estimated image index)` pairs, in ground-truth order.
     pub pairs: Vec<(usize, usize)>,
     /// Ground-truth images without an estimate (unregistered or absent).
@@ -40,14 +41,14 @@ pub struct ImageMatches {
 
 /// Matches the images of `est` to those of `gt` by [`image_key`] (then by unique stem).
 /// Duplicate keys on one side keep their first image and are reported.
-pub fn match_images(gt: &Reconstruction, est: &Reconstruction) -> ImageMatches {
+pub(crate) fn match_images(gt: &Reconstruction, est: &Reconstruction) -> ImageMatches {
     let gt_names: Vec<&str> = gt.images.iter().map(|i| i.name.as_str()).collect();
     let est_names: Vec<&str> = est.images.iter().map(|i| i.name.as_str()).collect();
     match_names(&gt_names, &est_names)
 }
 
 /// [`match_images`] on plain name lists.
-pub fn match_names(gt: &[&str], est: &[&str]) -> ImageMatches {
+pub(crate) fn match_names(gt: &[&str], est: &[&str]) -> ImageMatches {
     let mut out = ImageMatches::default();
     let index = |names: &[&str], key: fn(&str) -> String, side: &str, warn: &mut Vec<String>| {
         let mut map: BTreeMap<String, usize> = BTreeMap::new();
@@ -140,7 +141,8 @@ pub fn match_names(gt: &[&str], est: &[&str]) -> ImageMatches {
 
 /// The camera centres of matched images, `(ground truth, estimate)`, in match order: the input
 /// of a camera-based alignment.
-pub fn matched_centers(
+#[cfg(test)]
+pub(crate) fn matched_centers(
     gt: &Reconstruction,
     est: &Reconstruction,
     matches: &ImageMatches,

@@ -3,27 +3,27 @@
 //!
 //! | format | reader |
 //! |---|---|
-//! | COLMAP text / binary (`cameras`, `images`, `points3D`), one or several sub-models | [`colmap::read_colmap_folder`], [`colmap::read_colmap_text`], [`colmap::read_colmap_binary`] |
+//! | COLMAP text / binary (`cameras`, `images`, `points3D`), one or several sub-models | [`colmap::read_colmap_text`], [`colmap::read_colmap_binary`] |
 //! | VisualSfM NVM v3 (several models in one file) | [`nvm::read_nvm`] |
 //! | Bundler `.out` v0.3 + `list.txt` | [`bundler::read_bundler`] |
 //! | OpenMVG `sfm_data.json` | [`openmvg::read_openmvg_json`] |
 //! | `cameras.json` (`sfmeval.cameras/1`) | [`cameras_json::read_cameras_json`] |
-//! | any of the above among a folder's files, by content and name | [`read_model_files`], [`detect_model_format`] |
+//! | any of the above among a folder's files, by content and name | [`read_model_files`] |
 //!
 //! Poses are always `cam_from_world` in the OpenCV/COLMAP convention (x right, y down, z
 //! forward; `x_cam = R·X + t`), and intrinsics use COLMAP's pixel convention (the image centre is
-//! `(W/2, H/2)`), whatever the file's own convention. [`strip`] removes the camera centres that
-//! OpenMVG and Theia write into their PLY clouds; [`matching`] pairs images with ground-truth
-//! images by file name.
+//! `(W/2, H/2)`), whatever the file's own convention. Inside the crate, `strip` removes the camera centres
+//! that OpenMVG and Theia write into their PLY clouds and `matching` pairs images with
+//! ground-truth images by file name.
 
 pub mod bundler;
 pub mod cameras_json;
 pub mod colmap;
 pub mod colmap_write;
-pub mod matching;
+pub(crate) mod matching;
 pub mod nvm;
 pub mod openmvg;
-pub mod strip;
+pub(crate) mod strip;
 mod text;
 
 #[cfg(test)]
@@ -38,17 +38,17 @@ pub const MAX_IMAGE_SIZE: u64 = 1_000_000;
 
 /// Focal lengths must lie in `[MIN_FOCAL_PX, MAX_FOCAL_PX]` pixels (positive; a telephoto lens
 /// on a small-pixel sensor reaches 10⁶), except for models without one (equirectangular).
-pub const MIN_FOCAL_PX: f64 = 1e-6;
+pub(crate) const MIN_FOCAL_PX: f64 = 1e-6;
 
 /// See [`MIN_FOCAL_PX`]; principal points must also lie within ±`MAX_FOCAL_PX`.
-pub const MAX_FOCAL_PX: f64 = 1e9;
+pub(crate) const MAX_FOCAL_PX: f64 = 1e9;
 
 /// A rotation matrix is accepted when every entry of `R·Rᵀ − I` is within this and its
 /// determinant is positive (matrices written with 5 significant digits pass).
-pub const ROTATION_TOLERANCE: f64 = 1e-4;
+pub(crate) const ROTATION_TOLERANCE: f64 = 1e-4;
 
 /// A row-major 3×3 matrix.
-pub type Mat3 = [[f64; 3]; 3];
+pub(crate) type Mat3 = [[f64; 3]; 3];
 
 /// A rigid transform `x ↦ R·x + t`; for a camera pose, `cam_from_world`.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -68,7 +68,7 @@ impl Rigid {
 
     /// From a Hamilton quaternion `[w, x, y, z]` (normalised here) and a translation. `None`
     /// when the quaternion has zero or non-finite norm.
-    pub fn from_quaternion(q: [f64; 4], translation: Point3) -> Option<Rigid> {
+    pub(crate) fn from_quaternion(q: [f64; 4], translation: Point3) -> Option<Rigid> {
         Some(Rigid {
             rotation: quaternion_to_matrix(q)?,
             translation,
@@ -76,7 +76,7 @@ impl Rigid {
     }
 
     /// From a rotation and the camera centre `C` (so `t = −R·C`), as NVM and OpenMVG store it.
-    pub fn from_rotation_center(rotation: Mat3, center: Point3) -> Rigid {
+    pub(crate) fn from_rotation_center(rotation: Mat3, center: Point3) -> Rigid {
         let rc = mat_vec(&rotation, center);
         Rigid {
             rotation,
@@ -110,7 +110,7 @@ impl Rigid {
 /// Rotation matrix of a Hamilton quaternion `[w, x, y, z]`, normalised first (without overflow
 /// or underflow: any finite, non-zero quaternion is a rotation). `None` for a zero or
 /// non-finite quaternion.
-pub fn quaternion_to_matrix(q: [f64; 4]) -> Option<Mat3> {
+pub(crate) fn quaternion_to_matrix(q: [f64; 4]) -> Option<Mat3> {
     let m = q.iter().fold(0.0f64, |m, v| m.max(v.abs()));
     if !(m.is_finite() && m > 0.0) || q.iter().any(|v| !v.is_finite()) {
         return None;
@@ -139,17 +139,17 @@ pub fn quaternion_to_matrix(q: [f64; 4]) -> Option<Mat3> {
 }
 
 /// `M·v`.
-pub fn mat_vec(m: &Mat3, v: Point3) -> Point3 {
+pub(crate) fn mat_vec(m: &Mat3, v: Point3) -> Point3 {
     [0, 1, 2].map(|i| m[i][0] * v[0] + m[i][1] * v[1] + m[i][2] * v[2])
 }
 
 /// `Mᵀ·v`.
-pub fn mat_t_vec(m: &Mat3, v: Point3) -> Point3 {
+pub(crate) fn mat_t_vec(m: &Mat3, v: Point3) -> Point3 {
     [0, 1, 2].map(|i| m[0][i] * v[0] + m[1][i] * v[1] + m[2][i] * v[2])
 }
 
 /// `A·B`.
-pub fn mat_mul(a: &Mat3, b: &Mat3) -> Mat3 {
+pub(crate) fn mat_mul(a: &Mat3, b: &Mat3) -> Mat3 {
     let mut m = [[0.0; 3]; 3];
     for (i, row) in m.iter_mut().enumerate() {
         for (j, v) in row.iter_mut().enumerate() {
@@ -160,7 +160,7 @@ pub fn mat_mul(a: &Mat3, b: &Mat3) -> Mat3 {
 }
 
 /// `Mᵀ`.
-pub fn transpose(m: &Mat3) -> Mat3 {
+pub(crate) fn transpose(m: &Mat3) -> Mat3 {
     let mut t = [[0.0; 3]; 3];
     for (i, row) in t.iter_mut().enumerate() {
         for (j, v) in row.iter_mut().enumerate() {
@@ -172,7 +172,7 @@ pub fn transpose(m: &Mat3) -> Mat3 {
 
 /// `None` when `r` is a rotation within [`ROTATION_TOLERANCE`] (`R·Rᵀ = I`, determinant +1),
 /// else what is wrong.
-pub fn rotation_defect(r: &Mat3) -> Option<String> {
+pub(crate) fn rotation_defect(r: &Mat3) -> Option<String> {
     if r.iter().flatten().any(|v| !v.is_finite()) {
         return Some("has a non-finite entry".into());
     }
@@ -210,7 +210,7 @@ pub fn rotation_defect(r: &Mat3) -> Option<String> {
 
 /// Rotation angle of a rotation matrix in degrees, in `[0, 180]`; robust near 0 and 180°
 /// (`atan2` of the sine and cosine parts instead of `acos` of the trace).
-pub fn rotation_angle_deg(r: &Mat3) -> f64 {
+pub(crate) fn rotation_angle_deg(r: &Mat3) -> f64 {
     let cos = ((r[0][0] + r[1][1] + r[2][2]) - 1.0) / 2.0;
     let v = [r[2][1] - r[1][2], r[0][2] - r[2][0], r[1][0] - r[0][1]];
     let sin = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt() / 2.0;
@@ -243,7 +243,8 @@ pub struct Camera {
 
 impl Camera {
     /// A pinhole camera with one focal length and the given principal point.
-    pub fn simple(id: u64, model: &str, f: f64, cx: f64, cy: f64) -> Camera {
+    #[cfg(test)]
+    pub(crate) fn simple(id: u64, model: &str, f: f64, cx: f64, cy: f64) -> Camera {
         Camera {
             id,
             model: model.to_string(),
@@ -258,13 +259,13 @@ impl Camera {
     }
 
     /// Mean focal length `(fx + fy) / 2` in pixels.
-    pub fn focal(&self) -> f64 {
+    pub(crate) fn focal(&self) -> f64 {
         0.5 * (self.fx + self.fy)
     }
 
     /// Whether the model has a focal length at all (equirectangular / OpenMVG `spherical` have
     /// none: `fx = fy = 0`).
-    pub fn has_focal(&self) -> bool {
+    pub(crate) fn has_focal(&self) -> bool {
         let none = colmap::camera_model_by_name(&self.model)
             .is_some_and(|m| m.focal == colmap::FocalLayout::None);
         !(none || self.model.eq_ignore_ascii_case("spherical"))
@@ -273,8 +274,8 @@ impl Camera {
     /// Checks the intrinsics for sense; `item` names the camera in messages (`camera 3`,
     /// `camera 2 (image 'a.jpg')`). Errors ([`Error::OutOfRange`]): a width or height beyond
     /// [`MAX_IMAGE_SIZE`], only one of them 0, a focal length (of a model with one) outside
-    /// `[MIN_FOCAL_PX, MAX_FOCAL_PX]` — negative, zero or absurd —, a principal point or
-    /// parameter beyond ±[`MAX_FOCAL_PX`] / ±[`MAX_COORDINATE`], a non-finite value. Warnings
+    /// `[1e-6, 1e9]` px — negative, zero or absurd —, a principal point or parameter
+    /// beyond ±1e9 / ±1e50, a non-finite value. Warnings
     /// (returned): both sizes 0 (unknown) when `size_stored`, a principal point outside the
     /// image.
     pub fn check(
@@ -372,7 +373,7 @@ pub enum CameraWarning {
 
 impl CameraWarning {
     /// The warning for the cameras named in `items` (at most five are listed).
-    pub fn message(self, items: &[String]) -> String {
+    pub(crate) fn message(self, items: &[String]) -> String {
         let mut list = items.iter().take(5).cloned().collect::<Vec<_>>().join(", ");
         if items.len() > 5 {
             list.push_str(&format!(" and {} more", items.len() - 5));
@@ -489,7 +490,7 @@ impl Reconstruction {
     }
 
     /// Camera centres of the registered images, in image order.
-    pub fn camera_centers(&self) -> Vec<Point3> {
+    pub(crate) fn camera_centers(&self) -> Vec<Point3> {
         self.images.iter().map(Image::center).collect()
     }
 
@@ -514,7 +515,7 @@ impl Reconstruction {
     }
 
     /// The camera of an image, if present.
-    pub fn camera_of(&self, image: &Image) -> Option<&Camera> {
+    pub(crate) fn camera_of(&self, image: &Image) -> Option<&Camera> {
         self.cameras.iter().find(|c| c.id == image.camera_id)
     }
 
@@ -528,7 +529,7 @@ impl Reconstruction {
     }
 
     /// A summary of this model's size under `name`.
-    pub fn summary(&self, name: &str) -> SubModel {
+    pub(crate) fn summary(&self, name: &str) -> SubModel {
         SubModel {
             name: name.to_string(),
             images: self.images.len(),
@@ -538,8 +539,8 @@ impl Reconstruction {
 
     /// Checks what a reader returns, and adds its warnings: every camera's intrinsics
     /// ([`Camera::check`]; `size_stored` when the format stores the image size), every pose
-    /// (finite, a rotation within [`ROTATION_TOLERANCE`], translation and camera centre within
-    /// ±[`MAX_COORDINATE`]), every 3D point and 2D observation within ±[`MAX_COORDINATE`].
+    /// (finite, a rotation within 1e-4, translation and camera centre within ±1e50), every 3D
+    /// point and 2D observation within ±1e50.
     /// Errors name the camera or image and the field ([`Error::OutOfRange`]).
     pub fn validate(&mut self, format: &'static str, size_stored: bool) -> Result<()> {
         // One camera per image (NVM, Bundler): name the image too.
@@ -611,7 +612,7 @@ impl Reconstruction {
 
     /// Fails with [`Error::NonFinite`] when a pose or a point is NaN/infinite, and with
     /// [`Error::OutOfRange`] when a point lies beyond ±[`MAX_COORDINATE`].
-    pub fn check_finite(&self, format: &'static str) -> Result<()> {
+    pub(crate) fn check_finite(&self, format: &'static str) -> Result<()> {
         let bad: Vec<usize> = self
             .images
             .iter()
@@ -635,7 +636,7 @@ impl Reconstruction {
 /// Picks the largest model (most registered images, then most points; the first on ties) of
 /// several named ones and records the others in its [`Reconstruction::sub_models`] with a
 /// warning. Fails with [`Error::Empty`] when `models` is empty.
-pub fn choose_largest(models: Vec<(String, Reconstruction)>) -> Result<Reconstruction> {
+pub(crate) fn choose_largest(models: Vec<(String, Reconstruction)>) -> Result<Reconstruction> {
     let mut best: Option<usize> = None;
     for (i, (_, m)) in models.iter().enumerate() {
         let better = match best.and_then(|b| models.get(b)) {
@@ -677,7 +678,7 @@ pub fn choose_largest(models: Vec<(String, Reconstruction)>) -> Result<Reconstru
 
 /// An SfM model format [`detect_model_format`] recognises.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum ModelFormat {
+pub(crate) enum ModelFormat {
     /// A COLMAP model file (`cameras`/`images`/`points3D`, `.txt` or `.bin`).
     Colmap,
     /// VisualSfM NVM.
@@ -693,7 +694,7 @@ pub enum ModelFormat {
 /// Recognises an SfM model file by content first (`NVM_V3`, `# Bundle file`, JSON with
 /// `sfm_data_version`/`views` or `"schema": "sfmeval.cameras/1"` at its start or end), then by
 /// name.
-pub fn detect_model_format(name: &str, bytes: &[u8]) -> Option<ModelFormat> {
+pub(crate) fn detect_model_format(name: &str, bytes: &[u8]) -> Option<ModelFormat> {
     let base = name.rsplit(['/', '\\']).next().unwrap_or(name);
     let head = bytes.get(..bytes.len().min(4096)).unwrap_or_default();
     let head_text = String::from_utf8_lossy(head);

@@ -18,7 +18,7 @@ pub fn read_nvm(bytes: &[u8]) -> Result<Reconstruction> {
 }
 
 /// Reads every model of an NVM file, in file order, named `model 1`, `model 2`, ...
-pub fn read_nvm_models(bytes: &[u8]) -> Result<Vec<(String, Reconstruction)>> {
+pub(crate) fn read_nvm_models(bytes: &[u8]) -> Result<Vec<(String, Reconstruction)>> {
     let text = text::utf8(FMT, bytes)?;
     let lines: Vec<(usize, &str)> = text::data_lines(text, '#');
     let mut pos = 0usize;

@@ -12,7 +12,7 @@ use crate::geometry::{Aabb, Point3, PointCloud};
 
 /// What [`strip_camera_points`] removed.
 #[derive(Debug, Clone, PartialEq)]
-pub struct Stripped {
+pub(crate) struct Stripped {
     /// The cloud without the camera points.
     pub cloud: PointCloud,
     /// How many points were removed.
@@ -25,11 +25,11 @@ pub struct Stripped {
 }
 
 /// OpenMVG's marker colours: cameras, pose priors, control points.
-pub const MARKER_COLORS: [[u8; 3]; 3] = [[0, 255, 0], [0, 0, 255], [255, 0, 0]];
+pub(crate) const MARKER_COLORS: [[u8; 3]; 3] = [[0, 255, 0], [0, 0, 255], [255, 0, 0]];
 
 /// Relative tolerance (of the cloud's bounding-box diagonal) within which a point is taken to
 /// be a written camera centre. Writers print 6–9 significant digits.
-pub const CENTER_TOLERANCE: f64 = 1e-5;
+pub(crate) const CENTER_TOLERANCE: f64 = 1e-5;
 
 fn keep(cloud: &PointCloud, remove: &[bool]) -> PointCloud {
     let points = cloud
@@ -53,7 +53,11 @@ fn keep(cloud: &PointCloud, remove: &[bool]) -> PointCloud {
 /// of one of `centers`. When the cloud has colours, only points whose colour is the most common
 /// colour among the matches are marked (all centres are written in one colour), so a real point
 /// that happens to coincide keeps its place unless it has that colour too.
-pub fn mark_camera_centers(cloud: &PointCloud, centers: &[Point3], tolerance: f64) -> Vec<bool> {
+pub(crate) fn mark_camera_centers(
+    cloud: &PointCloud,
+    centers: &[Point3],
+    tolerance: f64,
+) -> Vec<bool> {
     let mut marks = vec![false; cloud.points.len()];
     let finite: Vec<Point3> = centers
         .iter()
@@ -107,7 +111,7 @@ pub fn mark_camera_centers(cloud: &PointCloud, centers: &[Point3], tolerance: f6
 
 /// Removes the points that coincide with known camera centres (see [`mark_camera_centers`]).
 /// Returns the cloud and the number removed.
-pub fn remove_camera_centers(cloud: &PointCloud, centers: &[Point3]) -> (PointCloud, usize) {
+pub(crate) fn remove_camera_centers(cloud: &PointCloud, centers: &[Point3]) -> (PointCloud, usize) {
     let marks = mark_camera_centers(cloud, centers, CENTER_TOLERANCE);
     let n = marks.iter().filter(|m| **m).count();
     (keep(cloud, &marks), n)
@@ -116,7 +120,7 @@ pub fn remove_camera_centers(cloud: &PointCloud, centers: &[Point3]) -> (PointCl
 /// Without known cameras: removes the leading and trailing runs of points whose colour is one
 /// of [`MARKER_COLORS`] (OpenMVG writes cameras first or last, Theia and openmvg-rs last), as
 /// long as at least one point remains. A cloud without colours is returned unchanged.
-pub fn remove_marker_runs(cloud: &PointCloud) -> (PointCloud, usize) {
+pub(crate) fn remove_marker_runs(cloud: &PointCloud) -> (PointCloud, usize) {
     let Some(colors) = &cloud.colors else {
         return (cloud.clone(), 0);
     };
@@ -138,7 +142,7 @@ pub fn remove_marker_runs(cloud: &PointCloud) -> (PointCloud, usize) {
 
 /// Removes camera-centre points from a cloud: by position when `centers` are given and match at
 /// least one point, else by marker colour runs. `source` names the cloud in the warning.
-pub fn strip_camera_points(
+pub(crate) fn strip_camera_points(
     cloud: &PointCloud,
     centers: Option<&[Point3]>,
     source: &str,

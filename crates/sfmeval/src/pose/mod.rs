@@ -145,7 +145,7 @@ pub struct CamerasReport {
 }
 
 /// Mean distance of points from their centroid (0 for fewer than 2 points).
-pub fn scene_radius(centers: &[Point3]) -> f64 {
+pub(crate) fn scene_radius(centers: &[Point3]) -> f64 {
     if centers.len() < 2 {
         return 0.0;
     }
@@ -160,7 +160,7 @@ pub fn scene_radius(centers: &[Point3]) -> f64 {
 }
 
 /// Angle in degrees between two vectors, `[0, 180]`; 0 when both are zero, 180 when only one is.
-pub fn vector_angle_deg(a: Point3, b: Point3) -> f64 {
+pub(crate) fn vector_angle_deg(a: Point3, b: Point3) -> f64 {
     let (na, nb) = (norm(a), norm(b));
     let tiny = 1e-300;
     match (na > tiny, nb > tiny) {
@@ -182,7 +182,7 @@ pub fn vector_angle_deg(a: Point3, b: Point3) -> f64 {
 /// AUC of the accuracy curve up to `max_deg`, sampled every degree: the mean over
 /// `k = 1..=max_deg` of the share of errors below `k` (numpy: `mean(cumsum(histogram(errors,
 /// bins=arange(max+1))) / n)`; the last bin includes its right edge).
-pub fn auc(errors: &[f64], max_deg: f64) -> f64 {
+pub(crate) fn auc(errors: &[f64], max_deg: f64) -> f64 {
     let bins = max_deg.floor().max(1.0) as usize;
     if errors.is_empty() {
         return 0.0;
@@ -231,7 +231,7 @@ pub fn evaluate_cameras(
 }
 
 /// [`evaluate_cameras`] with a given image matching.
-pub fn evaluate_cameras_matched(
+pub(crate) fn evaluate_cameras_matched(
     gt: &Reconstruction,
     est: &Reconstruction,
     matches: &ImageMatches,
