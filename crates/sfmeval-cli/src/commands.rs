@@ -99,6 +99,11 @@ struct InputArgs {
     /// fine), an .nvm, a Bundler .out, an OpenMVG sfm_data.json, or a cameras.json.
     #[arg(long, value_name = "PATH")]
     recon: PathBuf,
+    /// The reconstruction's name in the report and its notes (default: the file or folder
+    /// name). `sfmeval-runner report` and the page's Compare name a run `DATASET/PIPELINE`:
+    /// with that name the report is theirs byte for byte.
+    #[arg(long, value_name = "NAME")]
+    name: Option<String>,
     /// The SfM model (any format --recon takes) whose cameras go with a PLY --recon in the same
     /// frame: the PLY's points at the model's camera centres are removed (whatever their
     /// colour), and the model's cameras serve the camera alignment and the pose metrics. A
@@ -367,18 +372,14 @@ fn run_error(e: sfmeval::Error, input: &InputArgs) -> anyhow::Error {
 /// Reads the reconstruction of `--recon` (with `--recon-cameras`).
 fn read_recon(input: &InputArgs) -> Result<ReconInput> {
     let files = read_input_files(&input.recon)?;
+    let name = input.name.clone().unwrap_or_else(|| name_of(&input.recon));
     match &input.recon_cameras {
         Some(p) => {
             let cameras = model::read_model_files(&read_input_files(p)?)
                 .with_context(|| format!("reconstruction cameras '{}'", p.display()))?;
-            pipeline::read_reconstruction_with_cameras(
-                &name_of(&input.recon),
-                &files,
-                cameras,
-                &name_of(p),
-            )
+            pipeline::read_reconstruction_with_cameras(&name, &files, cameras, &name_of(p))
         }
-        None => read_reconstruction(&name_of(&input.recon), &files),
+        None => read_reconstruction(&name, &files),
     }
     .with_context(|| format!("reconstruction '{}'", input.recon.display()))
 }
