@@ -18,7 +18,7 @@ import sys
 import numpy as np
 import pytest
 
-from blender_testlib import BLENDER_SCRIPTS, REPO, have_bpy, run_generate
+from blender_testlib import BLENDER_SCRIPTS, have_bpy, release_bins, run_generate
 
 SCRIPT = os.path.join(os.path.dirname(os.path.abspath(__file__)), "blender_compare_script.py")
 TINY = ["--preset", "small", "--set", "render.samples=4", "--set", "outputs.depth=false",
@@ -28,19 +28,9 @@ GLTF_FROM_BLENDER = np.array([[1, 0, 0], [0, 0, 1], [0, -1, 0]], float)
 REAL = ["pycolmap", "pycolmap-global"]
 
 
-def _bin(env, name, package):
-    b = os.environ.get(env)
-    if b:
-        assert os.path.isfile(b), b
-        return b
-    subprocess.run(["cargo", "build", "--release", "-p", package], cwd=REPO, check=True)
-    return os.path.join(REPO, "target", "release", name)
-
-
 @pytest.fixture(scope="module")
 def bins():
-    return {"sfmeval": _bin("SFMEVAL_BIN", "sfmeval", "sfmeval-cli"),
-            "runner": _bin("SFMEVAL_RUNNER_BIN", "sfmeval-runner", "sfmeval-runner")}
+    return release_bins()
 
 
 @pytest.fixture(scope="module")
