@@ -10,6 +10,7 @@ import json
 import os
 import shlex
 import shutil
+import signal
 import subprocess
 import sys
 import time
@@ -48,6 +49,26 @@ def _runner_wrapper(tmp_path, runner, pidfile):
     return str(w)
 
 
+def _kill_runners(pidfile):
+    """After a failed run: the runners the wrapper logged (each leads a session and a group of
+    its own) and their tools' groups, if still there."""
+    if not pidfile.exists():
+        return
+    from sfmeval_blender.compare.run import _descendant_groups
+    for pid in map(int, pidfile.read_text().split()):
+        try:
+            with open("/proc/%d/cmdline" % pid, "rb") as f:
+                if b"sfmeval-runner" not in f.read():
+                    continue
+        except OSError:
+            continue
+        for g in _descendant_groups(pid) | {pid}:
+            try:
+                os.killpg(g, signal.SIGKILL)
+            except OSError:
+                pass
+
+
 def test_compare_run_and_cancel_in_a_window(tmp_path):
     """(a) the modal run returns to the event loop (the UI timer ticks while `fast` runs) and
     ends ok with run.json; (b) Cancel during `slow` ends the runner and the tool's process group
@@ -71,10 +92,18 @@ def test_compare_run_and_cancel_in_a_window(tmp_path):
            "--window-geometry", "0", "0", "1280", "1500", "-P", SCRIPT, "--", addon_zip, ds,
            bins["sfmeval"], runner, str(pidfile), SLEEP_ARG, str(out_json), str(png)]
     t0 = time.monotonic()
-    proc = subprocess.run(cmd, capture_output=True, text=True, env=env, timeout=180)
+    proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                            env=env, start_new_session=True)
+    try:
+        stdout, stderr = proc.communicate(timeout=180)
+    except subprocess.TimeoutExpired:
+        os.killpg(proc.pid, signal.SIGKILL)  # xvfb-run, Xvfb and Blender
+        stdout, stderr = proc.communicate()
+    finally:
+        _kill_runners(pidfile)
     sys.stderr.write("\n[compare window] Blender ran %.0f s\n" % (time.monotonic() - t0))
-    assert out_json.exists(), "no result (rc %d)\n%s\n%s" % (
-        proc.returncode, proc.stdout[-3000:], proc.stderr[-3000:])
+    assert out_json.exists(), "no result (rc %s)\n%s\n%s" % (
+        proc.returncode, stdout[-3000:], stderr[-3000:])
     res = json.loads(out_json.read_text())
     assert res["error"] is None, res["error"] + proc.stdout[-2000:]
     assert res["blender"].startswith("3."), res["blender"]
