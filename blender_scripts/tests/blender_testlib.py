@@ -34,6 +34,21 @@ def run_generate(args, python=None, timeout=900):
     return proc
 
 
+def _release_bin(env, name, package):
+    b = os.environ.get(env)
+    if b:
+        assert os.path.isfile(b), b
+        return b
+    subprocess.run(["cargo", "build", "--release", "-p", package], cwd=REPO, check=True)
+    return os.path.join(REPO, "target", "release", name)
+
+
+def release_bins():
+    """{"sfmeval", "runner"}: $SFMEVAL_BIN / $SFMEVAL_RUNNER_BIN, else built in target/release."""
+    return {"sfmeval": _release_bin("SFMEVAL_BIN", "sfmeval", "sfmeval-cli"),
+            "runner": _release_bin("SFMEVAL_RUNNER_BIN", "sfmeval-runner", "sfmeval-runner")}
+
+
 def run_blender(args, timeout=900):
     """Run the headless generator inside Debian's `blender` executable."""
     exe = shutil.which("blender")

@@ -6,6 +6,7 @@ the operator runs two real pipelines (pycolmap, pycolmap-global) through `sfmeva
 Debian's Blender 3.4 imports those same run folders (pre-made by the bpy test, to stay in the CI
 budget) and does the rest of the workflow itself. Beside the real runs: a failed run (a custom
 pipeline that exits 1, run by the real runner) and a corrupt one (a truncated sparse.ply).
+The crop sphere is checked on its own, on data/demo's model (no rendering).
 """
 
 import json
@@ -18,9 +19,10 @@ import sys
 import numpy as np
 import pytest
 
-from blender_testlib import BLENDER_SCRIPTS, REPO, have_bpy, run_generate
+from blender_testlib import BLENDER_SCRIPTS, REPO, have_bpy, release_bins, run_generate
 
 SCRIPT = os.path.join(os.path.dirname(os.path.abspath(__file__)), "blender_compare_script.py")
+SPHERE_SCRIPT = os.path.join(os.path.dirname(SCRIPT), "blender_crop_sphere_script.py")
 TINY = ["--preset", "small", "--set", "render.samples=4", "--set", "outputs.depth=false",
         "--set", "views.orbits=[{elevation_deg=20.0,count=12},"
                  "{elevation_deg=45.0,count=12,azimuth_offset_deg=10.0}]"]
@@ -28,19 +30,9 @@ GLTF_FROM_BLENDER = np.array([[1, 0, 0], [0, 0, 1], [0, -1, 0]], float)
 REAL = ["pycolmap", "pycolmap-global"]
 
 
-def _bin(env, name, package):
-    b = os.environ.get(env)
-    if b:
-        assert os.path.isfile(b), b
-        return b
-    subprocess.run(["cargo", "build", "--release", "-p", package], cwd=REPO, check=True)
-    return os.path.join(REPO, "target", "release", name)
-
-
 @pytest.fixture(scope="module")
 def bins():
-    return {"sfmeval": _bin("SFMEVAL_BIN", "sfmeval", "sfmeval-cli"),
-            "runner": _bin("SFMEVAL_RUNNER_BIN", "sfmeval-runner", "sfmeval-runner")}
+    return release_bins()
 
 
 @pytest.fixture(scope="module")
@@ -387,3 +379,39 @@ def test_binaries_are_found_in_preferences_path_or_target_release(bins, tmp_path
     with pytest.raises(tools.ToolMissing, match="not found on PATH.*cargo build --release -p "
                                                 "sfmeval-runner"):
         tools.find("sfmeval-runner")
+
+
+def test_crop_sphere_is_written_and_matches_the_cli(addon_zip, bins, tmp_path):
+    """A crop sphere (Debian Blender 3.4, headless, data/demo's model imported as a file): the
+    sfmeval.crop/1 file holds the sphere as placed, and the add-on's report is byte for byte
+    the CLI's on the same points, crop file and alignment."""
+    exe = shutil.which("blender")
+    assert exe, "Debian blender not installed (apt-get install blender python3-numpy)"
+    ds = tmp_path / "demo"
+    shutil.copytree(os.path.join(REPO, "data", "demo"), ds)
+    out = tmp_path / "sphere.json"
+    env = dict(os.environ, BLENDER_USER_SCRIPTS=str(tmp_path / "user_scripts"),
+               BLENDER_USER_CONFIG=str(tmp_path / "user_config"))
+    proc = subprocess.run([exe, "-b", "--factory-startup", "-noaudio", "--python-exit-code", "1",
+                           "-P", SPHERE_SCRIPT, "--", addon_zip, str(ds), str(out),
+                           bins["sfmeval"]], capture_output=True, text=True, env=env,
+                          timeout=300)
+    assert proc.returncode == 0 and "SPHERE DONE" in proc.stdout, \
+        proc.stdout[-4000:] + proc.stderr[-4000:]
+    res = json.loads(out.read_text())
+    with open(ds / "compare" / "crop.json") as f:
+        crop = json.load(f)
+    M = np.array(res["crop_matrix"])
+    assert crop["schema"] == "sfmeval.crop/1" and crop["max_distance"] == pytest.approx(0.05)
+    assert crop["volume"]["kind"] == "sphere"
+    assert np.allclose(crop["volume"]["center"], GLTF_FROM_BLENDER @ M[:3, 3], atol=1e-7)
+    assert crop["volume"]["radius"] == pytest.approx(0.35, abs=1e-7)
+    with open(res["report"], "rb") as f:
+        raw = f.read()
+    rep = json.loads(raw)
+    assert rep["crop"]["kind"] == "sphere+max_distance", rep["crop"]
+    assert rep["crop"]["discarded_outside_volume"] > 0 and rep["crop"]["kept"] > 0, rep["crop"]
+    mine, rows, _ = _eval(bins, str(ds), res, tmp_path)
+    assert mine.read_bytes() == raw, "the add-on's report differs from the CLI's"
+    assert res["summary"]["points"] == rep["crop"]["kept"]
+    assert res["summary"]["mean"] == rep["accuracy"]["mean"]

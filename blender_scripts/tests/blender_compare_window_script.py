@@ -1,0 +1,178 @@
+"""Driven by test_blender_compare_window.py inside Debian's Blender with a real window (under
+xvfb-run): the Compare panel's run operator runs modally; a timer (a stand-in for the user)
+presses the buttons, records what it sees and dumps it to JSON, then quits.
+
+1. Run `fast` (a custom pipeline: a short sleep, then a copy of a COLMAP model): the timer keeps
+   ticking while it runs, and it ends ok.
+2. Run `slow` (a custom pipeline sleeping a minute); once its tool is up, press Cancel: the
+   runner and the tool's process group must go, the row say cancelled, the timer keep ticking.
+3. A screenshot of the window.
+
+argv (after --): ZIP DATASET SFMEVAL RUNNER PIDFILE SLEEP_ARG OUT_JSON OUT_PNG
+RUNNER is a wrapper of sfmeval-runner adding the two `--custom` pipelines; for `run` it appends
+its pid (the runner's, it execs) to PIDFILE. SLEEP_ARG is the slow tool's unique `sleep` argument.
+"""
+
+import json
+import os
+import sys
+import time
+import traceback
+
+import bpy
+
+argv = sys.argv[sys.argv.index("--") + 1:]
+zip_path, ds, sfmeval_bin, runner_bin, pidfile, sleep_arg, out_json, png = argv
+bpy.context.preferences.view.show_splash = False
+bpy.ops.preferences.addon_install(filepath=zip_path, overwrite=True)
+bpy.ops.preferences.addon_enable(module="sfmeval_blender")
+prefs = bpy.context.preferences.addons["sfmeval_blender"].preferences
+prefs.sfmeval_path, prefs.runner_path = sfmeval_bin, runner_bin
+from sfmeval_blender.compare import panel as cpanel  # noqa: E402
+
+TICK = 0.25
+res = {"blender": bpy.app.version_string, "ticks": [], "phases": {}}
+state = {"phase": "start", "t0": time.monotonic(), "since": time.monotonic()}
+
+
+def now():
+    return time.monotonic() - state["t0"]
+
+
+def goto(phase):
+    res["phases"][phase] = now()
+    state.update(phase=phase, since=time.monotonic())
+
+
+def alive(pid):
+    """The process exists and is not a zombie."""
+    try:
+        with open("/proc/%d/stat" % pid) as f:
+            return f.read().rsplit(") ", 1)[1][0] != "Z"
+    except (OSError, IndexError):
+        return False
+
+
+def group_alive(pgid):
+    """Some live process is in process group `pgid`."""
+    for e in os.listdir("/proc"):
+        if e.isdigit():
+            try:
+                with open("/proc/%s/stat" % e) as f:
+                    fields = f.read().rsplit(") ", 1)[1].split()
+            except (OSError, IndexError):
+                continue
+            if fields[0] != "Z" and int(fields[2]) == pgid:
+                return True
+    return False
+
+
+def find_sleeper():
+    for e in os.listdir("/proc"):
+        if e.isdigit():
+            try:
+                with open("/proc/%s/cmdline" % e, "rb") as f:
+                    if f.read().split(b"\0")[:2] == [b"sleep", sleep_arg.encode()]:
+                        return int(e)
+            except OSError:
+                pass
+    return None
+
+
+def panel_labels(scene):
+    """The labels the panel's draw() writes (a fake layout records them)."""
+    labels = []
+
+    class L:
+        def __getattr__(self, name):
+            if name == "label":
+                return lambda text="", **k: labels.append(text)
+            return lambda *a, **k: L()
+
+        def __setattr__(self, k, v):
+            pass
+
+    ctx = type("Ctx", (), {"scene": scene, "preferences": bpy.context.preferences})()
+    bpy.types.SFMEVAL_PT_compare.draw(type("P", (), {"layout": L()})(), ctx)
+    return labels
+
+
+def finish(error=None):
+    res["error"] = error
+    with open(out_json, "w") as f:
+        json.dump(res, f, indent=1)
+    bpy.ops.wm.quit_blender()
+
+
+def tick():
+    try:
+        return _tick()
+    except Exception:
+        finish(traceback.format_exc())
+        return None
+
+
+def _tick():
+    scene = bpy.context.scene
+    c = scene.sfmeval_compare
+    win = bpy.context.window_manager.windows[0]
+    area = next(a for a in win.screen.areas if a.type == "VIEW_3D")
+    region = next(r for r in area.regions if r.type == "WINDOW")
+    res["ticks"].append([now(), state["phase"], cpanel._STATE["running"]])
+    if time.monotonic() - state["since"] > 40:
+        finish("phase %s took over 40 s" % state["phase"])
+        return None
+    with bpy.context.temp_override(window=win, area=area, region=region, scene=scene):
+        phase = state["phase"]
+        if phase == "start":
+            area.spaces.active.show_region_ui = True
+            # for the screenshot: the panel on top of the sidebar's default tab (Blender 3.4
+            # cannot switch tabs from Python)
+            pt = bpy.types.SFMEVAL_PT_compare
+            bpy.utils.unregister_class(pt)
+            pt.bl_category, pt.bl_order = "Item", -1
+            bpy.utils.register_class(pt)
+            c.dataset_dir = ds
+            assert bpy.ops.sfmeval.compare_pipelines() == {"FINISHED"}, c.message
+            res["listed"] = {p.name: p.installed for p in c.pipelines}
+            c.pipelines["fast"].selected = True
+            res["fast_invoke"] = sorted(bpy.ops.sfmeval.compare_run("INVOKE_DEFAULT"))
+            goto("fast")
+        elif phase == "fast":
+            if not cpanel._STATE["running"]:
+                p = c.pipelines["fast"]
+                res["fast"] = [p.state, p.elapsed, p.message]
+                c.pipelines["fast"].selected = False
+                c.pipelines["slow"].selected = True
+                res["slow_invoke"] = sorted(bpy.ops.sfmeval.compare_run("INVOKE_DEFAULT"))
+                goto("slow")
+        elif phase == "slow":
+            sleeper = find_sleeper()
+            if sleeper is not None:
+                with open(pidfile) as f:
+                    res["runner_pid"] = int(f.read().split()[-1])
+                res["sleeper_pid"], res["tool_pgid"] = sleeper, os.getpgid(sleeper)
+                res["before_cancel"] = [alive(res["runner_pid"]), group_alive(res["tool_pgid"]),
+                                        c.pipelines["slow"].state]
+                res["cancel_result"] = sorted(bpy.ops.sfmeval.compare_cancel())
+                goto("cancelled")
+        elif phase == "cancelled":
+            if "gone" not in res and not alive(res["runner_pid"]) \
+                    and not group_alive(res["tool_pgid"]):
+                res["gone"] = now()
+            # a second after the modal run ended: the timer still ticks (Blender responsive)
+            if "gone" in res and not cpanel._STATE["running"] \
+                    and time.monotonic() - state["since"] > 1.0:
+                p = c.pipelines["slow"]
+                res["slow"] = [p.state, p.elapsed, p.message]
+                res["labels"] = panel_labels(scene)
+                res["log"] = bpy.data.texts["sfmeval runs"].as_string()
+                goto("shoot")
+        elif phase == "shoot":
+            bpy.ops.screen.screenshot(filepath=png)
+            finish()
+            return None
+    return TICK
+
+
+bpy.app.timers.register(tick, first_interval=1.0)
