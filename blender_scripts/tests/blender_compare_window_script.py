@@ -6,7 +6,9 @@ presses the buttons, records what it sees and dumps it to JSON, then quits.
    ticking while it runs, and it ends ok.
 2. Run `slow` (a custom pipeline sleeping a minute); once its tool is up, press Cancel: the
    runner and the tool's process group must go, the row say cancelled, the timer keep ticking.
-3. A screenshot of the window.
+3. Import the runs (`fast`), evaluate them, frame the points in Solid shading and take a
+   screenshot of the window (OUT_PNG: the points in their viridis colours, the add-on set Color:
+   Attribute), then one with Color: Single (OUT_PNG with "-single" before ".png").
 
 argv (after --): ZIP DATASET SFMEVAL RUNNER PIDFILE SLEEP_ARG OUT_JSON OUT_PNG
 RUNNER is a wrapper of sfmeval-runner adding the two `--custom` pipelines; for `run` it appends
@@ -20,6 +22,7 @@ import time
 import traceback
 
 import bpy
+import numpy as np
 
 argv = sys.argv[sys.argv.index("--") + 1:]
 zip_path, ds, sfmeval_bin, runner_bin, pidfile, sleep_arg, out_json, png = argv
@@ -167,9 +170,40 @@ def _tick():
                 res["slow"] = [p.state, p.elapsed, p.message]
                 res["labels"] = panel_labels(scene)
                 res["log"] = bpy.data.texts["sfmeval runs"].as_string()
+                shading = area.spaces.active.shading
+                shading.type = "SOLID"
+                res["color_type_before"] = shading.color_type
+                assert bpy.ops.sfmeval.compare_import_runs() == {"FINISHED"}, c.message
+                assert bpy.ops.sfmeval.compare_evaluate() == {"FINISHED"}, c.message
+                obj = c.recons["fast"].object
+                res["fast_status"] = [c.recons["fast"].status, c.recons["fast"].message]
+                res["color_type"] = shading.color_type
+                me = obj.data
+                res["active_color"] = (me.color_attributes.active_color.name
+                                       if me.color_attributes.active_color else None)
+                res["vertices"] = len(me.vertices)
+                # the points framed (the startup cube, which would hide them, removed)
+                if "Cube" in bpy.data.objects:
+                    bpy.data.objects.remove(bpy.data.objects["Cube"])
+                co = np.array([obj.matrix_world @ v.co for v in me.vertices])
+                lo, hi = np.percentile(co, [10, 90], axis=0)  # (outliers far off)
+                r3d = area.spaces.active.region_3d
+                r3d.view_location = ((lo + hi) / 2).tolist()
+                r3d.view_distance = 1.5 * float(np.linalg.norm(hi - lo))
+                # the 3D view's drawing region in the window (origin bottom left) left of the
+                # sidebar, which overlaps it
+                ui = next(r for r in area.regions if r.type == "UI")
+                res["view_region"] = [region.x - win.x, region.y - win.y,
+                                      min(region.width, ui.x - region.x), region.height]
                 goto("shoot")
+                return 3.0
         elif phase == "shoot":
             bpy.ops.screen.screenshot(filepath=png)
+            area.spaces.active.shading.color_type = "SINGLE"
+            goto("shoot_single")
+            return 3.0
+        elif phase == "shoot_single":
+            bpy.ops.screen.screenshot(filepath=png[:-len(".png")] + "-single.png")
             finish()
             return None
     return TICK

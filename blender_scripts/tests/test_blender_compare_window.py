@@ -69,11 +69,30 @@ def _kill_runners(pidfile):
                 pass
 
 
+def viridis_pixels(png, region):
+    """How many pixels of the window screenshot's `region` ([x, y, width, height], origin bottom
+    left) are saturated colours with a hue in viridis' range (purple 290° → yellow 50°)."""
+    from PIL import Image
+    img = np.asarray(Image.open(png).convert("RGB")).astype(float)
+    x, y, w, h = region
+    top = img.shape[0] - (y + h)
+    px = img[max(top, 0):top + h, x:x + w].reshape(-1, 3)
+    hi, lo = px.max(1), px.min(1)
+    sat = (hi - lo) / np.maximum(hi, 1)
+    r, g, b = px.T
+    d = np.maximum(hi - lo, 1e-9)
+    hue = np.where(hi == r, (g - b) / d % 6, np.where(hi == g, (b - r) / d + 2, (r - g) / d + 4))
+    hue = hue * 60.0
+    return int(np.count_nonzero((sat > 0.35) & (hi > 50) & (hue > 45) & (hue < 300)))
+
+
 def test_compare_run_and_cancel_in_a_window(tmp_path):
     """(a) the modal run returns to the event loop (the UI timer ticks while `fast` runs) and
     ends ok with run.json; (b) Cancel during `slow` ends the runner and the tool's process group
     within seconds, the row says cancelled, the timer keeps ticking; (c) the screenshot is not
-    blank."""
+    blank; (d) `fast` imported and evaluated: Solid shading shows its points in their viridis
+    colours (Blender 3.4: spheres on the points carrying ``sfmeval_color``, Color: Attribute set
+    by the add-on), far more coloured pixels than with Color: Single."""
     xvfb, blender = shutil.which("xvfb-run"), shutil.which("blender")
     assert xvfb and shutil.which("xauth"), \
         "xvfb-run/xauth not installed: apt-get install xvfb xauth (requirements/apt-blender.txt)"
@@ -130,7 +149,8 @@ def test_compare_run_and_cancel_in_a_window(tmp_path):
     assert not os.path.exists(os.path.join(ds, "runs", "demo", "slow", "run.json"))
     # responsive throughout: no gap between UI ticks over 4 s (software GL redraws
     # take about a second), ticks after the run ended
-    times = [t[0] for t in ticks]
+    # (the screenshots' phases wait for redraws on purpose)
+    times = [t[0] for t in ticks if not t[1].startswith("shoot")]
     assert max(np.diff(times)) < 4.0, max(np.diff(times))
     assert any(t[1] == "cancelled" and not t[2] for t in ticks), ticks
     # (c) the screenshot: the window, not a blank image
@@ -138,3 +158,14 @@ def test_compare_run_and_cancel_in_a_window(tmp_path):
     img = np.asarray(Image.open(png).convert("RGB"))
     assert img.shape[0] >= 600 and img.shape[1] >= 800, img.shape
     assert img.std() > 10 and len(np.unique(img.reshape(-1, 3), axis=0)) > 50
+    # (d) the points' colours in Solid shading
+    assert res["fast_status"][0] == "ok", res["fast_status"]
+    assert res["color_type"] == "VERTEX", (res["color_type_before"], res["color_type"])
+    assert res["active_color"] == "sfmeval_color", res["active_color"]
+    assert res["vertices"] == rec["points"], (res["vertices"], rec["points"])
+    single = str(png)[:-len(".png")] + "-single.png"
+    n_color = viridis_pixels(png, res["view_region"])
+    n_single = viridis_pixels(single, res["view_region"])
+    sys.stderr.write("[compare window] viridis pixels: %d coloured, %d single\n"
+                     % (n_color, n_single))
+    assert n_color > 2000 and n_color > 5 * n_single, (n_color, n_single)

@@ -108,7 +108,9 @@ def new_points_object(context, name, points, cameras_json=None):
     obj.parent = gt_frame(context)
     obj.matrix_parent_inverse.identity()
     if len(pts):
-        size = float(np.linalg.norm(pts.max(0) - pts.min(0)))
+        # the cloud's extent without its few far outliers (which would make the points huge)
+        lo, hi = np.percentile(pts, [2, 98], axis=0)
+        size = float(np.linalg.norm(hi - lo))
         obj["sfmeval_display"] = show_as_points(obj, max(size, 1e-9) * 0.004)
     if cameras_json and os.path.isfile(cameras_json):
         add_cameras(coll, obj, cameras_json)
@@ -130,9 +132,17 @@ def _points_material():
     return mat
 
 
+# Point clouds: Solid shading never colours them and EEVEE draws them only from 4.2 on (EEVEE
+# Next; Debian's 3.4 shows them grey, Blender 5 in colour). Before 4.2 the points are tiny ico
+# spheres instead: real faces carrying ``sfmeval_color`` (and the active colour attribute).
+POINTS_AS_SPHERES = bpy.app.version < (4, 2, 0)
+
+
 def show_as_points(obj, radius):
     """A geometry-nodes modifier drawing the loose vertices as points of `radius` (the mesh,
-    which the evaluation reads, is unchanged). Returns an error text, or "" when done."""
+    which the evaluation reads, is unchanged): a point cloud in Blender 4.2+, else a low-poly
+    sphere on every vertex (realized, so ``sfmeval_color`` reaches Solid shading's Attribute
+    colour). Returns an error text, or "" when done."""
     try:
         ng = bpy.data.node_groups.new("sfmeval points", "GeometryNodeTree")
         if hasattr(ng, "interface"):  # Blender 4+
@@ -143,18 +153,40 @@ def show_as_points(obj, radius):
             ng.outputs.new("NodeSocketGeometry", "Geometry")
         gi = ng.nodes.new("NodeGroupInput")
         go = ng.nodes.new("NodeGroupOutput")
-        m2p = ng.nodes.new("GeometryNodeMeshToPoints")
-        m2p.inputs["Radius"].default_value = radius
         sm = ng.nodes.new("GeometryNodeSetMaterial")
         sm.inputs["Material"].default_value = _points_material()
-        ng.links.new(gi.outputs[0], m2p.inputs["Mesh"])
-        ng.links.new(m2p.outputs["Points"], sm.inputs["Geometry"])
+        if POINTS_AS_SPHERES:
+            ico = ng.nodes.new("GeometryNodeMeshIcoSphere")
+            ico.inputs["Radius"].default_value = radius
+            ico.inputs["Subdivisions"].default_value = 1
+            iop = ng.nodes.new("GeometryNodeInstanceOnPoints")
+            real = ng.nodes.new("GeometryNodeRealizeInstances")
+            ng.links.new(gi.outputs[0], iop.inputs["Points"])
+            ng.links.new(ico.outputs["Mesh"], iop.inputs["Instance"])
+            ng.links.new(iop.outputs["Instances"], real.inputs["Geometry"])
+            ng.links.new(real.outputs["Geometry"], sm.inputs["Geometry"])
+        else:
+            m2p = ng.nodes.new("GeometryNodeMeshToPoints")
+            m2p.inputs["Radius"].default_value = radius
+            ng.links.new(gi.outputs[0], m2p.inputs["Mesh"])
+            ng.links.new(m2p.outputs["Points"], sm.inputs["Geometry"])
         ng.links.new(sm.outputs["Geometry"], go.inputs[0])
         mod = obj.modifiers.new("sfmeval points", "NODES")
         mod.node_group = ng
         return ""
     except Exception as exc:  # display only: never fail the import for it
         return "points display: %s" % exc
+
+
+def show_colors(context):
+    """Solid shading coloured by the active colour attribute (``sfmeval_color``: Color:
+    Attribute, enum VERTEX) in the 3D views of the window, if there is one."""
+    screen = getattr(context, "screen", None)
+    for area in (screen.areas if screen else ()):
+        if area.type == "VIEW_3D":
+            for space in area.spaces:
+                if space.type == "VIEW_3D":
+                    space.shading.color_type = "VERTEX"  # shown as "Attribute"
 
 
 def add_cameras(coll, parent, path):
@@ -283,9 +315,15 @@ def paint(obj, distances, status, clip):
     else:  # pragma: no cover
         col = mesh.attributes.new("sfmeval_color", "FLOAT_COLOR", "POINT")
     col.data.foreach_set("color", rgba.ravel())
+    # Solid shading's Color: Attribute draws the active one (the spheres of show_as_points keep
+    # it through Realize Instances in Blender 3.4); the render one too, for the exporters
     if hasattr(mesh.color_attributes, "active_color"):
-        mesh.color_attributes.active_color = col  # Solid shading, Color: Attribute
+        mesh.color_attributes.active_color = col
+    if hasattr(mesh.color_attributes, "render_color_index"):
+        mesh.color_attributes.render_color_index = [a.name for a in mesh.color_attributes].index(
+            "sfmeval_color")
     mesh.update()
+    show_colors(bpy.context)
 
 
 def align_item(context, sfmeval, item, mode):
