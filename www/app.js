@@ -2,6 +2,7 @@
 import { Viewer } from './viewer.js';
 import { histogramPlot, curvesPlot, VIRIDIS } from './plots.js';
 import { setupCompare, drawCameras } from './compare.js';
+import { dropZone, entryFiles } from './files.js';
 
 const $ = (id) => document.getElementById(id);
 const state = {
@@ -340,44 +341,17 @@ $('dir-recon').addEventListener('change', (e) => handleFiles('recon', e.target.f
 $('dir-depth').addEventListener('change', (e) => handleFiles('depth', e.target.files));
 for (const [kind, input] of [['recon', 'file-recon'], ['gt', 'file-gt'], ['cams', 'file-cams'], ['depth', 'file-depth']]) {
   $(input).addEventListener('change', (e) => handleFiles(kind, e.target.files));
-  const zone = $(`drop-${kind}`);
-  zone.addEventListener('dragover', (e) => { e.preventDefault(); zone.classList.add('over'); });
-  zone.addEventListener('dragleave', () => zone.classList.remove('over'));
-  zone.addEventListener('drop', async (e) => {
-    e.preventDefault();
-    zone.classList.remove('over');
-    const entries = Array.from(e.dataTransfer.items || []).map((i) => i.webkitGetAsEntry && i.webkitGetAsEntry()).filter(Boolean);
+  dropZone($(`drop-${kind}`), async (entries, files) => {
     if ((kind === 'recon' || kind === 'depth') && entries.length === 1 && entries[0].isDirectory) {
       try { handleFiles(kind, await folderFiles(entries[0])); } catch (err) { inputFailed(kind, err); }
     } else {
-      handleFiles(kind, e.dataTransfer.files);
+      handleFiles(kind, files);
     }
   });
 }
-/** The files under a dropped folder, with webkitRelativePath-like names. */
+/** The model or depth-map files under a dropped folder, with webkitRelativePath-like names. */
 async function folderFiles(dir) {
-  const out = [];
-  const walk = async (entry, path) => {
-    if (entry.isFile) {
-      const f = await new Promise((res, rej) => entry.file(res, rej));
-      out.push(new File([f], f.name));
-      Object.defineProperty(out[out.length - 1], 'webkitRelativePath', { value: `${path}${f.name}` });
-    } else if (entry.isDirectory) {
-      const reader = entry.createReader();
-      for (;;) {
-        const batch = await new Promise((res, rej) => reader.readEntries(res, rej));
-        if (!batch.length) break;
-        for (const c of batch) await walk(c, `${path}${entry.name}/`.replace(/^\//, ''));
-      }
-    }
-  };
-  const reader = dir.createReader();
-  for (;;) {
-    const batch = await new Promise((res, rej) => reader.readEntries(res, rej));
-    if (!batch.length) break;
-    for (const c of batch) await walk(c, `${dir.name}/`);
-  }
-  return out.filter((f) => /\.(bin|txt|nvm|out|json|ply|npy)$/i.test(f.name));
+  return (await entryFiles(dir)).filter((f) => /\.(bin|txt|nvm|out|json|ply|npy)$/i.test(f.name));
 }
 
 function handleFiles(kind, files) {

@@ -6,6 +6,7 @@
 // overlaid P/R/F curves and the viewers' choice of reconstruction live here.
 import uPlot from 'uplot';
 import { Viewer } from './viewer.js';
+import { dropZone, entryFiles } from './files.js';
 
 const $ = (id) => document.getElementById(id);
 const esc = (s) => String(s).replace(/[&<>"]/g, (c) => ({ '&': '&amp;', '<': '&lt;', '>': '&gt;', '"': '&quot;' }[c]));
@@ -155,17 +156,11 @@ export function setupCompare({ call, viewer, measureOptions, showError, download
   };
   $('file-runs').addEventListener('change', (e) => take(e.target.files));
   $('dir-runs').addEventListener('change', (e) => take(e.target.files));
-  const zone = $('drop-runs');
-  zone.addEventListener('dragover', (e) => { e.preventDefault(); zone.classList.add('over'); });
-  zone.addEventListener('dragleave', () => zone.classList.remove('over'));
-  zone.addEventListener('drop', async (e) => {
-    e.preventDefault();
-    zone.classList.remove('over');
-    const entries = Array.from(e.dataTransfer.items || []).map((i) => i.webkitGetAsEntry && i.webkitGetAsEntry()).filter(Boolean);
+  dropZone($('drop-runs'), async (entries, dropped) => {
     try {
       const files = [];
-      for (const en of entries) files.push(...(await entryFiles(en, '')));
-      take(files.length ? files : e.dataTransfer.files);
+      for (const en of entries) files.push(...(await entryFiles(en)));
+      take(files.length ? files : dropped);
     } catch (err) { fail(`compare: ${err.message}`); }
   });
 
@@ -397,22 +392,4 @@ export function drawCameras(v, cams) {
   const estBox = document.getElementById('show-est-cams');
   if (gtBox) v.setVisible('gtCams', gtBox.checked);
   if (estBox) v.setVisible('estCams', estBox.checked);
-}
-
-/** The files under a dropped entry (file or folder), named by their path from the drop. */
-async function entryFiles(entry, prefix) {
-  if (entry.isFile) {
-    const f = await new Promise((res, rej) => entry.file(res, rej));
-    const out = new File([f], f.name);
-    Object.defineProperty(out, 'webkitRelativePath', { value: `${prefix}${f.name}` });
-    return [out];
-  }
-  const out = [];
-  const reader = entry.createReader();
-  for (;;) {
-    const batch = await new Promise((res, rej) => reader.readEntries(res, rej));
-    if (!batch.length) break;
-    for (const c of batch) out.push(...(await entryFiles(c, `${prefix}${entry.name}/`)));
-  }
-  return out;
 }
