@@ -326,15 +326,22 @@ def paint(obj, distances, status, clip):
     show_colors(bpy.context)
 
 
-def align_item(context, sfmeval, item, mode):
-    """Aligns a reconstruction's kept points: `mode` "auto" (cameras / global, then ICP) or
-    "icp" from the object's current matrix (Refine). Sets the object's matrix."""
-    obj = item.object
+def write_kept_points(context, item):
+    """Writes the object's kept points (Edit Mode deletions applied, reconstruction frame) to
+    compare/<name>/points.ply. Returns (dataset folder, work folder, the PLY's path)."""
     ds = require_dataset(context)
     work = work_dir(context, item.name)
     os.makedirs(work, exist_ok=True)
     pts = os.path.join(work, "points.ply")
-    plyio.write_points(pts, kept_points(obj))
+    plyio.write_points(pts, kept_points(item.object))
+    return ds, work, pts
+
+
+def align_item(context, sfmeval, item, mode):
+    """Aligns a reconstruction's kept points: `mode` "auto" (cameras / global, then ICP) or
+    "icp" from the object's current matrix (Refine). Sets the object's matrix."""
+    obj = item.object
+    ds, work, pts = write_kept_points(context, item)
     gt = gt_override(context)
     cams = item.cameras_source or None
     if mode != "icp":
@@ -360,11 +367,7 @@ def measure_item(context, sfmeval, item, crop=None, gt=None):
     --align given``), the crop file and the run's cameras; paints the points; returns the
     report. Files: compare/<name>/{points.ply, gt_from_recon.txt, report.json, distances.csv}."""
     obj = item.object
-    ds = require_dataset(context)
-    work = work_dir(context, item.name)
-    os.makedirs(work, exist_ok=True)
-    pts = os.path.join(work, "points.ply")
-    plyio.write_points(pts, kept_points(obj))
+    ds, work, pts = write_kept_points(context, item)
     tpath = os.path.join(work, "gt_from_recon.txt")
     ev.write_transform(tpath, gt_from_recon(obj))
     rep, dist, status = ev.evaluate(sfmeval, ds, pts, tpath, os.path.join(work, "report.json"),
