@@ -13,6 +13,9 @@ import bmesh
 import numpy as np
 from mathutils import Matrix
 
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from panel_probe import panel_labels  # noqa: E402
+
 argv = sys.argv[sys.argv.index("--") + 1:] if "--" in sys.argv else sys.argv[1:]
 zip_path, ds, mode, out_json, sfmeval_bin, runner_bin = argv
 bpy.ops.preferences.addon_install(filepath=zip_path, overwrite=True)
@@ -34,23 +37,8 @@ def call(op, **kw):
 
 
 def panel_draws():
-    """The panel's draw() runs without error (a fake layout records the labels)."""
-    labels = []
-
-    class L:
-        def __getattr__(self, name):
-            if name == "label":
-                return lambda text="", **k: labels.append(text)
-            return lambda *a, **k: L()
-
-        def __setattr__(self, k, v):
-            pass
-
-    panel = bpy.types.SFMEVAL_PT_compare
-    ctx = type("Ctx", (), {"scene": scene, "preferences": bpy.context.preferences})()
-    fake = type("P", (), {"layout": L()})()
-    panel.draw(fake, ctx)
-    return labels
+    """The Compare panel's labels (its draw() runs without error)."""
+    return panel_labels(bpy.types.SFMEVAL_PT_compare, scene)
 
 
 # A missing binary: a message naming it and what to build; nothing else breaks.

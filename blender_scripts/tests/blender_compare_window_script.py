@@ -24,6 +24,9 @@ import traceback
 import bpy
 import numpy as np
 
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from panel_probe import panel_labels  # noqa: E402
+
 argv = sys.argv[sys.argv.index("--") + 1:]
 zip_path, ds, sfmeval_bin, runner_bin, pidfile, sleep_arg, out_json, png = argv
 bpy.context.preferences.view.show_splash = False
@@ -80,24 +83,6 @@ def find_sleeper():
             except OSError:
                 pass
     return None
-
-
-def panel_labels(scene):
-    """The labels the panel's draw() writes (a fake layout records them)."""
-    labels = []
-
-    class L:
-        def __getattr__(self, name):
-            if name == "label":
-                return lambda text="", **k: labels.append(text)
-            return lambda *a, **k: L()
-
-        def __setattr__(self, k, v):
-            pass
-
-    ctx = type("Ctx", (), {"scene": scene, "preferences": bpy.context.preferences})()
-    bpy.types.SFMEVAL_PT_compare.draw(type("P", (), {"layout": L()})(), ctx)
-    return labels
 
 
 def finish(error=None):
@@ -168,7 +153,7 @@ def _tick():
                     and time.monotonic() - state["since"] > 1.0:
                 p = c.pipelines["slow"]
                 res["slow"] = [p.state, p.elapsed, p.message]
-                res["labels"] = panel_labels(scene)
+                res["labels"] = panel_labels(bpy.types.SFMEVAL_PT_compare, scene)
                 res["log"] = bpy.data.texts["sfmeval runs"].as_string()
                 shading = area.spaces.active.shading
                 shading.type = "SOLID"

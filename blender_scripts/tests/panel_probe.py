@@ -1,0 +1,22 @@
+"""Inside Blender: the labels a panel's draw() writes, through a fake layout that accepts every
+call (the compare drivers read the Compare pipelines panel's text this way)."""
+
+import bpy
+
+
+def panel_labels(panel, scene):
+    """The label texts `panel.draw` writes for `scene` (preferences from the running Blender)."""
+    labels = []
+
+    class Layout:
+        def __getattr__(self, name):
+            if name == "label":
+                return lambda text="", **k: labels.append(text)
+            return lambda *a, **k: Layout()
+
+        def __setattr__(self, k, v):
+            pass
+
+    ctx = type("Ctx", (), {"scene": scene, "preferences": bpy.context.preferences})()
+    panel.draw(type("P", (), {"layout": Layout()})(), ctx)
+    return labels
