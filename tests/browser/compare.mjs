@@ -5,8 +5,8 @@
 // Usage: node compare.mjs --url URL --runs RUNS --dataset DATASET --table RUNNER_TABLE
 //          --cli target/release/sfmeval --out DIR --crop crop.json --table-crop TABLE_WITH_CROP
 // Prints one "ok NAME" / "FAILED NAME: why" line per check; exits 1 when one failed.
-import { createRequire } from 'node:module';
 import { chromium } from 'playwright-core';
+import { axeViolations } from './axe.mjs';
 import { execFileSync } from 'node:child_process';
 import { readFileSync, mkdirSync, readdirSync, writeFileSync } from 'node:fs';
 import { join, resolve } from 'node:path';
@@ -190,14 +190,9 @@ try {
   await page.screenshot({ path: join(out, 'compare.png') });
   // the comparison (table, sort buttons, curves, both viewers) passes axe-core: no serious or
   // critical violation
-  await page.addScriptTag({ path: createRequire(import.meta.url).resolve('axe-core/axe.min.js') });
-  const axe = await page.evaluate(async () => {
-    const r = await window.axe.run(document, { resultTypes: ['violations'] });
-    return r.violations.map((v) => ({ id: v.id, impact: v.impact, n: v.nodes.length, where: v.nodes.slice(0, 3).map((x) => x.target.join(' ')) }));
-  });
-  const axeBad = axe.filter((v) => v.impact === 'serious' || v.impact === 'critical');
-  if (axe.length > axeBad.length) console.log(`note: compare: minor axe findings: ${axe.filter((v) => !axeBad.includes(v)).map((v) => `${v.id} (${v.impact}, ${v.n})`).join(', ')}`);
-  check('compare-axe-no-serious-violations', axeBad.length === 0, JSON.stringify(axeBad));
+  const axe = await axeViolations(page);
+  if (axe.minor.length) console.log(`note: compare: minor axe findings: ${axe.minor.join(', ')}`);
+  check('compare-axe-no-serious-violations', axe.bad.length === 0, JSON.stringify(axe.bad));
   await page.selectOption('#cmp-view-b', '');
   const single = await page.evaluate(() => document.getElementById('viewer2').hidden);
   check('side-by-side-off', single === true, String(single));

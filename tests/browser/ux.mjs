@@ -8,7 +8,7 @@
 // Usage: node ux.mjs --url http://127.0.0.1:PORT/ --out DIR
 // Prints one "ok NAME" / "FAILED NAME: why" line per check; exits 1 when one failed.
 import { chromium } from 'playwright-core';
-import { createRequire } from 'node:module';
+import { axeViolations } from './axe.mjs';
 import { mkdirSync } from 'node:fs';
 import { join, resolve } from 'node:path';
 
@@ -17,7 +17,6 @@ const url = args.url;
 const out = resolve(args.out);
 mkdirSync(out, { recursive: true });
 const origin = new URL(url).origin;
-const axePath = createRequire(import.meta.url).resolve('axe-core/axe.min.js');
 
 let failed = 0;
 const check = (name, ok, why = '') => {
@@ -78,13 +77,7 @@ async function dropBrokenPly(page) {
   await page.waitForFunction(() => document.getElementById('info-recon').classList.contains('error'), null, { timeout: 30000 });
 }
 async function axeScan(page, name) {
-  if (!(await page.evaluate(() => typeof window.axe === 'object'))) await page.addScriptTag({ path: axePath });
-  const res = await page.evaluate(async () => {
-    const r = await window.axe.run(document, { resultTypes: ['violations'] });
-    return r.violations.map((v) => ({ id: v.id, impact: v.impact, n: v.nodes.length, where: v.nodes.slice(0, 3).map((x) => x.target.join(' ')) }));
-  });
-  const bad = res.filter((v) => v.impact === 'serious' || v.impact === 'critical');
-  const minor = res.filter((v) => !bad.includes(v)).map((v) => `${v.id} (${v.impact}, ${v.n})`);
+  const { bad, minor } = await axeViolations(page);
   if (minor.length) console.log(`note: ${name}: minor axe findings: ${minor.join(', ')}`);
   check(name, bad.length === 0, JSON.stringify(bad));
 }
