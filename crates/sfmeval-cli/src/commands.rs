@@ -22,6 +22,7 @@ use sfmeval_fs::{Disk, name_of, path_str, read, read_input_files, write_atomic};
 
 use crate::progress::Bars;
 use crate::summary;
+use crate::tanksandtemples::{LogArgs, TntArgs, log_cmd, tnt_cmd};
 
 /// Measure Structure-from-Motion reconstructions against ground truth.
 #[derive(Parser, Debug)]
@@ -73,6 +74,13 @@ enum Command {
         #[arg(long, value_name = "N", default_value_t = ReadLimits::DEFAULT_MAX_TRIANGLES)]
         max_triangles: u64,
     },
+    /// The Tanks and Temples protocol on a scene folder: trajectory alignment, three ICP
+    /// refinements, crop, voxel down-sampling, precision / recall / F at the scene's τ, as the
+    /// benchmark's own evaluation toolbox computes them.
+    #[command(alias = "tanksandtemples")]
+    Tnt(Box<TntArgs>),
+    /// Write a model's cameras as a Tanks and Temples .log trajectory (one frame per image).
+    Log(LogArgs),
     /// Evaluate the demo pair shipped with sfmeval and print the summary.
     Demo {
         /// Print the report JSON instead of the summary.
@@ -246,6 +254,8 @@ pub fn run(cli: Cli) -> Result<()> {
             file,
             max_triangles,
         } => info(&file, &ReadLimits::triangles(max_triangles)),
+        Command::Tnt(args) => tnt_cmd(&args),
+        Command::Log(args) => log_cmd(&args),
         Command::Demo { json, report } => demo(json, report.as_deref()),
     }
 }

@@ -3,6 +3,7 @@
 mod commands;
 mod progress;
 mod summary;
+mod tanksandtemples;
 
 use std::process::ExitCode;
 

@@ -79,6 +79,31 @@ pub fn read_input_files(path: &Path) -> Result<BTreeMap<String, Vec<u8>>> {
     Ok(sfmeval::files::read_input_files(&Disk, path_str(path)?)?)
 }
 
+/// Image file extensions (lower case) an image folder's listing keeps.
+pub const IMAGE_EXTENSIONS: [&str; 6] = ["jpg", "jpeg", "png", "tif", "tiff", "bmp"];
+
+/// The image files directly inside `dir` (by extension, any case), by name in sorted order: the
+/// input-image order of a Tanks and Temples `.log` trajectory.
+pub fn image_names(dir: &Path) -> Result<Vec<String>> {
+    let mut names = Vec::new();
+    for entry in std::fs::read_dir(dir)
+        .with_context(|| format!("cannot list the images folder '{}'", dir.display()))?
+    {
+        let path = entry
+            .with_context(|| format!("cannot list the images folder '{}'", dir.display()))?
+            .path();
+        let is_image = path
+            .extension()
+            .and_then(|e| e.to_str())
+            .is_some_and(|e| IMAGE_EXTENSIONS.contains(&e.to_ascii_lowercase().as_str()));
+        if is_image && path.is_file() {
+            names.push(name_of(&path));
+        }
+    }
+    names.sort();
+    Ok(names)
+}
+
 /// Reads a ground truth and its optional parts from disk ([`Dataset::read_with_limits`]).
 pub fn read_dataset(paths: &DatasetPaths, limits: &ReadLimits) -> Result<Dataset> {
     Ok(Dataset::read_with_limits(&Disk, paths, limits)?)

@@ -7,5 +7,7 @@
 mod disk;
 mod write;
 
-pub use disk::{Disk, name_of, path_str, read, read_dataset, read_input_files};
+pub use disk::{
+    Disk, IMAGE_EXTENSIONS, image_names, name_of, path_str, read, read_dataset, read_input_files,
+};
 pub use write::write_atomic;

@@ -9,9 +9,16 @@
 //!  "max_distance": 0.05}
 //! ```
 //! `volume` kinds: `box` (`min`, `max`), `oriented_box` (`center`, `half_extents`, `rotation` =
-//! row-major `world_from_box`, whose columns are the box axes), `sphere` (`center`, `radius`).
+//! row-major `world_from_box`, whose columns are the box axes), `sphere` (`center`, `radius`),
+//! `polygon_prism` (`polygon`, `axis`, `axis_min`, `axis_max`: Open3D's
+//! `SelectionPolygonVolume`, the crop of the Tanks and Temples benchmark; see
+//! [`Volume::PolygonPrism`]).
 //! Both fields are optional. The volume crops the reconstruction and the ground-truth samples of
 //! completeness alike; `max_distance` discards reconstructed points only.
+//!
+//! [`Crop::parse`] also reads Open3D's own `SelectionPolygonVolume` JSON (the `<scene>.json` of
+//! a Tanks and Temples scene, `"class_name": "SelectionPolygonVolume"`) as a crop with that
+//! volume.
 
 use serde::{Deserialize, Serialize};
 
@@ -45,6 +52,43 @@ pub enum Volume {
         /// Radius.
         radius: f64,
     },
+    /// A prism: a polygon drawn across `axis`, extruded from `axis_min` to `axis_max` along it
+    /// (Open3D's `SelectionPolygonVolume`, with its exact inside test: the coordinate along
+    /// `axis` within `[axis_min, axis_max]`, and an odd number of polygon edges crossing the
+    /// point's row strictly before it; the polygon's own coordinate along `axis` is ignored).
+    PolygonPrism {
+        /// The polygon's vertices in order (closed implicitly).
+        polygon: Vec<Point3>,
+        /// The extrusion axis: `x`, `y` or `z`.
+        axis: Axis,
+        /// Lower bound along `axis`.
+        axis_min: f64,
+        /// Upper bound along `axis`.
+        axis_max: f64,
+    },
+}
+
+/// A coordinate axis.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Axis {
+    /// x.
+    X,
+    /// y.
+    Y,
+    /// z.
+    Z,
+}
+
+impl Axis {
+    /// `(u, v, w)`: the two polygon coordinates and the axis itself, in Open3D's order.
+    fn uvw(self) -> (usize, usize, usize) {
+        match self {
+            Axis::X => (1, 2, 0),
+            Axis::Y => (0, 2, 1),
+            Axis::Z => (0, 1, 2),
+        }
+    }
 }
 
 impl Volume {
@@ -54,6 +98,7 @@ impl Volume {
             Volume::Box { .. } => "box",
             Volume::OrientedBox { .. } => "oriented_box",
             Volume::Sphere { .. } => "sphere",
+            Volume::PolygonPrism { .. } => "polygon_prism",
         }
     }
 
@@ -78,6 +123,12 @@ impl Volume {
                 let d = sub(p, *center);
                 d[0] * d[0] + d[1] * d[1] + d[2] * d[2] <= radius * radius
             }
+            Volume::PolygonPrism {
+                polygon,
+                axis,
+                axis_min,
+                axis_max,
+            } => in_prism(polygon, *axis, *axis_min, *axis_max, p),
         }
     }
 
@@ -101,15 +152,98 @@ impl Volume {
             Volume::Sphere { center, radius } => {
                 finite(center) && radius.is_finite() && *radius >= 0.0
             }
+            Volume::PolygonPrism {
+                polygon,
+                axis_min,
+                axis_max,
+                ..
+            } => {
+                polygon.len() >= 3
+                    && polygon.iter().all(|p| finite(p))
+                    && axis_min.is_finite()
+                    && axis_max.is_finite()
+                    && axis_min <= axis_max
+            }
         };
         if ok {
             Ok(())
         } else {
             Err(Error::InvalidOption(format!(
-                "crop {} is invalid (non-finite values, min > max, negative size, or a rotation that is not orthonormal)",
+                "crop {} is invalid (non-finite values, min > max, negative size, a rotation that is not orthonormal, or a polygon of fewer than 3 vertices)",
                 self.kind()
             )))
         }
+    }
+}
+
+/// Open3D's `SelectionPolygonVolume::CropInPolygon` for one point: inside when the coordinate
+/// along the axis lies in `[axis_min, axis_max]` and the number of polygon edges crossing the
+/// point's row at a `u` strictly below the point's is odd (Open3D sorts the crossings and takes
+/// `lower_bound`; counting them is the same without the allocation).
+fn in_prism(polygon: &[Point3], axis: Axis, axis_min: f64, axis_max: f64, p: Point3) -> bool {
+    let (u, v, w) = axis.uvw();
+    if p[w] < axis_min || p[w] > axis_max {
+        return false;
+    }
+    let n = polygon.len();
+    let mut below = 0usize;
+    for i in 0..n {
+        let (a, b) = (polygon[i], polygon[(i + 1) % n]);
+        if (a[v] < p[v] && b[v] >= p[v]) || (b[v] < p[v] && a[v] >= p[v]) {
+            let node = a[u] + (p[v] - a[v]) / (b[v] - a[v]) * (b[u] - a[u]);
+            if node < p[u] {
+                below += 1;
+            }
+        }
+    }
+    below % 2 == 1
+}
+
+/// Open3D's `SelectionPolygonVolume` JSON (`visualization.read_selection_polygon_volume`).
+#[derive(Deserialize)]
+struct Open3dPolygonVolume {
+    class_name: String,
+    #[serde(default = "one")]
+    version_major: i64,
+    #[serde(default)]
+    version_minor: i64,
+    bounding_polygon: Vec<Point3>,
+    orthogonal_axis: String,
+    axis_min: f64,
+    axis_max: f64,
+}
+
+fn one() -> i64 {
+    1
+}
+
+impl Open3dPolygonVolume {
+    fn into_volume(self) -> Result<Volume> {
+        if self.class_name != "SelectionPolygonVolume"
+            || self.version_major != 1
+            || self.version_minor != 0
+        {
+            return Err(Error::InvalidOption(format!(
+                "crop file: class '{}' version {}.{} is not Open3D's SelectionPolygonVolume 1.0",
+                self.class_name, self.version_major, self.version_minor
+            )));
+        }
+        let axis = match self.orthogonal_axis.as_str() {
+            "x" | "X" => Axis::X,
+            "y" | "Y" => Axis::Y,
+            "z" | "Z" => Axis::Z,
+            other => {
+                return Err(Error::InvalidOption(format!(
+                    "crop file: orthogonal_axis is '{other}', expected x, y or z"
+                )));
+            }
+        };
+        Ok(Volume::PolygonPrism {
+            polygon: self.bounding_polygon,
+            axis,
+            axis_min: self.axis_min,
+            axis_max: self.axis_max,
+        })
     }
 }
 
@@ -141,9 +275,24 @@ pub struct Crop {
 pub(crate) const CROP_SCHEMA: &str = "sfmeval.crop/1";
 
 impl Crop {
-    /// Parses a crop file.
+    /// Parses a crop file: `sfmeval.crop/1`, or Open3D's `SelectionPolygonVolume` JSON (a
+    /// Tanks and Temples `<scene>.json`), which becomes a [`Volume::PolygonPrism`] crop.
     pub fn parse(bytes: &[u8]) -> Result<Crop> {
-        let crop: Crop = serde_json::from_slice(bytes)
+        let value: serde_json::Value = serde_json::from_slice(bytes)
+            .map_err(|e| Error::InvalidOption(format!("crop file: {e}")))?;
+        if value.get("class_name").is_some() {
+            let o3d: Open3dPolygonVolume = serde_json::from_value(value).map_err(|e| {
+                Error::InvalidOption(format!("crop file (Open3D SelectionPolygonVolume): {e}"))
+            })?;
+            let crop = Crop {
+                schema: None,
+                volume: Some(o3d.into_volume()?),
+                max_distance: None,
+            };
+            crop.validate()?;
+            return Ok(crop);
+        }
+        let crop: Crop = serde_json::from_value(value)
             .map_err(|e| Error::InvalidOption(format!("crop file: {e}")))?;
         if let Some(s) = crop.schema.as_ref().filter(|s| *s != CROP_SCHEMA) {
             return Err(Error::InvalidOption(format!(
@@ -227,5 +376,69 @@ mod tests {
         assert!(Crop::parse(br#"{"volume":{"kind":"cone"}}"#).is_err());
         assert!(Crop::parse(br#"{"max_distance":-1}"#).is_err());
         assert!(Crop::parse(br#"{"max_dist":1}"#).is_err());
+    }
+
+    /// An L-shaped prism across y (the polygon in x–z), as Open3D's crop test reads it.
+    fn l_prism() -> Volume {
+        Volume::PolygonPrism {
+            polygon: vec![
+                [0.0, 9.0, 0.0],
+                [2.0, 9.0, 0.0],
+                [2.0, 9.0, 1.0],
+                [1.0, 9.0, 1.0],
+                [1.0, 9.0, 2.0],
+                [0.0, 9.0, 2.0],
+            ],
+            axis: Axis::Y,
+            axis_min: -1.0,
+            axis_max: 1.0,
+        }
+    }
+
+    #[test]
+    fn polygon_prism_follows_open3d() {
+        let l = l_prism();
+        // Inside both arms, the polygon's own y (9) ignored.
+        assert!(l.contains([0.5, 0.0, 0.5]) && l.contains([1.5, 1.0, 0.5]));
+        assert!(l.contains([0.5, -1.0, 1.5]));
+        // The notch of the L, beyond the axis range, outside the polygon.
+        assert!(!l.contains([1.5, 0.0, 1.5]));
+        assert!(!l.contains([0.5, 1.0001, 0.5]) && !l.contains([0.5, -1.5, 0.5]));
+        assert!(!l.contains([-0.1, 0.0, 0.5]) && !l.contains([0.5, 0.0, 2.5]));
+        // Open3D's edge rules: a crossing counts when the edge spans (v_i < p_v <= v_j) and the
+        // crossing's u is strictly below p_u: the left edge (u = 0) is outside, the right edge
+        // (u = 2) is inside, the bottom row (v = 0) is outside, the row v = 1 is inside.
+        assert!(!l.contains([0.0, 0.0, 0.5]));
+        assert!(l.contains([2.0, 0.0, 0.5]));
+        assert!(!l.contains([0.5, 0.0, 0.0]));
+        assert!(l.contains([1.5, 0.0, 1.0]));
+    }
+
+    #[test]
+    fn open3d_selection_polygon_volume_file() {
+        let json = br#"{
+            "axis_max" : 1.0, "axis_min" : -1.0,
+            "bounding_polygon" : [[0,9,0],[2,9,0],[2,9,1],[1,9,1],[1,9,2],[0,9,2]],
+            "class_name" : "SelectionPolygonVolume",
+            "orthogonal_axis" : "Y", "version_major" : 1, "version_minor" : 0}"#;
+        let c = Crop::parse(json).unwrap();
+        assert_eq!(c.volume, Some(l_prism()));
+        assert_eq!(c.kind(), "polygon_prism");
+        // The sfmeval form round-trips.
+        assert_eq!(
+            Crop::parse(c.to_file_json().as_bytes()).unwrap().volume,
+            c.volume
+        );
+        let bad_axis = String::from_utf8_lossy(json).replace("\"Y\"", "\"w\"");
+        let e = Crop::parse(bad_axis.as_bytes()).unwrap_err().to_string();
+        assert!(e.contains("orthogonal_axis is 'w'"), "{e}");
+        let other = String::from_utf8_lossy(json).replace("SelectionPolygonVolume", "PointCloud");
+        let e = Crop::parse(other.as_bytes()).unwrap_err().to_string();
+        assert!(e.contains("class 'PointCloud'"), "{e}");
+        let two = br#"{"class_name":"SelectionPolygonVolume","bounding_polygon":[[0,0,0],[1,0,0]],"orthogonal_axis":"z","axis_min":0,"axis_max":1}"#;
+        assert!(Crop::parse(two).is_err());
+        let missing = br#"{"class_name":"SelectionPolygonVolume","orthogonal_axis":"z","axis_min":0,"axis_max":1}"#;
+        let e = Crop::parse(missing).unwrap_err().to_string();
+        assert!(e.contains("bounding_polygon"), "{e}");
     }
 }

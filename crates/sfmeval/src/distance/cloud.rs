@@ -32,6 +32,16 @@ impl CloudIndex {
             .execute();
         (r.distance.sqrt(), r.item as usize)
     }
+
+    /// Squared distance from `p` to its nearest neighbour, and that neighbour's index.
+    pub(crate) fn nearest_squared(&self, p: Point3) -> (f64, usize) {
+        let r = self
+            .tree
+            .query(&p)
+            .nearest_one::<SquaredEuclidean<f64>>()
+            .execute();
+        (r.distance, r.item as usize)
+    }
 }
 
 // Test data only: platform maths is fine here (reports use libm, see clippy.toml).

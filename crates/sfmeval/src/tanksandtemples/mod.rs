@@ -1,0 +1,34 @@
+//! The Tanks and Temples evaluation protocol, as the benchmark's own toolbox
+//! (`python_toolbox/evaluation` of the TanksAndTemples repository) runs it, so that its
+//! precision, recall and F-score compare with the benchmark's leaderboard: the scene's files
+//! ([`scene`]), the `.log` trajectories ([`trajectory`]), the trajectory alignment, the three
+//! ICP refinements, crop, voxel down-sampling, distances both ways, the scores and curves
+//! ([`curves`]) and the coloured clouds.
+//!
+//! Where sfmeval can differ from the toolbox at all: the trajectory alignment is a RANSAC
+//! (seeded here, parallel and unseeded in Open3D 0.20, exhaustive in the 0.9 the toolbox
+//! pinned), so the final transform may differ slightly; with the final transform fixed every
+//! step is deterministic and matches the toolbox's numbers.
+
+mod colors;
+pub mod curves;
+mod icp;
+pub mod matrix;
+mod protocol;
+mod report;
+pub mod scene;
+pub mod trajectory;
+mod trajectory_alignment;
+mod voxel;
+
+pub use colors::hot_r;
+pub use icp::IcpCriteria;
+pub use protocol::{
+    MAPPING_ABOVE_FRAMES, PLOT_STRETCH, Registration, TntEvaluation, TntRequest,
+    UNIFORM_MAX_POINTS, evaluate,
+};
+pub use report::*;
+pub use scene::{SCENE_TAU, Scene, scene_tau};
+pub use trajectory::{LogFrame, Mapping, log_from_model, read_log, read_mapping, write_log};
+pub use trajectory_alignment::{TrajectoryAlignment, TrajectoryAlignmentOptions};
+pub use voxel::voxel_down_sample;

@@ -1,0 +1,461 @@
+//! The protocol end to end, step for step as the toolbox's `run.py` runs it:
+//! 1. trajectory alignment of the reconstruction's `.log` against the reference trajectory
+//!    taken into the ground-truth frame by `<scene>_trans.txt`;
+//! 2. three ICP refinements (`registration_vol_ds` at voxel τ with correspondence distance 80τ,
+//!    at τ/2 with 20τ, then `registration_unif` with 2τ), each on both clouds cropped (the
+//!    reconstruction after the current transform) and down-sampled;
+//! 3. `EvaluateHisto`: both clouds cropped and voxel down-sampled at τ/2, nearest-neighbour
+//!    distances both ways, precision / recall / F at τ and the cumulative curves.
+//!
+//! The cropped and down-sampled ground truth is computed once per voxel size (the toolbox
+//! recomputes the same clouds in every step), and one k-d tree serves the τ/2 refinement and the
+//! evaluation.
+
+use super::colors;
+use super::curves::{self, Scores};
+use super::icp::{IcpCriteria, registration_icp};
+use super::matrix::{self, Matrix4};
+use super::report::*;
+use super::scene::{Scene, scene_tau};
+use super::trajectory::LogFrame;
+use super::trajectory_alignment::{TrajectoryAlignmentOptions, align_trajectories};
+use super::voxel::voxel_down_sample;
+use crate::crop::{Axis, Volume};
+use crate::distance::CloudIndex;
+use crate::error::{Error, Result};
+use crate::geometry::Point3;
+use crate::parallel;
+use crate::progress::{Progress, Stage};
+use crate::report::Tool;
+
+/// Trajectories longer than this are a video's: the mapping file picks the reference frames.
+pub const MAPPING_ABOVE_FRAMES: usize = 1600;
+
+/// The toolbox's point budget of the last refinement (`MAX_POINT_NUMBER`).
+pub const UNIFORM_MAX_POINTS: u64 = 4_000_000;
+
+/// The curves run to τ times this (the toolbox's `plot_stretch`).
+pub const PLOT_STRETCH: f64 = 5.0;
+
+/// How the reconstruction reaches the ground-truth frame.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Registration {
+    /// The protocol's trajectory alignment and three ICP refinements, from this trajectory.
+    Protocol {
+        /// The reconstruction's `.log` frames.
+        trajectory: Vec<LogFrame>,
+        /// The name of the `.log` for the report.
+        trajectory_name: String,
+        /// Trajectory-alignment parameters.
+        options: TrajectoryAlignmentOptions,
+    },
+    /// A known `gt_from_recon` (the registration skipped).
+    Given(Matrix4),
+}
+
+/// One evaluation request.
+#[derive(Debug, Clone)]
+pub struct TntRequest {
+    /// τ in ground-truth units; `None` takes the scene's from the toolbox's table.
+    pub tau: Option<f64>,
+    /// The registration.
+    pub registration: Registration,
+    /// ICP stop rule of the refinements.
+    pub icp: IcpCriteria,
+}
+
+/// The report and the two measured clouds (for the coloured PLYs).
+#[derive(Debug, Clone)]
+pub struct TntEvaluation {
+    /// The report.
+    pub report: TntReport,
+    /// Reconstruction points measured (ground-truth frame, cropped, down-sampled).
+    pub precision_points: Vec<Point3>,
+    /// Their distances to the ground truth.
+    pub precision_distances: Vec<f64>,
+    /// Ground-truth points measured.
+    pub recall_points: Vec<Point3>,
+    /// Their distances to the reconstruction.
+    pub recall_distances: Vec<f64>,
+}
+
+impl TntEvaluation {
+    /// The toolbox's `<scene>.precision.ply`: the measured reconstruction coloured by distance.
+    pub fn precision_ply(&self) -> Vec<u8> {
+        colors::distance_ply(
+            &self.precision_points,
+            &self.precision_distances,
+            self.report.protocol.evaluation.color_max_distance,
+        )
+    }
+
+    /// The toolbox's `<scene>.recall.ply`: the measured ground truth coloured by distance.
+    pub fn recall_ply(&self) -> Vec<u8> {
+        colors::distance_ply(
+            &self.recall_points,
+            &self.recall_distances,
+            self.report.protocol.evaluation.color_max_distance,
+        )
+    }
+
+    /// The toolbox's text outputs by file suffix: `.precision.txt`, `.recall.txt` (the curves)
+    /// and `.prf_tau_plotstr.txt` (P, R, F, τ, stretch), as `numpy.savetxt` writes them.
+    pub fn toolbox_texts(&self) -> [(&'static str, String); 3] {
+        let r = &self.report;
+        [
+            (".precision.txt", curves::savetxt(&r.curves.precision)),
+            (".recall.txt", curves::savetxt(&r.curves.recall)),
+            (
+                ".prf_tau_plotstr.txt",
+                curves::savetxt(&[
+                    r.precision.value,
+                    r.recall.value,
+                    r.f_score,
+                    r.protocol.tau,
+                    r.protocol.evaluation.plot_stretch,
+                ]),
+            ),
+        ]
+    }
+}
+
+/// Evaluates the reconstructed cloud `recon_points` (named `recon_name`) on `scene`.
+pub fn evaluate(
+    scene: &Scene,
+    recon_name: &str,
+    recon_points: &[Point3],
+    request: &TntRequest,
+    progress: &dyn Progress,
+) -> Result<TntEvaluation> {
+    let (tau, tau_source) = match (request.tau, scene_tau(&scene.name)) {
+        (Some(t), _) => (t, "option"),
+        (None, Some(t)) => (t, "scene table"),
+        (None, None) => {
+            return Err(Error::InvalidOption(format!(
+                "scene '{}' is not one of the benchmark's (Barn, Caterpillar, Church, Courthouse, Ignatius, Meetingroom, Truck): give τ",
+                scene.name
+            )));
+        }
+    };
+    if !(tau.is_finite() && tau > 0.0) {
+        return Err(Error::InvalidOption(format!("τ must be > 0, got {tau}")));
+    }
+    if recon_points.is_empty() {
+        return Err(Error::Empty {
+            what: format!("reconstruction '{recon_name}'"),
+        });
+    }
+    let volume = &scene.crop;
+    let crop = |pts: &[Point3]| -> Vec<Point3> {
+        pts.iter()
+            .copied()
+            .filter(|p| volume.contains(*p))
+            .collect()
+    };
+    let crop_moved = |t: &Matrix4| -> Vec<Point3> {
+        recon_points
+            .iter()
+            .map(|p| matrix::apply(t, *p))
+            .filter(|p| volume.contains(*p))
+            .collect()
+    };
+    let nonempty = |pts: Vec<Point3>, what: &str| -> Result<Vec<Point3>> {
+        if pts.is_empty() {
+            Err(Error::Geometry(format!(
+                "no {what} point lies inside the crop of scene '{}'",
+                scene.name
+            )))
+        } else {
+            Ok(pts)
+        }
+    };
+    let mut warnings = Vec::new();
+
+    progress.start(Stage::Alignment, 5);
+    let gt_cropped = nonempty(crop(&scene.ground_truth), "ground-truth")?;
+    let gt_half = voxel_down_sample(&gt_cropped, tau / 2.0)?;
+    let gt_half_index = CloudIndex::new(&gt_half)?;
+    progress.advance(1);
+
+    let mut stage_params = Vec::new();
+    let mut stage_results = Vec::new();
+    let (mode, alignment, trajectory_input, gt_from_recon) = match &request.registration {
+        Registration::Given(t) => {
+            matrix::validate(t, "the given transform")?;
+            progress.advance(3);
+            ("given", None, None, *t)
+        }
+        Registration::Protocol {
+            trajectory,
+            trajectory_name,
+            options,
+        } => {
+            let (centers, mapped) = trajectory_centers(scene, trajectory)?;
+            let reference: Vec<Point3> = scene
+                .reference_trajectory
+                .iter()
+                .map(|f| matrix::apply(&scene.gt_from_reference, f.center()))
+                .collect();
+            let aligned = align_trajectories(&centers, &reference, options)?;
+            progress.advance(1);
+            let mut t = aligned.gt_from_recon;
+            // Two voxel refinements, then the uniform one.
+            let gt_full = voxel_down_sample(&gt_cropped, tau)?;
+            let gt_full_index = CloudIndex::new(&gt_full)?;
+            for (voxel, distance, target, index) in [
+                (tau, 80.0 * tau, &gt_full, &gt_full_index),
+                (tau / 2.0, 20.0 * tau, &gt_half, &gt_half_index),
+            ] {
+                let source = voxel_down_sample(&nonempty(crop_moved(&t), "reconstructed")?, voxel)?;
+                let r = registration_icp(&source, target, index, distance, request.icp);
+                t = matrix::mul(&r.transformation, &t);
+                stage_params.push(StageParams::new(
+                    "voxel",
+                    Some(voxel),
+                    None,
+                    distance,
+                    request.icp,
+                ));
+                stage_results.push(StageResult {
+                    source_points: source.len(),
+                    target_points: target.len(),
+                    iterations: r.iterations,
+                    fitness: r.fitness,
+                    inlier_rmse: r.inlier_rmse,
+                    gt_from_recon: t,
+                });
+                progress.advance(1);
+            }
+            let source = uniform_down_sample(nonempty(crop_moved(&t), "reconstructed")?);
+            let target = uniform_down_sample(gt_cropped.clone());
+            let index = CloudIndex::new(&target)?;
+            let r = registration_icp(&source, &target, &index, 2.0 * tau, request.icp);
+            t = matrix::mul(&r.transformation, &t);
+            stage_params.push(StageParams::new(
+                "uniform",
+                None,
+                Some(UNIFORM_MAX_POINTS),
+                2.0 * tau,
+                request.icp,
+            ));
+            stage_results.push(StageResult {
+                source_points: source.len(),
+                target_points: target.len(),
+                iterations: r.iterations,
+                fitness: r.fitness,
+                inlier_rmse: r.inlier_rmse,
+                gt_from_recon: t,
+            });
+            progress.advance(1);
+            if aligned.fitness < 0.5 {
+                warnings.push(format!(
+                    "trajectory alignment: only {:.0} % of the cameras came within {} of the reference",
+                    100.0 * aligned.fitness,
+                    options.max_correspondence_distance
+                ));
+            }
+            let registered = trajectory
+                .iter()
+                .filter(|f| f.metadata.get(1).is_some_and(|v| *v >= 0))
+                .count();
+            (
+                "protocol",
+                Some(aligned),
+                Some(TrajectoryInput {
+                    name: trajectory_name.clone(),
+                    frames: trajectory.len(),
+                    registered,
+                    mapped,
+                }),
+                t,
+            )
+        }
+    };
+    progress.finish();
+
+    // EvaluateHisto.
+    let recon_cropped = crop_moved(&gt_from_recon);
+    let recon_cropped_count = recon_cropped.len();
+    let precision_points = voxel_down_sample(&recon_cropped, tau / 2.0)?;
+    drop(recon_cropped);
+    progress.start(Stage::Accuracy, precision_points.len() as u64);
+    let precision_distances =
+        parallel::map_points(&precision_points, progress, |p| gt_half_index.nearest(*p).0);
+    progress.finish();
+    let recall_distances = if precision_points.is_empty() {
+        warnings.push(
+            "no reconstructed point lies inside the crop: precision, recall and F are 0".into(),
+        );
+        Vec::new()
+    } else {
+        let recon_index = CloudIndex::new(&precision_points)?;
+        progress.start(Stage::Completeness, gt_half.len() as u64);
+        let d = parallel::map_points(&gt_half, progress, |p| recon_index.nearest(*p).0);
+        progress.finish();
+        d
+    };
+    let scores = curves::scores(&precision_distances, &recall_distances, tau, PLOT_STRETCH);
+
+    let (axis, axis_min, axis_max, polygon_vertices) = match volume {
+        Volume::PolygonPrism {
+            polygon,
+            axis,
+            axis_min,
+            axis_max,
+        } => (
+            match axis {
+                Axis::X => "x",
+                Axis::Y => "y",
+                Axis::Z => "z",
+            },
+            *axis_min,
+            *axis_max,
+            polygon.len(),
+        ),
+        _ => ("", f64::NAN, f64::NAN, 0),
+    };
+    let Scores {
+        precision,
+        recall,
+        f_score,
+        edges,
+        precision_curve,
+        recall_curve,
+    } = scores;
+    let report = TntReport {
+        schema: TNT_SCHEMA.into(),
+        tool: Tool::default(),
+        protocol: ProtocolSection {
+            name: "tanksandtemples".into(),
+            reference: "Tanks and Temples python_toolbox/evaluation (run.py)".into(),
+            scene: scene.name.clone(),
+            tau,
+            tau_source: tau_source.into(),
+            crop: CropSection {
+                file: format!("{}.json", scene.name),
+                kind: volume.kind().into(),
+                axis: axis.into(),
+                axis_min,
+                axis_max,
+                polygon_vertices,
+            },
+            trajectory_alignment: match &request.registration {
+                Registration::Protocol { options, .. } => Some(options.into()),
+                Registration::Given(_) => None,
+            },
+            refinement: stage_params,
+            evaluation: EvaluationParams {
+                voxel_size: tau / 2.0,
+                threshold: tau,
+                plot_stretch: PLOT_STRETCH,
+                bin_width: tau / 100.0,
+                color_max_distance: 3.0 * tau,
+                colormap: "hot_r".into(),
+            },
+        },
+        inputs: InputsSection {
+            reconstruction: NamedCount {
+                name: recon_name.into(),
+                points: recon_points.len(),
+            },
+            trajectory: trajectory_input,
+            ground_truth: NamedCount {
+                name: scene.ground_truth_path.clone(),
+                points: scene.ground_truth.len(),
+            },
+            reference_frames: scene.reference_trajectory.len(),
+            gt_from_reference: scene.gt_from_reference,
+        },
+        registration: RegistrationSection {
+            mode: mode.into(),
+            trajectory_alignment: alignment,
+            refinement: stage_results,
+            gt_from_recon,
+        },
+        precision: side(precision, recon_cropped_count, &precision_distances),
+        recall: side(recall, gt_cropped.len(), &recall_distances),
+        f_score,
+        curves: CurvesSection {
+            edges,
+            precision: precision_curve,
+            recall: recall_curve,
+        },
+        warnings,
+    };
+    Ok(TntEvaluation {
+        report,
+        precision_points,
+        precision_distances,
+        recall_points: gt_half,
+        recall_distances,
+    })
+}
+
+/// The camera centres the alignment uses: every frame's, or through the mapping file the
+/// reference frames of a video trajectory (longer than [`MAPPING_ABOVE_FRAMES`]).
+fn trajectory_centers(scene: &Scene, trajectory: &[LogFrame]) -> Result<(Vec<Point3>, bool)> {
+    if trajectory.len() <= MAPPING_ABOVE_FRAMES {
+        return Ok((trajectory.iter().map(LogFrame::center).collect(), false));
+    }
+    let Some(mapping) = &scene.mapping else {
+        return Err(Error::Missing {
+            what: format!(
+                "mapping reference for a trajectory of {} frames (more than {MAPPING_ABOVE_FRAMES})",
+                trajectory.len()
+            ),
+            file: format!("{}_mapping_reference.txt", scene.name),
+        });
+    };
+    let centers = mapping
+        .video_frames
+        .iter()
+        .map(|&k| {
+            trajectory
+                .get(k as usize - 1)
+                .map(LogFrame::center)
+                .ok_or_else(|| {
+                    Error::InvalidOption(format!(
+                        "the mapping reference names video frame {k}, the trajectory has {}",
+                        trajectory.len()
+                    ))
+                })
+        })
+        .collect::<Result<_>>()?;
+    Ok((centers, true))
+}
+
+/// The toolbox's `uniform` down-sampling: every k-th point with `k = round(n / 4e6)` (Python's
+/// round, halves to even) when `n` exceeds the budget.
+fn uniform_down_sample(points: Vec<Point3>) -> Vec<Point3> {
+    let n = points.len() as u64;
+    if n <= UNIFORM_MAX_POINTS {
+        return points;
+    }
+    let k = (n as f64 / UNIFORM_MAX_POINTS as f64)
+        .round_ties_even()
+        .max(1.0) as usize;
+    points.into_iter().step_by(k).collect()
+}
+
+fn side(value: f64, cropped_points: usize, distances: &[f64]) -> SideSection {
+    let (mean, median) = if distances.is_empty() {
+        (0.0, 0.0)
+    } else {
+        let mut sorted = distances.to_vec();
+        sorted.sort_by(f64::total_cmp);
+        let n = sorted.len();
+        let median = if n % 2 == 1 {
+            sorted[n / 2]
+        } else {
+            0.5 * (sorted[n / 2 - 1] + sorted[n / 2])
+        };
+        (distances.iter().sum::<f64>() / n as f64, median)
+    };
+    SideSection {
+        value,
+        cropped_points,
+        points: distances.len(),
+        mean_distance: mean,
+        median_distance: median,
+    }
+}
