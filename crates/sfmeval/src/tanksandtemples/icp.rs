@@ -58,7 +58,7 @@ struct Matches {
 
 fn matches(source: &[Point3], target: &CloudIndex, max_distance: f64) -> Matches {
     let limit = max_distance * max_distance;
-    let nearest = parallel::map(source, &NoProgress, |p| target.nearest_squared(*p));
+    let nearest = parallel::map_points(source, &NoProgress, |p| target.nearest_squared(*p));
     let mut pairs = Vec::new();
     let mut error2 = 0.0;
     for (i, (d2, j)) in nearest.into_iter().enumerate() {

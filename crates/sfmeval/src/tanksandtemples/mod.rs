@@ -5,10 +5,11 @@
 //! ICP refinements, crop, voxel down-sampling, distances both ways, the scores and curves
 //! ([`curves`]) and the coloured clouds.
 //!
-//! Where sfmeval can differ from the toolbox at all: the trajectory alignment is a RANSAC
-//! (seeded here, parallel and unseeded in Open3D 0.20, exhaustive in the 0.9 the toolbox
-//! pinned), so the final transform may differ slightly; with the final transform fixed every
-//! step is deterministic and matches the toolbox's numbers.
+//! Where sfmeval can differ from the toolbox at all: the trajectory alignment is a RANSAC over
+//! random samples (seeded here, unseeded in the toolbox), so the final transform can differ
+//! slightly, and the toolbox's ICP stop rule (see [`IcpCriteria::TOOLBOX`]) passes such a
+//! difference on; with the final transform fixed every step is deterministic and gives the
+//! toolbox's numbers.
 
 mod colors;
 pub mod curves;

@@ -84,10 +84,8 @@ pub struct TrajectoryParams {
     pub max_correspondence_distance: f64,
     /// Pairs per sample.
     pub ransac_n: usize,
-    /// Most samples.
+    /// Samples drawn and scored (all of them, as Open3D 0.9 did).
     pub max_iterations: u32,
-    /// Early-stop confidence.
-    pub confidence: f64,
     /// Seed of the sample stream.
     pub seed: u64,
     /// Above this many frames the trajectory is a video's, sampled through the mapping file.
@@ -100,7 +98,6 @@ impl From<&TrajectoryAlignmentOptions> for TrajectoryParams {
             max_correspondence_distance: o.max_correspondence_distance,
             ransac_n: o.ransac_n,
             max_iterations: o.max_iterations,
-            confidence: o.confidence,
             seed: o.seed,
             mapping_above_frames: super::protocol::MAPPING_ABOVE_FRAMES,
         }
