@@ -2,7 +2,7 @@
 //! matplotlib's `hot_r` map at `min(d, max) / max` (max = 3τ), written as a PLY with the
 //! distance as a property too. The map is built as matplotlib builds it: a 256-entry lookup table
 //! interpolated from `hot`'s segment data reversed, a value `x` picking entry `⌊256·x⌋` (the last
-//! for `x = 1`); Open3D stores a channel `c` as the byte `⌊255·c⌋`.
+//! for `x = 1`); Open3D stores a channel `c` as the byte nearest `255·c`.
 
 use std::sync::OnceLock;
 
@@ -70,9 +70,9 @@ pub fn hot_r(x: f64) -> [f64; 3] {
     hot_r_table()[i]
 }
 
-/// The byte Open3D writes for a channel (`(uchar) min(255, max(0, 255·c))`).
+/// The byte Open3D's PLY writer stores for a channel: `255·c` rounded, within 0..=255.
 pub fn channel_byte(c: f64) -> u8 {
-    (c * 255.0).clamp(0.0, 255.0) as u8
+    (c * 255.0).clamp(0.0, 255.0).round() as u8
 }
 
 /// A binary little-endian PLY: `double x y z`, `uchar red green blue` (hot_r of the distance
@@ -110,7 +110,7 @@ mod tests {
         let c = hot_r(0.1);
         assert!(c[0] == 1.0 && c[1] == 1.0 && c[2] > 0.0 && c[2] < 1.0);
         assert_eq!(channel_byte(1.0), 255);
-        assert_eq!(channel_byte(0.0416), 10);
+        assert_eq!(channel_byte(0.0416), 11);
         let ply = distance_ply(&[[0.0; 3]], &[0.5], 1.0);
         assert!(ply.starts_with(b"ply\nformat binary_little_endian"));
         assert_eq!(
