@@ -63,6 +63,9 @@ check bench-compare-quick .venv/bin/python bench/compare.py --quick
 while read -r line; do skip "bench-compare-quick" "$line"; done < <(
   sed -nE 's/^skipped: (.*)$/\1/p' "$log/bench-compare-quick.log")
 
+# The Tanks and Temples protocol against the benchmark's own toolbox, quick mode.
+check bench-tnt-quick .venv/bin/python bench/tanksandtemples.py --quick
+
 # Python tests (reference tools, real files).
 export SFMEVAL_BIN="$PWD/target/release/sfmeval"
 pytest_dirs=()
