@@ -318,6 +318,12 @@ pub struct Table1Args {
     /// Only these presets (default: statue vase bicycle hydrant vehicle).
     #[arg(long, num_args = 1..)]
     pub presets: Vec<String>,
+    /// Real scenes besides the generated datasets: folders in the Tanks and Temples layout
+    /// (images/ plus <scene>.ply, <scene>.json, <scene>_trans.txt, <scene>_COLMAP_SfM.log, the
+    /// folder named after the scene), run like the others and evaluated with the benchmark's
+    /// protocol at the scene's τ.
+    #[arg(long = "scene", value_name = "DIR")]
+    pub scenes: Vec<PathBuf>,
     /// The dataset generator.
     #[command(flatten)]
     pub generator: GeneratorArgs,

@@ -27,6 +27,7 @@ mod setup;
 mod sweep;
 mod table;
 mod table1;
+mod tnt;
 
 use std::process::ExitCode;
 

@@ -80,6 +80,10 @@ pub fn report(args: &ReportArgs) -> Result<Vec<Row>> {
                 .unwrap_or_default(),
         };
         let any_ok = records.iter().any(|(r, _)| r.status == Status::Ok);
+        if crate::tnt::is_scene(&ds_dir, &ds) {
+            rows.extend(report_tnt_dataset(&ds, &ds_dir, &records, args)?);
+            continue;
+        }
         let mut gt = if any_ok {
             match load_gt(&ds_dir) {
                 Ok(g) => Some(g),
@@ -130,6 +134,64 @@ pub fn report(args: &ReportArgs) -> Result<Vec<Row>> {
         }
     }
     write_tables(&args.out, &rows)?;
+    Ok(rows)
+}
+
+/// The rows of a Tanks and Temples scene's runs, evaluated with the benchmark's protocol (τ: the
+/// benchmark's for its scenes, else the first `--tau`).
+fn report_tnt_dataset(
+    ds: &str,
+    ds_dir: &Path,
+    records: &[(RunRecord, &PathBuf)],
+    args: &ReportArgs,
+) -> Result<Vec<Row>> {
+    let any_ok = records.iter().any(|(r, _)| r.status == Status::Ok);
+    let scene = if any_ok {
+        match crate::tnt::read_scene(ds_dir, ds) {
+            Ok(s) => Ok(s),
+            Err(e) => Err(format!("{e:#}")),
+        }
+    } else {
+        Err(String::new())
+    };
+    let mut rows = Vec::new();
+    for (rec, dir) in records {
+        let mut row = base_row(&rec.facts());
+        if rec.status == Status::Ok {
+            let result = match &scene {
+                Ok((scene, diagonal)) => crate::tnt::evaluate_run(
+                    scene,
+                    *diagonal,
+                    dir,
+                    rec,
+                    &args.out,
+                    sfmeval::tanksandtemples::scene_tau(ds)
+                        .or(args.eval.tau.first().copied()),
+                ),
+                Err(e) => Err(anyhow::anyhow!("Tanks and Temples scene {}: {e}", ds_dir.display())),
+            };
+            match result {
+                Ok(r) => row = r,
+                Err(e) => {
+                    row.status = "evaluation failed".into();
+                    row.reason = Some(format!("{e:#}"));
+                }
+            }
+        }
+        if args.verbose {
+            eprintln!(
+                "{}/{}: {}{}",
+                row.dataset,
+                row.pipeline,
+                row.status,
+                row.thresholds
+                    .first()
+                    .map(|t| format!(", Tanks and Temples F {:.4} at τ {}", t.f_score, t.tau))
+                    .unwrap_or_default()
+            );
+        }
+        rows.push(row);
+    }
     Ok(rows)
 }
 

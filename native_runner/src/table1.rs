@@ -98,6 +98,17 @@ pub fn table1(a: &Table1Args) -> Result<()> {
         }
         datasets.push(Dataset::open(&dest)?);
     }
+    for scene in &a.scenes {
+        let ds = Dataset::open(scene)?;
+        if !crate::tnt::is_scene(&ds.dir, &ds.name) {
+            anyhow::bail!(
+                "--scene {}: no {name}_trans.txt and {name}_COLMAP_SfM.log in it (the Tanks and Temples layout, folder named after the scene)",
+                scene.display(),
+                name = ds.name
+            );
+        }
+        datasets.push(ds);
+    }
     let gen_seconds = t0.elapsed().as_secs_f64();
     timing.insert("render_seconds".into(), gen_times.into());
     let customs = crate::pipelines::parse_customs(&a.tools.customs)?;

@@ -57,25 +57,23 @@ def _colmap_images(sparse_dir):
     return poses
 
 
-def build(out, gt_points=500_000, dense_points=200_000, seed=0):
-    """Writes the scene under OUT and returns its paths and τ."""
-    out = Path(out)
-    scene_dir, recon = out / SCENE, out / "recon"
+def write_scene(scene_dir, name, glb, cameras_json, gt_points, seed=0):
+    """Writes NAME.ply, NAME.json, NAME_trans.txt and NAME_COLMAP_SfM.log into SCENE_DIR from a
+    ground-truth mesh and its cameras.json; returns (mesh, ground-truth points, τ, names)."""
+    scene_dir = Path(scene_dir)
     scene_dir.mkdir(parents=True, exist_ok=True)
-    recon.mkdir(parents=True, exist_ok=True)
-    rng = np.random.default_rng(seed)
-    mesh = trimesh.load(DEMO / "ground_truth.glb", force="mesh")
+    mesh = trimesh.load(glb, force="mesh")
     gt, _ = trimesh.sample.sample_surface(mesh, gt_points, seed=seed)
-    _write_cloud(scene_dir / f"{SCENE}.ply", gt)
+    _write_cloud(scene_dir / f"{name}.ply", gt)
     lo, hi = gt.min(0), gt.max(0)
     diag = float(np.linalg.norm(hi - lo))
     tau = float(f"{0.004 * diag:.3g}")
 
     # Reference frame: the ground truth under a known similarity.
     gt_from_ref = similarity(1.3, quat_to_rot([0.9, 0.1, 0.35, -0.2]), np.array([0.5, -0.2, 1.0]))
-    np.savetxt(scene_dir / f"{SCENE}_trans.txt", gt_from_ref)
+    np.savetxt(scene_dir / f"{name}_trans.txt", gt_from_ref)
     ref_from_gt = np.linalg.inv(gt_from_ref)
-    cams = json.loads((DEMO / "cameras.json").read_text())
+    cams = json.loads(Path(cameras_json).read_text())
     names = sorted(im["name"] for im in cams["images"])
     by_name = {im["name"]: im["cam_from_world"] for im in cams["images"]}
     sys.path.insert(0, str(TOOLBOX))
@@ -83,14 +81,14 @@ def build(out, gt_points=500_000, dense_points=200_000, seed=0):
 
     ref_rot = quat_to_rot([0.9, 0.1, 0.35, -0.2]).T
     traj = []
-    for k, name in enumerate(names):
-        r = np.array(by_name[name]["rotation"], float)
-        t = np.array(by_name[name]["translation"], float)
+    for k, n in enumerate(names):
+        r = np.array(by_name[n]["rotation"], float)
+        t = np.array(by_name[n]["translation"], float)
         pose = np.eye(4)
         pose[:3, :3] = ref_rot @ r.T
         pose[:3, 3] = apply(ref_from_gt, -r.T @ t)
         traj.append(trajectory_io.CameraPose([k, k, 0], pose))
-    trajectory_io.write_trajectory(traj, str(scene_dir / f"{SCENE}_COLMAP_SfM.log"))
+    trajectory_io.write_trajectory(traj, str(scene_dir / f"{name}_COLMAP_SfM.log"))
 
     # Crop: an irregular polygon in x-z (cuts a side and the corners) across y, without the base.
     (x0, y0, z0), (x1, y1, z1) = lo - 0.02 * (hi - lo), hi + 0.02 * (hi - lo)
@@ -100,7 +98,19 @@ def build(out, gt_points=500_000, dense_points=200_000, seed=0):
     crop = {"class_name": "SelectionPolygonVolume", "version_major": 1, "version_minor": 0,
             "orthogonal_axis": "Y", "axis_min": float(lo[1] + 0.05 * (hi[1] - lo[1])),
             "axis_max": float(y1), "bounding_polygon": polygon}
-    (scene_dir / f"{SCENE}.json").write_text(json.dumps(crop, indent=1))
+    (scene_dir / f"{name}.json").write_text(json.dumps(crop, indent=1))
+    return mesh, gt, tau, names, by_name
+
+
+def build(out, gt_points=500_000, dense_points=200_000, seed=0):
+    """Writes the scene under OUT and returns its paths and τ."""
+    out = Path(out)
+    scene_dir, recon = out / SCENE, out / "recon"
+    recon.mkdir(parents=True, exist_ok=True)
+    rng = np.random.default_rng(seed)
+    mesh, gt, tau, names, by_name = write_scene(scene_dir, SCENE, DEMO / "ground_truth.glb",
+                                                DEMO / "cameras.json", gt_points, seed)
+    lo, hi = gt.min(0), gt.max(0)
 
     # The reconstruction: the pycolmap run, its frame found from the camera centres.
     poses = _colmap_images(DEMO / "sparse")

@@ -23,8 +23,9 @@ pub struct TntArgs {
     /// The files' stem when it is not the folder's name.
     #[arg(long, value_name = "NAME")]
     scene_name: Option<String>,
-    /// The reconstructed point cloud (PLY).
-    #[arg(long, value_name = "FILE")]
+    /// The reconstruction: a PLY point cloud (usually the dense one), or any SfM model sfmeval
+    /// reads (COLMAP folder, .nvm, Bundler .out, sfm_data.json), whose points are measured.
+    #[arg(long, value_name = "PATH")]
     recon: PathBuf,
     /// The reconstruction's camera trajectory (.log, one frame per input image; `sfmeval log`
     /// writes it from an SfM model).
@@ -89,8 +90,11 @@ pub fn tnt_cmd(args: &TntArgs) -> Result<()> {
             bail!("give --trajectory FILE.log (or --transform FILE to skip the registration)")
         }
     };
-    let recon = sfmeval::io::read_point_cloud(&name_of(&args.recon), &read(&args.recon)?)
-        .with_context(|| format!("reconstruction '{}'", args.recon.display()))?;
+    let recon = sfmeval::pipeline::read_reconstruction(
+        &name_of(&args.recon),
+        &read_input_files(&args.recon)?,
+    )
+    .with_context(|| format!("reconstruction '{}'", args.recon.display()))?;
     let request = TntRequest {
         tau: args.tau,
         registration,

@@ -167,6 +167,36 @@ pub fn evaluated_row(rec: &RunFacts, report: &Report, kept_distances: &[f64]) ->
     row
 }
 
+/// The row of a run evaluated with the Tanks and Temples protocol: accuracy is the measured
+/// reconstruction points' distances (mean, median), completeness the ground truth's, and the one
+/// threshold is the scene's τ (`gt_diagonal` gives its percent); no camera errors (the scene has
+/// no ground-truth cameras).
+pub fn tnt_row(
+    rec: &RunFacts,
+    report: &sfmeval::tanksandtemples::TntReport,
+    precision_distances: &[f64],
+    gt_diagonal: f64,
+) -> Row {
+    let mut row = base_row(rec);
+    let tau = report.protocol.tau;
+    row.points = report.inputs.reconstruction.points as u64;
+    row.mean = Some(report.precision.mean_distance);
+    row.median = Some(report.precision.median_distance);
+    let n = precision_distances.len().max(1) as f64;
+    row.rms = Some((precision_distances.iter().map(|d| d * d).sum::<f64>() / n).sqrt());
+    row.completeness_mean = Some(report.recall.mean_distance);
+    row.thresholds = vec![Prf {
+        tau,
+        tau_percent_of_diagonal: 100.0 * tau / gt_diagonal,
+        precision: report.precision.value,
+        recall: report.recall.value,
+        f_score: report.f_score,
+    }];
+    row.cdf = cdf_points(precision_distances);
+    row.report = Some(report_path(&rec.dataset, &rec.pipeline));
+    row
+}
+
 #[cfg(test)]
 #[allow(clippy::unwrap_used, clippy::expect_used)]
 mod tests {
