@@ -660,7 +660,22 @@ function currentCrop() {
   if (d !== '') crop.max_distance = Number(d);
   return crop;
 }
+/** Open3D's SelectionPolygonVolume test, as the core's `Volume::PolygonPrism`. */
+function inPrism(v, p) {
+  const [u, w, a] = { x: [1, 2, 0], y: [0, 2, 1], z: [0, 1, 2] }[v.axis];
+  if (p[a] < v.axis_min || p[a] > v.axis_max) return false;
+  let below = 0;
+  const n = v.polygon.length;
+  for (let i = 0; i < n; i++) {
+    const s = v.polygon[i], e = v.polygon[(i + 1) % n];
+    if ((s[w] < p[w] && e[w] >= p[w]) || (e[w] < p[w] && s[w] >= p[w])) {
+      if (s[u] + (p[w] - s[w]) / (e[w] - s[w]) * (e[u] - s[u]) < p[u]) below++;
+    }
+  }
+  return below % 2 === 1;
+}
 function contains(v, x, y, z) {
+  if (v.kind === 'polygon_prism') return inPrism(v, [x, y, z]);
   if (v.kind === 'sphere') {
     const dx = x - v.center[0], dy = y - v.center[1], dz = z - v.center[2];
     return dx * dx + dy * dy + dz * dz <= v.radius * v.radius;

@@ -253,6 +253,7 @@ export class Viewer {
   cropVolume() {
     const o = this.cropObject;
     if (!o) return undefined;
+    if (o.userData.kind === 'polygon_prism') return o.userData.volume;
     const p = o.position;
     if (o.userData.kind === 'sphere') {
       const s = Math.max(o.scale.x, o.scale.y, o.scale.z);
@@ -268,9 +269,31 @@ export class Viewer {
     };
   }
 
+  /**
+   * Shows an imported `polygon_prism` volume (Open3D's SelectionPolygonVolume, the Tanks and
+   * Temples crop) as the polygon extruded along its axis; it is kept as read (no gizmo).
+   */
+  setPolygonPrism(v) {
+    this.setCropKind('none');
+    const [u, w, a] = { x: [1, 2, 0], y: [0, 2, 1], z: [0, 1, 2] }[v.axis];
+    const shape = new THREE.Shape(v.polygon.map((p) => new THREE.Vector2(p[u], p[w])));
+    const geo = new THREE.ExtrudeGeometry(shape, { depth: v.axis_max - v.axis_min, bevelEnabled: false });
+    const basis = (k) => new THREE.Vector3(...[0, 1, 2].map((i) => (i === k ? 1 : 0)));
+    const m = new THREE.Matrix4().makeBasis(basis(u), basis(w), basis(a));
+    m.setPosition(basis(a).multiplyScalar(v.axis_min));
+    geo.applyMatrix4(m);
+    const mesh = new THREE.Mesh(geo, new THREE.MeshBasicMaterial({ color: 0x4fc3f7, transparent: true, opacity: 0.12, depthWrite: false, side: THREE.DoubleSide }));
+    mesh.add(new THREE.LineSegments(new THREE.EdgesGeometry(geo), new THREE.LineBasicMaterial({ color: 0x4fc3f7 })));
+    mesh.userData.kind = 'polygon_prism';
+    mesh.userData.volume = v;
+    this.cropObject = mesh;
+    this.world.add(mesh);
+  }
+
   /** Places the gizmo at a crop volume (from an imported crop file). */
   setCropVolume(v) {
     if (!v) { this.setCropKind('none'); return 'none'; }
+    if (v.kind === 'polygon_prism') { this.setPolygonPrism(v); return 'polygon_prism'; }
     const kind = v.kind === 'sphere' ? 'sphere' : 'box';
     this.setCropKind(kind);
     const o = this.cropObject;
@@ -293,7 +316,7 @@ export class Viewer {
   /** Sizes the crop volume to the GT bounds. */
   fitCrop(bounds) {
     const o = this.cropObject;
-    if (!o) return;
+    if (!o || o.userData.kind === 'polygon_prism') return;
     o.quaternion.identity();
     o.position.set(...[0, 1, 2].map((k) => (bounds[k] + bounds[k + 3]) / 2));
     if (o.userData.kind === 'sphere') {

@@ -165,10 +165,12 @@ fn report_tnt_dataset(
                     dir,
                     rec,
                     &args.out,
-                    sfmeval::tanksandtemples::scene_tau(ds)
-                        .or(args.eval.tau.first().copied()),
+                    sfmeval::tanksandtemples::scene_tau(ds).or(args.eval.tau.first().copied()),
                 ),
-                Err(e) => Err(anyhow::anyhow!("Tanks and Temples scene {}: {e}", ds_dir.display())),
+                Err(e) => Err(anyhow::anyhow!(
+                    "Tanks and Temples scene {}: {e}",
+                    ds_dir.display()
+                )),
             };
             match result {
                 Ok(r) => row = r,

@@ -56,7 +56,10 @@ pub fn evaluate_run(
     let (frames, _) = tnt::log_from_model(model, &names);
     let rel = report_path(&rec.dataset, &rec.pipeline);
     let files = out.join(rel.trim_end_matches(".json"));
-    write_atomic(&files.join("trajectory.log"), tnt::write_log(&frames).as_bytes())?;
+    write_atomic(
+        &files.join("trajectory.log"),
+        tnt::write_log(&frames).as_bytes(),
+    )?;
     let request = TntRequest {
         tau,
         registration: Registration::Protocol {
@@ -78,7 +81,10 @@ pub fn evaluate_run(
         &evaluation.recall_ply(),
     )?;
     for (suffix, text) in evaluation.toolbox_texts() {
-        write_atomic(&files.join(format!("{}{suffix}", scene.name)), text.as_bytes())?;
+        write_atomic(
+            &files.join(format!("{}{suffix}", scene.name)),
+            text.as_bytes(),
+        )?;
     }
     Ok(tnt_row(
         &rec.facts(),

@@ -198,6 +198,31 @@ try {
   const close = (a, b) => JSON.stringify(a, (k, v) => (typeof v === 'number' ? Number(v.toPrecision(9)) : v)) === JSON.stringify(b, (k, v) => (typeof v === 'number' ? Number(v.toPrecision(9)) : v));
   check('crop-import-roundtrip', close(reexport, orig), `${JSON.stringify(reexport)} vs ${cropFile.text}`);
 
+  // an Open3D SelectionPolygonVolume (a Tanks and Temples crop) imported: drawn as a prism, the
+  // live count and the report as the CLI's with the same file
+  const b = await page.evaluate(() => window.sfmeval.state.gt.bounds);
+  const lerp = (k, t) => b[k] + t * (b[k + 3] - b[k]);
+  const prism = {
+    class_name: 'SelectionPolygonVolume', version_major: 1, version_minor: 0, orthogonal_axis: 'Y',
+    axis_min: lerp(1, 0.2), axis_max: lerp(1, 1.1),
+    bounding_polygon: [[lerp(0, -0.1), 0, lerp(2, -0.1)], [lerp(0, 0.7), 0, lerp(2, -0.1)], [lerp(0, 0.7), 0, lerp(2, 0.5)],
+      [lerp(0, 0.4), 0, lerp(2, 1.1)], [lerp(0, -0.1), 0, lerp(2, 1.1)]],
+  };
+  const prismPath = join(out, 'Synth.json');
+  writeFileSync(prismPath, JSON.stringify(prism, null, 1));
+  await page.setInputFiles('#crop-import', prismPath);
+  await page.waitForFunction(() => document.getElementById('crop-kind').value === 'polygon_prism');
+  await evaluateAndWait();
+  const pagePrism = await downloadText('#dl-report');
+  const expectedPrism = cliReport(['--recon', demo('sparse.ply'), '--align', 'auto', '--crop', prismPath], 'cli-auto-prism.json');
+  check('report-polygon-prism-crop-equals-cli', noteSame('report-polygon-prism-crop-equals-cli', pagePrism.text, expectedPrism),
+    `page ${pagePrism.path} vs cli-auto-prism.json: ${firstDiff(pagePrism.text, expectedPrism)}`);
+  const repPrism = JSON.parse(expectedPrism);
+  check('polygon-prism-crops-something', repPrism.crop.kind === 'polygon_prism' && repPrism.crop.kept > 0
+    && repPrism.crop.kept < repPrism.inputs.reconstruction.points, JSON.stringify(repPrism.crop));
+  check('polygon-prism-live-kept-equals-report', (await page.textContent('#kept')) === `${repPrism.crop.kept} / ${repPrism.inputs.reconstruction.points}`,
+    await page.textContent('#kept'));
+
   // 3. the viewer draws something: screenshot, and count non-background pixels of the canvas
   await page.waitForTimeout(300);
   await page.screenshot({ path: join(out, 'page.png') });
