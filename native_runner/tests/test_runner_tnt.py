@@ -28,7 +28,7 @@ def scene_report(runner_bin, batch, tmp_path_factory):
     os.symlink(os.path.join(batch["dataset"], "images"), scene_dir / "images")
     table = root / "table"
     proc = run_cli(runner_bin, "report", batch["runs"], "--datasets", scene_dir, "--out", table,
-                   "--tau", tau, "--verbose")
+                   "--tau", tau)
     return {"dir": scene_dir, "table": table, "tau": tau, "names": names, "stderr": proc.stderr}
 
 

@@ -94,32 +94,52 @@ pub fn align_trajectories(
                 .collect()
         })
         .collect();
-    let score = |sample: &Vec<(u32, u32)>| -> (f64, f64) {
+    // A sample's score: (matched, sum of squared distances), or None once it provably cannot beat
+    // `bound` (the best of the chunks before): too few centres left to reach its match count, or
+    // its match count reached at most and its squared error already larger. Pruning never
+    // drops a sample that would have won, so the winner is the exhaustive search's.
+    let score = |sample: &Vec<(u32, u32)>, bound: Option<(usize, f64)>| -> Option<(usize, f64)> {
         let t = fit(recon_centers, reference_in_gt, sample);
         let (mut matched, mut error2) = (0usize, 0.0);
-        for p in recon_centers {
+        for (k, p) in recon_centers.iter().enumerate() {
             let (d2, _) = index.nearest_squared(matrix::apply(&t, *p));
             if d2 < limit2 {
                 matched += 1;
                 error2 += d2;
             }
+            if let Some((best_matched, best_error2)) = bound {
+                let reachable = matched + (n - k - 1);
+                if reachable < best_matched || (reachable == best_matched && error2 > best_error2) {
+                    return None;
+                }
+            }
         }
-        let rmse = if matched == 0 {
+        Some((matched, error2))
+    };
+    let rmse = |(matched, error2): (usize, f64)| {
+        if matched == 0 {
             0.0
         } else {
             (error2 / matched as f64).sqrt()
-        };
-        (matched as f64 / n as f64, rmse)
+        }
     };
-    let scores = parallel::map(&samples, &NoProgress, score);
-    let mut best = 0;
-    for (k, s) in scores.iter().enumerate() {
-        let b = scores[best];
-        if s.0 > b.0 || (s.0 == b.0 && s.1 < b.1) {
-            best = k;
+    // Chunks in sample order: each chunk is scored in parallel against the best before it.
+    let mut best: Option<(usize, (usize, f64))> = None;
+    for (c, chunk) in samples.chunks(4096).enumerate() {
+        let bound = best.map(|(_, s)| s);
+        let scores = parallel::map(chunk, &NoProgress, |s| score(s, bound));
+        for (k, s) in scores.into_iter().enumerate() {
+            let Some(s) = s else { continue };
+            let better = best.is_none_or(|(_, b)| {
+                s.0 > b.0 || (s.0 == b.0 && rmse(s) < rmse(b))
+            });
+            if better {
+                best = Some((c * 4096 + k, s));
+            }
         }
     }
-    let (fitness, inlier_rmse) = scores.get(best).copied().unwrap_or((0.0, 0.0));
+    let (best, scores) = best.map_or((0, (0, 0.0)), |b| b);
+    let (fitness, inlier_rmse) = (scores.0 as f64 / n as f64, rmse(scores));
     if fitness == 0.0 {
         return Err(Error::Geometry(format!(
             "trajectory alignment: no sample brought any camera within {} of the reference (is the trajectory in the reference's frame order?)",
