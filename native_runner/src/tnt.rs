@@ -56,10 +56,11 @@ pub fn evaluate_run(
     let (frames, _) = tnt::log_from_model(model, &names);
     let rel = report_path(&rec.dataset, &rec.pipeline);
     let files = out.join(rel.trim_end_matches(".json"));
-    write_atomic(
-        &files.join("trajectory.log"),
-        tnt::write_log(&frames).as_bytes(),
-    )?;
+    let log = tnt::write_log(&frames);
+    write_atomic(&files.join("trajectory.log"), log.as_bytes())?;
+    // Evaluated from the written file's numbers (12 decimals), so that `sfmeval tnt` on the
+    // run's files reproduces the report exactly.
+    let frames = tnt::read_log(log.as_bytes())?;
     let request = TntRequest {
         tau,
         registration: Registration::Protocol {
