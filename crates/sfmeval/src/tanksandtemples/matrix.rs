@@ -35,7 +35,7 @@ pub fn mul(a: &Matrix4, b: &Matrix4) -> Matrix4 {
     m
 }
 
-/// Checks a transform: finite, within ±[`MAX_COORDINATE`], last row `0 0 0 1`, and an
+/// Checks a transform: finite, entries within ±1e50, last row `0 0 0 1`, and an
 /// invertible upper 3×3. `what` names it in the error.
 pub fn validate(m: &Matrix4, what: &str) -> Result<()> {
     if let Some(v) = m
