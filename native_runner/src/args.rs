@@ -319,7 +319,7 @@ pub struct Table1Args {
     #[arg(long, num_args = 1..)]
     pub presets: Vec<String>,
     /// Real scenes besides the generated datasets: folders in the Tanks and Temples layout
-    /// (images/ plus <scene>.ply, <scene>.json, <scene>_trans.txt, <scene>_COLMAP_SfM.log, the
+    /// (images/ plus SCENE.ply, SCENE.json, SCENE_trans.txt, SCENE_COLMAP_SfM.log, the
     /// folder named after the scene), run like the others and evaluated with the benchmark's
     /// protocol at the scene's τ.
     #[arg(long = "scene", value_name = "DIR")]

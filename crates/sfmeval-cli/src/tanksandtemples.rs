@@ -15,9 +15,9 @@ use crate::progress::Bars;
 /// `sfmeval tnt`'s flags.
 #[derive(Args, Debug)]
 pub struct TntArgs {
-    /// The scene folder as the benchmark ships it: <scene>.ply, <scene>.json (crop),
-    /// <scene>_trans.txt, <scene>_COLMAP_SfM.log and, for video trajectories,
-    /// <scene>_mapping_reference.txt. The folder's name is the scene's.
+    /// The scene folder as the benchmark ships it: SCENE.ply, SCENE.json (crop),
+    /// SCENE_trans.txt, SCENE_COLMAP_SfM.log and, for video trajectories,
+    /// SCENE_mapping_reference.txt. The folder's name is the scene's.
     #[arg(long, value_name = "DIR")]
     scene: PathBuf,
     /// The files' stem when it is not the folder's name.
@@ -40,7 +40,7 @@ pub struct TntArgs {
     /// Seed of the trajectory alignment's RANSAC.
     #[arg(long, value_name = "S", default_value_t = 0)]
     seed: u64,
-    /// Output folder for report.json, <scene>.precision.ply / .recall.ply (coloured by
+    /// Output folder for report.json, SCENE.precision.ply / .recall.ply (coloured by
     /// distance) and the toolbox's .precision.txt, .recall.txt and .prf_tau_plotstr.txt
     /// (default: an `evaluation` folder beside the reconstruction, as the toolbox does).
     #[arg(long, value_name = "DIR")]

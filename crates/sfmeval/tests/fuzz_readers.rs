@@ -106,10 +106,23 @@ fn tanksandtemples_readers_survive_mutations() {
         }
     });
     // The unmutated files read.
-    assert_eq!(read_log(&fixture("Synth_COLMAP_SfM.log")).unwrap().len(), 36);
-    assert_eq!(read_mapping(&fixture("Synth_mapping_reference.txt")).unwrap().video_frames[35], 351);
+    assert_eq!(
+        read_log(&fixture("Synth_COLMAP_SfM.log")).unwrap().len(),
+        36
+    );
+    assert_eq!(
+        read_mapping(&fixture("Synth_mapping_reference.txt"))
+            .unwrap()
+            .video_frames[35],
+        351
+    );
     assert!(matrix::parse(&fixture("Synth_trans.txt"), "trans").is_ok());
-    assert!(sfmeval::crop::Crop::parse(&fixture("Synth.json")).unwrap().volume.is_some());
+    assert!(
+        sfmeval::crop::Crop::parse(&fixture("Synth.json"))
+            .unwrap()
+            .volume
+            .is_some()
+    );
 }
 
 #[test]

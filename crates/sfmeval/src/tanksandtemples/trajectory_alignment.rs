@@ -130,9 +130,7 @@ pub fn align_trajectories(
         let scores = parallel::map(chunk, &NoProgress, |s| score(s, bound));
         for (k, s) in scores.into_iter().enumerate() {
             let Some(s) = s else { continue };
-            let better = best.is_none_or(|(_, b)| {
-                s.0 > b.0 || (s.0 == b.0 && rmse(s) < rmse(b))
-            });
+            let better = best.is_none_or(|(_, b)| s.0 > b.0 || (s.0 == b.0 && rmse(s) < rmse(b)));
             if better {
                 best = Some((c * 4096 + k, s));
             }
