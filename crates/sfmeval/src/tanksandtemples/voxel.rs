@@ -35,23 +35,20 @@ pub fn voxel_down_sample(points: &[Point3], size: f64) -> Result<Vec<Point3>> {
             "voxel size {size} is too small for a cloud {extent} across"
         )));
     }
-    let mut voxel_of: HashMap<[i32; 3], u32, BuildHasherDefault<VoxelHasher>> =
-        HashMap::with_capacity_and_hasher(points.len() / 4, Default::default());
-    let mut sums: Vec<([f64; 3], u32)> = Vec::new();
-    for p in points {
-        // Floors within ±i32::MAX by the check above; `as` saturates anyway.
-        let key = [0, 1, 2].map(|k| ((p[k] - start[k]) / size).floor() as i32);
-        let next = sums.len() as u32;
-        let slot = *voxel_of.entry(key).or_insert(next);
-        if slot == next {
-            sums.push(([0.0; 3], 0));
-        }
-        let (sum, n) = &mut sums[slot as usize];
-        for k in 0..3 {
-            sum[k] += p[k];
-        }
-        *n += 1;
-    }
+    // Voxel indices as one u64 key (21 bits an axis) when the grid is small enough, the common
+    // case, else the index triple.
+    let cells = (0..3)
+        .map(|k| ((max[k] - start[k]) / size).floor())
+        .fold(0.0, f64::max);
+    let index = |p: &Point3| [0, 1, 2].map(|k| ((p[k] - start[k]) / size).floor() as i32);
+    let sums = if cells < f64::from(1u32 << 21) {
+        group(points, |p| {
+            let [x, y, z] = index(p).map(|i| u64::from(i as u32));
+            (x << 42) | (y << 21) | z
+        })
+    } else {
+        group(points, index)
+    };
     Ok(sums
         .into_iter()
         .map(|(s, n)| {
@@ -61,19 +58,51 @@ pub fn voxel_down_sample(points: &[Point3], size: f64) -> Result<Vec<Point3>> {
         .collect())
 }
 
-/// A fast hasher for voxel keys (multiply–rotate over the three coordinates); the map's order is
-/// never used, so its quality only matters for speed.
+/// Sums and counts per key, in the order keys first appear, points summed in input order.
+fn group<K: std::hash::Hash + Eq>(
+    points: &[Point3],
+    key: impl Fn(&Point3) -> K,
+) -> Vec<([f64; 3], u32)> {
+    let mut voxel_of: HashMap<K, u32, BuildHasherDefault<VoxelHasher>> =
+        HashMap::with_capacity_and_hasher(points.len() / 4, Default::default());
+    let mut sums: Vec<([f64; 3], u32)> = Vec::new();
+    for p in points {
+        let next = sums.len() as u32;
+        let slot = *voxel_of.entry(key(p)).or_insert(next);
+        if slot == next {
+            sums.push(([0.0; 3], 0));
+        }
+        let (sum, n) = &mut sums[slot as usize];
+        for k in 0..3 {
+            sum[k] += p[k];
+        }
+        *n += 1;
+    }
+    sums
+}
+
+/// A fast hasher for voxel keys (multiply–rotate, then a finaliser); the map's order is never
+/// used, so its quality only matters for speed.
 #[derive(Default)]
 struct VoxelHasher(u64);
 
 impl Hasher for VoxelHasher {
     fn finish(&self) -> u64 {
-        self.0
+        // MurmurHash3's finaliser: the map takes its bucket from the low bits, which the
+        // multiplications alone fill from the key's low bits only.
+        let mut h = self.0;
+        h ^= h >> 33;
+        h = h.wrapping_mul(0xff51_afd7_ed55_8ccd);
+        h ^= h >> 33;
+        h = h.wrapping_mul(0xc4ce_b9fe_1a85_ec53);
+        h ^ (h >> 33)
     }
 
     fn write(&mut self, bytes: &[u8]) {
-        for b in bytes {
-            self.write_u64(u64::from(*b));
+        for chunk in bytes.chunks(8) {
+            let mut word = [0u8; 8];
+            word[..chunk.len()].copy_from_slice(chunk);
+            self.write_u64(u64::from_le_bytes(word));
         }
     }
 
@@ -113,5 +142,11 @@ mod tests {
         assert!(voxel_down_sample(&pts, f64::NAN).is_err());
         assert!(voxel_down_sample(&pts, 1e-12).is_err());
         assert!(voxel_down_sample(&[], 1.0).unwrap().is_empty());
+        // A grid wider than 2^21 voxels takes the triple-key path: the same means.
+        let wide = [[0.0, 0.0, 0.0], [0.2, 0.0, 0.0], [5e6, 1.0, 1.0]];
+        assert_eq!(
+            voxel_down_sample(&wide, 1.0).unwrap(),
+            vec![[0.1, 0.0, 0.0], [5e6, 1.0, 1.0]]
+        );
     }
 }
