@@ -29,11 +29,20 @@ def clean_out_dir(out_dir):
         p = os.path.join(out_dir, sub)
         if os.path.isdir(p):
             shutil.rmtree(p)
-    for name in ("cameras.json", "dataset.json", "timing.json", "ground_truth.glb", "scene.blend",
-                 ".aux.exr"):
+    for name in ("cameras.json", "dataset.json", "timing.json", "ground_truth.glb", "scene.blend"):
         p = os.path.join(out_dir, name)
         if os.path.exists(p):
             os.remove(p)
+    remove_leftovers(out_dir)
+
+
+def remove_leftovers(out_dir):
+    """Temporary files of renders that were killed: the depth pass's ``.aux-<pid>.exr`` and the
+    lossless ``images/*.render.png`` of a post-processed view."""
+    import glob
+    for p in glob.glob(os.path.join(out_dir, ".aux*.exr")) + glob.glob(
+            os.path.join(out_dir, "images", "*.render.png")):
+        os.remove(p)
 
 
 def _build_scene(cfg):
@@ -142,6 +151,7 @@ def finalize(cfg, out_dir):
             out.append(os.path.join(out_dir, "masks", stem + ".png"))
         return out
 
+    remove_leftovers(out_dir)
     found = parts.read_parts(out_dir)
     info, timing_parts = parts.merge([p for p in found if p["images"]], cfg, names, files)
     steps.store(bpy.context.scene, "render_info", info)

@@ -830,7 +830,8 @@ def render_aux(cfg, out_dir, meta, progress=None, after_frame=None):
         for o in holdouts:
             o.is_holdout = True
         _set_output(scene, "EXR", cfg)
-        tmp = os.path.join(out_dir, ".aux.exr")
+        # one name per process: parts of a dataset may render into the same folder at once
+        tmp = os.path.join(out_dir, ".aux-%d.exr" % os.getpid())
         depth_dir = os.path.join(out_dir, "depth")
         mask_dir = os.path.join(out_dir, "masks")
         if cfg["outputs"]["depth"]:

@@ -92,23 +92,25 @@ def test_dry_run_writes_the_scripts_and_submits_nothing(runner_bin, cluster, tmp
     assert cluster.jobs() == {} and not (slurm / "jobs.json").exists()
     render = (slurm / "render.sbatch").read_text()
     run = (slurm / "run.sbatch").read_text()
-    for line in ["#SBATCH --array=0-1", "#SBATCH --cpus-per-task=1", "#SBATCH --mem=1G",
+    for line in ["#SBATCH --cpus-per-task=1", "#SBATCH --mem=1G",
                  "#SBATCH --partition=debug", "#SBATCH --account=lab",
                  "#SBATCH --output=%s/logs/render-%%a.out" % slurm]:
         assert line in render.splitlines(), (line, render)
-    for line in ["#SBATCH --array=0-1", "#SBATCH --cpus-per-task=2", "#SBATCH --mem=3G",
+    for line in ["#SBATCH --cpus-per-task=2", "#SBATCH --mem=3G",
                  "#SBATCH --time=00:20:00", "#SBATCH --partition=debug"]:
         assert line in run.splitlines(), (line, run)
     assert "slurm-task --plan %s/plan.json --stage run --index \"$SLURM_ARRAY_TASK_ID\"" \
         % slurm in run
     collect = (slurm / "collect.sbatch").read_text()
-    assert "--array" not in collect and "--stage collect --index 0" in collect
+    assert "#SBATCH --array" not in collect and "--stage collect --index 0" in collect
     submit = (slurm / "submit.sh").read_text().splitlines()
     sb = [l for l in submit if "sbatch --parsable" in l]
-    assert [l.split("=")[0] for l in sb] == ["render", "finalize", "run", "collect"]
-    assert "--dependency=afterok:$render --kill-on-invalid-dep=yes" in sb[1]
-    assert "--dependency=afterok:$finalize --kill-on-invalid-dep=yes" in sb[2]
-    assert "--dependency=afterany:$render:$finalize:$run" in sb[3]
+    assert [l.split("=")[0] for l in sb] == ["render_0", "finalize_0", "run_0", "collect"]
+    assert "--parsable --array=0-1 %s/render.sbatch" % slurm in sb[0]
+    assert "--array=0 --dependency=afterok:$render_0 --kill-on-invalid-dep=yes" in sb[1]
+    assert "--array=0-1 --dependency=afterok:$finalize_0 --kill-on-invalid-dep=yes" in sb[2]
+    assert "--dependency=afterany:$render_0:$finalize_0:$run_0" in sb[3]
+    assert "--array" not in sb[3]
     assert slurm_testlib.subprocess.run(["bash", "-n", str(slurm / "submit.sh")]).returncode == 0
     plan = load(slurm / "plan.json")
     assert plan["cells"] == [{"dataset": NAME, "pipeline": "openmvg"},
@@ -157,7 +159,8 @@ def test_slurm_gives_the_local_table_and_resume_completes_it(runner_bin, tools, 
     subs = load(out / "slurm" / "jobs.json")
     assert len(subs) == 1
     stages = {s["stage"]: s for s in subs[0]["stages"]}
-    assert list(stages) == ["render", "finalize", "run", "collect"]
+    assert [s["label"] for s in subs[0]["stages"]] == ["render_0", "finalize_0", "run_0",
+                                                       "collect"]
     assert stages["render"]["tasks"] == [0, 1] and stages["run"]["tasks"] == [0, 1]
     plan = load(out / "slurm" / "plan.json")
     k = [c["pipeline"] for c in plan["cells"]].index("pycolmap")

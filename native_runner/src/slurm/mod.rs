@@ -9,7 +9,7 @@
 //!    result becomes a failed or timed-out cell with Slurm's reason), evaluate and write the
 //!    tables, as a local `table1` does.
 //!
-//! The modules: [`plan`] (what task k of a stage does, where it writes), [`resources`] (the
+//! The modules: [`plan`] (what task k of a stage does, where it writes), [`resources`](mod@resources) (the
 //! per-stage `--cpus-per-task`, `--mem`, `--time`, partition, account), [`script`] (the sbatch
 //! scripts and `submit.sh`), [`submit`] (`sbatch` and `jobs.json`), [`state`] (which tasks left
 //! their result, why one did not), [`task`] (running one task) and [`collect`].
@@ -89,28 +89,47 @@ fn make_plan(a: &Table1Args, argv: Vec<String>) -> Result<Plan> {
     })
 }
 
-/// What to submit: each stage's tasks without result (all of them in a new batch), each
-/// waiting on the last stage submitted before it; the collect stage always.
+/// What to submit: per dataset, its render tasks without result, then its finalize task, then
+/// its run tasks, each `afterok` on the one before it that is submitted; last the collect,
+/// `afterany` on everything submitted (always: the tables are rewritten on every submission).
 fn submissions(plan: &Plan) -> Vec<Submission> {
+    let missing: Vec<Vec<usize>> = [Stage::Render, Stage::Finalize, Stage::Run]
+        .into_iter()
+        .map(|st| missing_tasks(plan, st))
+        .collect();
+    let n = plan.render_shards.max(1);
     let mut subs: Vec<Submission> = Vec::new();
-    for stage in [Stage::Render, Stage::Finalize, Stage::Run] {
-        let tasks = missing_tasks(plan, stage);
-        if tasks.is_empty() {
-            continue;
+    for (d, ds) in plan.datasets.iter().enumerate() {
+        let mut previous: Option<usize> = None;
+        for (stage, tasks) in [Stage::Render, Stage::Finalize, Stage::Run]
+            .into_iter()
+            .zip(&missing)
+        {
+            let mine: Vec<usize> = tasks
+                .iter()
+                .copied()
+                .filter(|&k| match stage {
+                    Stage::Render => k / n == d,
+                    Stage::Finalize => k == d,
+                    _ => plan.cells.get(k).is_some_and(|c| c.dataset == ds.name),
+                })
+                .collect();
+            if mine.is_empty() {
+                continue;
+            }
+            subs.push(Submission {
+                stage,
+                label: format!("{}_{d}", stage.name()),
+                tasks: mine,
+                dependency: previous.map_or(Dependency::None, Dependency::AfterOk),
+            });
+            previous = Some(subs.len() - 1);
         }
-        let dependency = match subs.last() {
-            Some(prev) => Dependency::AfterOk(prev.stage),
-            None => Dependency::None,
-        };
-        subs.push(Submission {
-            stage,
-            tasks,
-            dependency,
-        });
     }
-    let before: Vec<Stage> = subs.iter().map(|s| s.stage).collect();
+    let before: Vec<usize> = (0..subs.len()).collect();
     subs.push(Submission {
         stage: Stage::Collect,
+        label: "collect".into(),
         tasks: vec![0],
         dependency: if before.is_empty() {
             Dependency::None
@@ -159,13 +178,13 @@ pub fn submit_table1(a: &Table1Args) -> Result<()> {
         std::fs::create_dir_all(&dir).with_context(|| format!("creating {}", dir.display()))?;
     }
     let subs = submissions(&plan);
-    for sub in &subs {
+    for stage in Stage::ALL {
         let r = res
-            .get(&sub.stage)
-            .with_context(|| format!("no resources for stage {}", sub.stage.name()))?;
+            .get(&stage)
+            .with_context(|| format!("no resources for stage {}", stage.name()))?;
         write_atomic(
-            &plan.script(sub.stage),
-            sbatch_script(&plan, sub, r)?.as_bytes(),
+            &plan.script(stage),
+            sbatch_script(&plan, stage, r)?.as_bytes(),
         )?;
     }
     let submit_path = plan.slurm_dir().join("submit.sh");
@@ -176,15 +195,15 @@ pub fn submit_table1(a: &Table1Args) -> Result<()> {
     let mut text = serde_json::to_string_pretty(&plan)?;
     text.push('\n');
     write_atomic(&plan_path, text.as_bytes())?;
-    let summary: Vec<String> = subs
-        .iter()
-        .map(|s| {
-            format!(
-                "{} {}/{}",
-                s.stage.name(),
-                s.tasks.len(),
-                plan.task_count(s.stage)
-            )
+    let summary: Vec<String> = Stage::ALL
+        .into_iter()
+        .filter_map(|st| {
+            let k: usize = subs
+                .iter()
+                .filter(|s| s.stage == st)
+                .map(|s| s.tasks.len())
+                .sum();
+            (k > 0).then(|| format!("{} {k}/{}", st.name(), plan.task_count(st)))
         })
         .collect();
     if a.slurm.dry_run {
@@ -205,4 +224,95 @@ pub fn submit_table1(a: &Table1Args) -> Result<()> {
         plan.slurm_dir().join("logs").display()
     );
     Ok(())
+}
+
+#[cfg(test)]
+#[allow(clippy::unwrap_used, clippy::expect_used)]
+mod tests {
+    use super::*;
+
+    fn plan(out: &std::path::Path) -> Plan {
+        let ds = |n: &str| DatasetPlan {
+            preset: n.into(),
+            name: n.into(),
+            generator_args: Vec::new(),
+        };
+        let cell = |d: &str, p: &str| CellPlan {
+            dataset: d.into(),
+            pipeline: p.into(),
+        };
+        Plan {
+            schema: PLAN_SCHEMA.into(),
+            argv: Vec::new(),
+            cwd: out.into(),
+            runner: out.join("sfmeval-runner"),
+            python: out.join("python"),
+            blender_scripts: out.into(),
+            out: out.into(),
+            render_shards: 2,
+            datasets: vec![ds("b"), ds("a")],
+            pipelines: vec!["p".into(), "q".into()],
+            cells: vec![
+                cell("a", "p"),
+                cell("a", "q"),
+                cell("b", "p"),
+                cell("b", "q"),
+            ],
+        }
+    }
+
+    #[test]
+    fn each_dataset_is_chained_alone_and_resume_submits_what_is_missing() {
+        let out = std::env::temp_dir().join(format!("sfmeval-slurm-plan-{}", std::process::id()));
+        let p = plan(&out);
+        let subs = submissions(&p);
+        let shape: Vec<(String, Vec<usize>, Dependency)> = subs
+            .iter()
+            .map(|s| (s.label.clone(), s.tasks.clone(), s.dependency.clone()))
+            .collect();
+        assert_eq!(
+            shape,
+            vec![
+                ("render_0".into(), vec![0, 1], Dependency::None),
+                ("finalize_0".into(), vec![0], Dependency::AfterOk(0)),
+                ("run_0".into(), vec![2, 3], Dependency::AfterOk(1)),
+                ("render_1".into(), vec![2, 3], Dependency::None),
+                ("finalize_1".into(), vec![1], Dependency::AfterOk(3)),
+                ("run_1".into(), vec![0, 1], Dependency::AfterOk(4)),
+                (
+                    "collect".into(),
+                    vec![0],
+                    Dependency::AfterAny(vec![0, 1, 2, 3, 4, 5])
+                ),
+            ]
+        );
+        // Dataset b finalized, one shard of a rendered, a's run of q finished.
+        std::fs::create_dir_all(p.dataset_dir("b")).unwrap();
+        std::fs::write(p.dataset_dir("b").join("dataset.json"), "{}").unwrap();
+        let parts = p.dataset_dir("a").join(".parts");
+        std::fs::create_dir_all(&parts).unwrap();
+        std::fs::write(parts.join("views-1-of-2.json"), "{}").unwrap();
+        let run = p.task_runs(1).join("a").join("q");
+        std::fs::create_dir_all(&run).unwrap();
+        std::fs::write(run.join("run.json"), "{}").unwrap();
+        let shape: Vec<(String, Vec<usize>, Dependency)> = submissions(&p)
+            .iter()
+            .map(|s| (s.label.clone(), s.tasks.clone(), s.dependency.clone()))
+            .collect();
+        assert_eq!(
+            shape,
+            vec![
+                ("run_0".into(), vec![2, 3], Dependency::None),
+                ("render_1".into(), vec![2], Dependency::None),
+                ("finalize_1".into(), vec![1], Dependency::AfterOk(1)),
+                ("run_1".into(), vec![0], Dependency::AfterOk(2)),
+                (
+                    "collect".into(),
+                    vec![0],
+                    Dependency::AfterAny(vec![0, 1, 2, 3])
+                ),
+            ]
+        );
+        let _ = std::fs::remove_dir_all(&out);
+    }
 }

@@ -9,25 +9,29 @@ use crate::exec::shell_quote;
 use crate::slurm::plan::{Plan, Stage};
 use crate::slurm::resources::Resources;
 
-/// How a stage waits for the ones before it.
+/// How a submission waits for the ones before it (indices into the list of submissions).
 #[derive(Debug, Clone, PartialEq)]
 pub enum Dependency {
     /// Starts at once.
     None,
-    /// `afterok` on a stage: every task of it succeeded. The job is cancelled when that can
+    /// `afterok`: every task of that submission succeeded. The job is cancelled when that can
     /// no longer happen (`--kill-on-invalid-dep=yes`), so nothing waits forever.
-    AfterOk(Stage),
-    /// `afterany` on stages: they ended, however (the collect stage: a failed, cancelled or
+    AfterOk(usize),
+    /// `afterany`: those submissions ended, however (the collect stage: a failed, cancelled or
     /// timed-out task becomes a failed cell of the table).
-    AfterAny(Vec<Stage>),
+    AfterAny(Vec<usize>),
 }
 
-/// One stage to submit: its tasks (array indices) and what it waits for.
+/// One `sbatch` call: a stage's script for some of its tasks (one dataset's), and what it
+/// waits for. The datasets are chained separately, so one dataset's runs start when its own
+/// render is finished and a failed render holds back only its own runs.
 #[derive(Debug, Clone)]
 pub struct Submission {
     /// The stage.
     pub stage: Stage,
-    /// Its task indices to run (all of them, or the missing ones on `--resume`).
+    /// Its name in `submit.sh` and `jobs.json`: `render_0`, `run_2`, `collect`.
+    pub label: String,
+    /// The task indices (the array), all or the missing ones on `--resume`.
     pub tasks: Vec<usize>,
     /// What it waits for.
     pub dependency: Dependency,
@@ -71,22 +75,20 @@ fn sbatch_path(p: &Path) -> Result<String> {
     Ok(s)
 }
 
-/// The sbatch script of one stage.
-pub fn sbatch_script(plan: &Plan, sub: &Submission, res: &Resources) -> Result<String> {
-    let stage = sub.stage.name();
+/// The sbatch script of one stage (the array of tasks is given at submission).
+pub fn sbatch_script(plan: &Plan, stage: Stage, res: &Resources) -> Result<String> {
+    let kind = stage;
+    let stage = kind.name();
     let logs = plan.slurm_dir().join("logs");
     let mut s = String::from("#!/bin/bash\n");
     s.push_str(&format!(
-        "# sfmeval-runner {}: stage '{stage}' of the batch in {} ({} of {} task(s)).\n",
+        "# sfmeval-runner {}: stage '{stage}' of the batch in {} ({} task(s); submit.sh gives\n\
+         # each sbatch call its --array of task indices).\n",
         env!("CARGO_PKG_VERSION"),
         plan.out.display(),
-        sub.tasks.len(),
-        plan.task_count(sub.stage)
+        plan.task_count(kind)
     ));
     s.push_str(&format!("#SBATCH --job-name=sfmeval-{stage}\n"));
-    if sub.stage != Stage::Collect {
-        s.push_str(&format!("#SBATCH --array={}\n", array_spec(&sub.tasks)));
-    }
     s.push_str(&format!("#SBATCH --cpus-per-task={}\n", res.cpus));
     s.push_str(&format!("#SBATCH --mem={}\n", res.mem));
     s.push_str(&format!("#SBATCH --time={}\n", res.time));
@@ -97,20 +99,24 @@ pub fn sbatch_script(plan: &Plan, sub: &Submission, res: &Resources) -> Result<S
         s.push_str(&format!("#SBATCH --account={a}\n"));
     }
     s.push_str(&format!("#SBATCH --chdir={}\n", sbatch_path(&plan.cwd)?));
-    let log = match sub.stage {
+    let log = match kind {
         Stage::Collect => "collect.out".to_string(),
         _ => format!("{stage}-%a.out"),
     };
     s.push_str(&format!("#SBATCH --output={}/{log}\n", sbatch_path(&logs)?));
     s.push_str("#SBATCH --open-mode=append\n");
-    let index = match sub.stage {
+    let index = match kind {
         Stage::Collect => "0".to_string(),
         _ => "\"$SLURM_ARRAY_TASK_ID\"".to_string(),
     };
     s.push_str("set -eu\n");
     s.push_str(&format!(
         "echo \"# sfmeval {stage} task {} (job ${{SLURM_JOB_ID}}) on $(hostname) at $(date -u +%FT%TZ)\"\n",
-        if sub.stage == Stage::Collect { "0".to_string() } else { "${SLURM_ARRAY_TASK_ID}".to_string() }
+        if kind == Stage::Collect {
+            "0".to_string()
+        } else {
+            "${SLURM_ARRAY_TASK_ID}".to_string()
+        }
     ));
     s.push_str(&format!(
         "exec {} slurm-task --plan {} --stage {stage} --index {index}\n",
@@ -120,30 +126,32 @@ pub fn sbatch_script(plan: &Plan, sub: &Submission, res: &Resources) -> Result<S
     Ok(s)
 }
 
-/// The `sbatch` options of a submission's dependency, given the job ids of the stages
-/// submitted before it.
-pub fn dependency_args(dep: &Dependency, job_of: impl Fn(Stage) -> Option<String>) -> Vec<String> {
-    match dep {
-        Dependency::None => Vec::new(),
-        Dependency::AfterOk(st) => match job_of(*st) {
-            Some(id) => vec![
-                format!("--dependency=afterok:{id}"),
-                "--kill-on-invalid-dep=yes".into(),
-            ],
-            None => Vec::new(),
-        },
-        Dependency::AfterAny(sts) => {
-            let ids: Vec<String> = sts.iter().filter_map(|s| job_of(*s)).collect();
-            if ids.is_empty() {
-                Vec::new()
-            } else {
-                vec![format!("--dependency=afterany:{}", ids.join(":"))]
+/// The `sbatch` options of one call: its array (not for collect) and its dependency, given
+/// the job ids of the submissions before it.
+pub fn sbatch_args(sub: &Submission, job_of: impl Fn(usize) -> Option<String>) -> Vec<String> {
+    let mut args = Vec::new();
+    if sub.stage != Stage::Collect {
+        args.push(format!("--array={}", array_spec(&sub.tasks)));
+    }
+    match &sub.dependency {
+        Dependency::None => {}
+        Dependency::AfterOk(i) => {
+            if let Some(id) = job_of(*i) {
+                args.push(format!("--dependency=afterok:{id}"));
+                args.push("--kill-on-invalid-dep=yes".into());
+            }
+        }
+        Dependency::AfterAny(list) => {
+            let ids: Vec<String> = list.iter().filter_map(|i| job_of(*i)).collect();
+            if !ids.is_empty() {
+                args.push(format!("--dependency=afterany:{}", ids.join(":")));
             }
         }
     }
+    args
 }
 
-/// `submit.sh`: submits the written scripts in order, each with its dependency.
+/// `submit.sh`: submits the written scripts in order, each with its array and dependency.
 pub fn submit_sh(plan: &Plan, subs: &[Submission], sbatch: &str) -> String {
     let mut s = String::from("#!/bin/bash\n");
     s.push_str(&format!(
@@ -151,15 +159,11 @@ pub fn submit_sh(plan: &Plan, subs: &[Submission], sbatch: &str) -> String {
         Plan::path(&plan.out).display()
     ));
     for sub in subs {
-        let var = sub.stage.name();
-        let deps = dependency_args(&sub.dependency, |st| {
-            subs.iter()
-                .any(|x| x.stage == st)
-                .then(|| format!("${}", st.name()))
-        });
+        let args = sbatch_args(sub, |i| subs.get(i).map(|x| format!("${}", x.label)));
         let mut cmd = vec![shell_quote(sbatch), "--parsable".to_string()];
-        cmd.extend(deps);
+        cmd.extend(args);
         cmd.push(shell_quote(&plan.script(sub.stage).to_string_lossy()));
+        let var = &sub.label;
         s.push_str(&format!("{var}=$({} | cut -d';' -f1)\n", cmd.join(" ")));
         s.push_str(&format!("echo \"{var}: job ${var}\"\n"));
     }
@@ -179,16 +183,29 @@ mod tests {
     }
 
     #[test]
-    fn dependencies_name_only_submitted_stages() {
-        let job = |st: Stage| (st != Stage::Finalize).then(|| format!("{}", st as u8 + 10));
+    fn sbatch_args_name_the_array_and_only_submitted_jobs() {
+        let sub = |stage, dependency| Submission {
+            stage,
+            label: "x".into(),
+            tasks: vec![0, 1, 3],
+            dependency,
+        };
+        let job = |i: usize| (i != 1).then(|| format!("{}", i + 10));
         assert_eq!(
-            dependency_args(&Dependency::AfterOk(Stage::Render), job),
-            ["--dependency=afterok:10", "--kill-on-invalid-dep=yes"]
+            sbatch_args(&sub(Stage::Run, Dependency::AfterOk(0)), job),
+            [
+                "--array=0-1,3",
+                "--dependency=afterok:10",
+                "--kill-on-invalid-dep=yes"
+            ]
         );
-        assert!(dependency_args(&Dependency::AfterOk(Stage::Finalize), job).is_empty());
         assert_eq!(
-            dependency_args(
-                &Dependency::AfterAny(vec![Stage::Render, Stage::Finalize, Stage::Run]),
+            sbatch_args(&sub(Stage::Run, Dependency::AfterOk(1)), job),
+            ["--array=0-1,3"]
+        );
+        assert_eq!(
+            sbatch_args(
+                &sub(Stage::Collect, Dependency::AfterAny(vec![0, 1, 2])),
                 job
             ),
             ["--dependency=afterany:10:12"]

@@ -2,14 +2,13 @@
 //! the job ids of the stages before it; and the record of every submission
 //! (`OUT/slurm/jobs.json`).
 
-use std::collections::BTreeMap;
 use std::process::Command;
 
 use anyhow::{Context, Result, bail};
 use sfmeval_fs::write_atomic;
 
-use crate::slurm::plan::{Plan, Stage};
-use crate::slurm::script::{Submission, dependency_args};
+use crate::slurm::plan::Plan;
+use crate::slurm::script::{Submission, sbatch_args};
 
 /// The job id in `sbatch --parsable`'s output (`ID` or `ID;CLUSTER`).
 pub fn parse_job_id(stdout: &str) -> Result<String> {
@@ -26,22 +25,22 @@ pub fn parse_job_id(stdout: &str) -> Result<String> {
     Ok(id)
 }
 
-/// Submits the scripts of `subs` in order; returns each stage's job id.
-pub fn submit(plan: &Plan, subs: &[Submission], sbatch: &str) -> Result<BTreeMap<Stage, String>> {
-    let mut jobs: BTreeMap<Stage, String> = BTreeMap::new();
+/// Submits `subs` in order; returns their job ids.
+pub fn submit(plan: &Plan, subs: &[Submission], sbatch: &str) -> Result<Vec<String>> {
+    let mut jobs: Vec<String> = Vec::new();
     for sub in subs {
-        let deps = dependency_args(&sub.dependency, |st| jobs.get(&st).cloned());
+        let args = sbatch_args(sub, |i| jobs.get(i).cloned());
         let script = plan.script(sub.stage);
         let out = Command::new(sbatch)
             .arg("--parsable")
-            .args(&deps)
+            .args(&args)
             .arg(&script)
             .output()
             .with_context(|| format!("running {sbatch} (is Slurm installed here?)"))?;
         if !out.status.success() {
             bail!(
                 "{sbatch} {} {} failed ({}): {}{}",
-                deps.join(" "),
+                args.join(" "),
                 script.display(),
                 out.status,
                 String::from_utf8_lossy(&out.stderr).trim(),
@@ -49,26 +48,26 @@ pub fn submit(plan: &Plan, subs: &[Submission], sbatch: &str) -> Result<BTreeMap
                     String::new()
                 } else {
                     format!(
-                        " (already submitted: {}; scancel them or let them run, then --resume)",
-                        jobs.values().cloned().collect::<Vec<_>>().join(" ")
+                        " (already submitted: jobs {}; scancel them or let them run, then --resume)",
+                        jobs.join(" ")
                     )
                 }
             );
         }
         let id = parse_job_id(&String::from_utf8_lossy(&out.stdout))?;
         eprintln!(
-            "slurm: {} ({} task(s)) submitted as job {id} {}",
-            sub.stage.name(),
-            sub.tasks.len(),
-            deps.join(" ")
+            "slurm: {} submitted as job {id}: {}",
+            sub.label,
+            args.join(" ")
         );
-        jobs.insert(sub.stage, id);
+        jobs.push(id);
     }
     Ok(jobs)
 }
 
-/// Appends one submission (time, stages, job ids, tasks) to `OUT/slurm/jobs.json`.
-pub fn record(plan: &Plan, subs: &[Submission], jobs: &BTreeMap<Stage, String>) -> Result<()> {
+/// Appends one submission (time; per sbatch call its stage, label, job id, tasks) to
+/// `OUT/slurm/jobs.json`.
+pub fn record(plan: &Plan, subs: &[Submission], jobs: &[String]) -> Result<()> {
     let path = plan.slurm_dir().join("jobs.json");
     let mut all: Vec<serde_json::Value> = std::fs::read(&path)
         .ok()
@@ -80,9 +79,10 @@ pub fn record(plan: &Plan, subs: &[Submission], jobs: &BTreeMap<Stage, String>) 
         .unwrap_or(0.0);
     all.push(serde_json::json!({
         "submitted_unix": now,
-        "stages": subs.iter().map(|s| serde_json::json!({
+        "stages": subs.iter().zip(jobs).map(|(s, job)| serde_json::json!({
             "stage": s.stage.name(),
-            "job": jobs.get(&s.stage),
+            "label": s.label,
+            "job": job,
             "tasks": s.tasks,
         })).collect::<Vec<_>>(),
     }));
