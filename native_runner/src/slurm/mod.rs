@@ -44,7 +44,8 @@ fn make_plan(a: &Table1Args, argv: Vec<String>) -> Result<Plan> {
     }
     let out = std::path::absolute(&a.out)
         .with_context(|| format!("resolving --out {}", a.out.display()))?;
-    let python = std::path::absolute(find_python(a.tools.python.as_deref())?)?;
+    // absolute when given as a path; a bare name is looked up on each node's PATH
+    let python = find_python(a.tools.python.as_deref())?;
     let blender_scripts = std::path::absolute(find_blender_scripts(
         a.generator.blender_scripts.as_deref(),
     )?)?;

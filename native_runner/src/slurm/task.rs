@@ -60,7 +60,9 @@ fn generator(plan: &Plan, ds: &DatasetPlan, extra: &[&str]) -> Result<()> {
         extra.join(" "),
         dir.display()
     );
+    // from the datasets folder, as a local table1 runs it (relative model paths in --set)
     let status = Command::new(&plan.python)
+        .current_dir(plan.out.join("datasets"))
         .arg(&script)
         .args(&ds.generator_args)
         .args(extra)
