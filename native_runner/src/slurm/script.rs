@@ -77,18 +77,17 @@ fn sbatch_path(p: &Path) -> Result<String> {
 
 /// The sbatch script of one stage (the array of tasks is given at submission).
 pub fn sbatch_script(plan: &Plan, stage: Stage, res: &Resources) -> Result<String> {
-    let kind = stage;
-    let stage = kind.name();
+    let name = stage.name();
     let logs = plan.slurm_dir().join("logs");
     let mut s = String::from("#!/bin/bash\n");
     s.push_str(&format!(
-        "# sfmeval-runner {}: stage '{stage}' of the batch in {} ({} task(s); submit.sh gives\n\
+        "# sfmeval-runner {}: stage '{name}' of the batch in {} ({} task(s); submit.sh gives\n\
          # each sbatch call its --array of task indices).\n",
         env!("CARGO_PKG_VERSION"),
         plan.out.display(),
-        plan.task_count(kind)
+        plan.task_count(stage)
     ));
-    s.push_str(&format!("#SBATCH --job-name=sfmeval-{stage}\n"));
+    s.push_str(&format!("#SBATCH --job-name=sfmeval-{name}\n"));
     s.push_str(&format!("#SBATCH --cpus-per-task={}\n", res.cpus));
     s.push_str(&format!("#SBATCH --mem={}\n", res.mem));
     s.push_str(&format!("#SBATCH --time={}\n", res.time));
@@ -99,27 +98,27 @@ pub fn sbatch_script(plan: &Plan, stage: Stage, res: &Resources) -> Result<Strin
         s.push_str(&format!("#SBATCH --account={a}\n"));
     }
     s.push_str(&format!("#SBATCH --chdir={}\n", sbatch_path(&plan.cwd)?));
-    let log = match kind {
+    let log = match stage {
         Stage::Collect => "collect.out".to_string(),
-        _ => format!("{stage}-%a.out"),
+        _ => format!("{name}-%a.out"),
     };
     s.push_str(&format!("#SBATCH --output={}/{log}\n", sbatch_path(&logs)?));
     s.push_str("#SBATCH --open-mode=append\n");
-    let index = match kind {
+    let index = match stage {
         Stage::Collect => "0".to_string(),
         _ => "\"$SLURM_ARRAY_TASK_ID\"".to_string(),
     };
     s.push_str("set -eu\n");
     s.push_str(&format!(
-        "echo \"# sfmeval {stage} task {} (job ${{SLURM_JOB_ID}}) on $(hostname) at $(date -u +%FT%TZ)\"\n",
-        if kind == Stage::Collect {
+        "echo \"# sfmeval {name} task {} (job ${{SLURM_JOB_ID}}) on $(hostname) at $(date -u +%FT%TZ)\"\n",
+        if stage == Stage::Collect {
             "0".to_string()
         } else {
             "${SLURM_ARRAY_TASK_ID}".to_string()
         }
     ));
     s.push_str(&format!(
-        "exec {} slurm-task --plan {} --stage {stage} --index {index}\n",
+        "exec {} slurm-task --plan {} --stage {name} --index {index}\n",
         shell_quote(&plan.runner.to_string_lossy()),
         shell_quote(&Plan::path(&plan.out).to_string_lossy()),
     ));
