@@ -162,6 +162,10 @@ def test_slurm_gives_the_local_table_and_resume_completes_it(runner_bin, tools, 
     assert [s["label"] for s in subs[0]["stages"]] == ["render_0", "finalize_0", "run_0",
                                                        "collect"]
     assert stages["render"]["tasks"] == [0, 1] and stages["run"]["tasks"] == [0, 1]
+    # resuming while the batch is still queued would run tasks twice at once
+    early = run_cli(runner_bin, *table1_args(out, *SLURM, "--resume"), env=env, check=False)
+    assert early.returncode == 1 and "still in the queue" in early.stderr, early.stderr
+    assert len(load(out / "slurm" / "jobs.json")) == 1
     plan = load(out / "slurm" / "plan.json")
     k = [c["pipeline"] for c in plan["cells"]].index("pycolmap")
     job = "%s_%d" % (stages["run"]["job"], k)

@@ -175,6 +175,16 @@ pub fn submit_table1(a: &Table1Args) -> Result<()> {
             plan_path.display()
         );
     }
+    if a.slurm.resume && !a.slurm.dry_run {
+        let queued = submit::still_queued(&plan, &a.slurm.sbatch)?;
+        if !queued.is_empty() {
+            bail!(
+                "--resume: jobs {} of this batch are still in the queue: wait for them (or \
+                 scancel them), then resume",
+                queued.join(" ")
+            );
+        }
+    }
     for dir in [plan.slurm_dir().join("logs"), plan.out.join("datasets")] {
         std::fs::create_dir_all(&dir).with_context(|| format!("creating {}", dir.display()))?;
     }

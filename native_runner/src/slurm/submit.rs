@@ -65,6 +65,54 @@ pub fn submit(plan: &Plan, subs: &[Submission], sbatch: &str) -> Result<Vec<Stri
     Ok(jobs)
 }
 
+/// The jobs of earlier submissions (`OUT/slurm/jobs.json`) still in the queue: a resumed
+/// batch must not run a task twice at once.
+pub fn still_queued(plan: &Plan, sbatch: &str) -> Result<Vec<String>> {
+    let path = plan.slurm_dir().join("jobs.json");
+    let all: Vec<serde_json::Value> = match std::fs::read(&path) {
+        Ok(b) => {
+            serde_json::from_slice(&b).with_context(|| format!("parsing {}", path.display()))?
+        }
+        Err(_) => return Ok(Vec::new()),
+    };
+    let ids: Vec<String> = all
+        .iter()
+        .flat_map(|s| s["stages"].as_array().cloned().unwrap_or_default())
+        .filter_map(|st| st["job"].as_str().map(str::to_string))
+        .collect();
+    if ids.is_empty() {
+        return Ok(Vec::new());
+    }
+    // squeue beside the given sbatch, else on PATH
+    let sbatch_path = std::path::Path::new(sbatch);
+    let squeue = match sbatch_path.parent() {
+        Some(dir) if !dir.as_os_str().is_empty() => dir.join("squeue"),
+        _ => std::path::PathBuf::from("squeue"),
+    };
+    // every job of this user (array tasks under their array's id), kept when it is ours
+    let out = Command::new(&squeue)
+        .args(["-h", "--me", "-o", "%F"])
+        .output()
+        .with_context(|| format!("running {}", squeue.display()))?;
+    if !out.status.success() {
+        bail!(
+            "{} failed ({}): {}",
+            squeue.display(),
+            out.status,
+            String::from_utf8_lossy(&out.stderr).trim()
+        );
+    }
+    let text = String::from_utf8_lossy(&out.stdout);
+    let mut queued: Vec<String> = text
+        .lines()
+        .map(|l| l.trim().to_string())
+        .filter(|l| ids.contains(l))
+        .collect();
+    queued.sort();
+    queued.dedup();
+    Ok(queued)
+}
+
 /// Appends one submission (time; per sbatch call its stage, label, job id, tasks) to
 /// `OUT/slurm/jobs.json`.
 pub fn record(plan: &Plan, subs: &[Submission], jobs: &[String]) -> Result<()> {
