@@ -338,7 +338,7 @@ pub struct Table1Args {
     pub slurm: SlurmArgs,
 }
 
-/// Where `table1` runs: here, or as Slurm job arrays (`--executor slurm`).
+/// Where `table1` and `sweep` run: here, or as Slurm job arrays (`--executor slurm`).
 #[derive(Args, Clone)]
 pub struct SlurmArgs {
     /// `local` (everything in this process) or `slurm`: write sbatch scripts for the stages
@@ -370,6 +370,23 @@ pub struct SlurmArgs {
     /// Slurm: the sbatch executable.
     #[arg(long, default_value = "sbatch")]
     pub sbatch: String,
+}
+
+impl SlurmArgs {
+    /// Fails when a Slurm-only option is given without `--executor slurm`.
+    pub fn check_local(&self) -> Result<()> {
+        if self.dry_run
+            || self.resume
+            || !self.stages.is_empty()
+            || self.partition.is_some()
+            || self.account.is_some()
+        {
+            anyhow::bail!(
+                "--dry-run, --resume, --stage, --partition and --account go with --executor slurm"
+            );
+        }
+        Ok(())
+    }
 }
 
 /// Arguments of the hidden `slurm-task`: one task of a planned batch.
@@ -428,6 +445,9 @@ pub struct SweepArgs {
     /// How every run is measured.
     #[command(flatten)]
     pub eval: EvalArgs,
+    /// Where the stages run (this machine, or a Slurm cluster).
+    #[command(flatten)]
+    pub slurm: SlurmArgs,
 }
 
 #[cfg(test)]

@@ -7,7 +7,7 @@
 //! sfmeval-runner merge runs-0/ runs-1/ ... --out runs/
 //! sfmeval-runner report runs/ --out table/
 //! sfmeval-runner table1 [--quick] [--out table1/] [--executor slurm [--dry-run] [--resume]]
-//! sfmeval-runner sweep --factor views=12,24,36 --dataset-preset statue --pipelines LIST --out sweep/
+//! sfmeval-runner sweep --factor views=12,24,36 --dataset-preset statue --pipelines LIST --out sweep/ [--executor slurm ...]
 //! ```
 
 mod adapters;
@@ -45,6 +45,7 @@ fn main() -> ExitCode {
         Command::Table1(a) if a.slurm.executor == "slurm" => slurm::submit_table1(&a),
         Command::Table1(a) => table1::table1(&a),
         Command::SlurmTask(a) => slurm::task::slurm_task(&a),
+        Command::Sweep(a) if a.slurm.executor == "slurm" => slurm::submit_sweep(&a),
         Command::Sweep(a) => sweep::sweep(&a),
         Command::Pipelines(a) => commands::pipelines(&a),
     };

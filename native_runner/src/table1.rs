@@ -7,7 +7,7 @@
 use std::path::Path;
 use std::time::Instant;
 
-use anyhow::{Context, Result, bail};
+use anyhow::{Context, Result};
 
 use sfmeval_fs::write_atomic;
 
@@ -87,11 +87,7 @@ fn generate(
 pub fn table1(a: &Table1Args) -> Result<()> {
     let t0 = Instant::now();
     a.exec.check()?;
-    let s = &a.slurm;
-    if s.dry_run || s.resume || !s.stages.is_empty() || s.partition.is_some() || s.account.is_some()
-    {
-        bail!("--dry-run, --resume, --stage, --partition and --account go with --executor slurm");
-    }
+    a.slurm.check_local()?;
     let python = crate::env::find_python(a.tools.python.as_deref())?;
     let scripts = std::path::absolute(find_blender_scripts(
         a.generator.blender_scripts.as_deref(),

@@ -1,4 +1,4 @@
-"""`sfmeval-runner table1 --executor slurm` on a real one-node Slurm cluster (slurmctld + slurmd +
+"""`sfmeval-runner table1|sweep --executor slurm` on a real one-node Slurm cluster (slurmctld + slurmd +
 munged started by slurm_testlib in a temporary folder, stopped by their PIDs at the end).
 
 The job: `table1 --quick` on one preset (statue) with two pipelines (openmvg, pycolmap) at
@@ -6,8 +6,11 @@ The job: `table1 --quick` on one preset (statue) with two pipelines (openmvg, py
 task per pipeline, collect. It is run once locally and once through Slurm; the pycolmap run task
 is cancelled (scancel) while it runs, the table is written with that cell marked, and
 `--resume` submits only that task (and the collect), after which the table equals the local one
-byte for byte. Measured on 2 vCPUs: ~15 s locally, ~25 s through Slurm, ~10 s the resume."""
+byte for byte. Then a `noise=0,8` sweep (small preset at the same size, openmvg) locally and
+through Slurm: the same sweep.csv and charts but for the run times. Measured on 2 vCPUs
+(loaded): table1 ~12 s locally, ~25 s through Slurm with its resume; the sweep test 40-60 s."""
 
+import csv
 import json
 import os
 import time
@@ -220,3 +223,45 @@ def test_slurm_gives_the_local_table_and_resume_completes_it(runner_bin, tools, 
     assert (out / "table" / "table1.md").read_text() == (local / "table" / "table1.md").read_text()
     print("slurm: first submission %.1f s, resume %.1f s" % (first, resumed))
     print(json.dumps(load(out / "table1.json")["timing"]))
+
+
+SWEEP = ["sweep", "--factor", "noise=0,8", "--dataset-preset", "small",
+         "--set", "render.samples=4", "--set", "camera.resolution=[320, 180]",
+         "--set", "views.orbits=[{elevation_deg=20.0, count=12}, "
+                  "{elevation_deg=45.0, count=12, azimuth_offset_deg=15.0}]",
+         "--pipelines", "openmvg", "--samples", "100000"]
+
+
+def test_a_sweep_through_slurm_equals_the_local_sweep(runner_bin, tools, cluster, tmp_path):
+    """`sweep --executor slurm`: one dataset per value (2 render parts each), its runs, and a
+    collect that writes the local sweep's CSV and charts."""
+    local = tmp_path / "local"
+    run_cli(runner_bin, *SWEEP, "--out", local)
+    out = tmp_path / "slurm"
+    p = run_cli(runner_bin, *SWEEP, "--out", out, *SLURM, env={"SLURM_CONF": cluster.conf})
+    assert "submitted render 4/4, finalize 2/2, run 2/2, collect 1/1" in p.stderr, p.stderr
+    labels = [s["label"] for s in load(out / "slurm" / "jobs.json")[0]["stages"]]
+    assert labels == ["render_0", "finalize_0", "run_0", "render_1", "finalize_1", "run_1",
+                      "collect"]
+    cluster.wait_idle(240)
+    # every column but the measured run time (run.wall_seconds), which two runs never share
+    def table(path):
+        with open(path, newline="") as f:
+            return [{k: v for k, v in r.items() if k != "run.wall_seconds"}
+                    for r in csv.DictReader(f)]
+    rows = table(out / "sweep.csv")
+    assert rows == table(local / "sweep.csv")
+    assert [(r["dataset"], r["pipeline"]) for r in rows] == [("noise-0", "openmvg"),
+                                                             ("noise-8", "openmvg")]
+    assert rows[0]["status"] == "ok" and float(rows[0]["report.accuracy.mean"]) > 0
+    charts = sorted(os.listdir(local / "charts"))
+    assert "report_accuracy_mean.svg" in charts and sorted(os.listdir(out / "charts")) == charts
+    for c in charts:
+        if c != "run_wall_seconds.svg":
+            assert (out / "charts" / c).read_text() == (local / "charts" / c).read_text(), c
+    doc = load(out / "sweep.json")
+    assert [v["status"] for v in doc["variants"]] == ["rendered", "rendered"]
+    assert doc["timing"]["executor"] == "slurm" and doc["timing"]["tasks_without_result"] == []
+    for v in ["noise-0", "noise-8"]:
+        a, b = files(local / "datasets" / v), files(out / "datasets" / v)
+        assert [f for f in a if a[f] != b.get(f)] == ["timing.json"], v

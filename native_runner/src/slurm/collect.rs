@@ -12,13 +12,16 @@ use anyhow::{Context, Result};
 use serde_json::json;
 use sfmeval_fs::write_atomic;
 
+use crate::args::{SweepArgs, Table1Args};
 use crate::dataset::Dataset;
 use crate::files::{copy_dir, partial_name, replace_dir};
 use crate::pipelines::{parse_customs, parse_list};
 use crate::report::{ReportArgs, report};
 use crate::run::{RUN_SCHEMA, RunRecord, Status, read_record};
-use crate::slurm::plan::{CellPlan, Plan, Stage};
+use crate::slurm::plan::{CellPlan, Job, Plan, Stage};
 use crate::slurm::state::{dataset_done, end_reason, task_done};
+use crate::sweep::variants::Variant;
+use crate::sweep::{SweepPlan, write_results};
 
 /// Why run task `k` has no result: its dataset's missing render or finalize task, or itself.
 fn why_missing(plan: &Plan, k: usize, cell: &CellPlan) -> (Status, String) {
@@ -110,17 +113,27 @@ fn write_missing_run(
     replace_dir(&tmp, dest)
 }
 
-/// Merges the runs, marks the missing ones, evaluates, writes `OUT/table/` and
-/// `OUT/table1.json`.
-pub fn collect(plan: &Plan) -> Result<()> {
-    let t0 = Instant::now();
-    let a = plan.table1_args()?;
-    let customs = parse_customs(&a.tools.customs)?;
-    let specs = parse_list(&a.pipelines, &customs)?;
+/// What the merge found.
+struct Merged {
+    /// Runs with a result, by status.
+    executed: BTreeMap<String, usize>,
+    /// The tasks without result (task, dataset, pipeline, status, reason).
+    without_result: Vec<serde_json::Value>,
+    /// Wall seconds of the runs with a result.
+    runs_seconds: f64,
+}
+
+/// Merges every run task's result into `OUT/runs/`; a task without result becomes a failed
+/// run there.
+fn merge_runs(plan: &Plan, job: &Job) -> Result<Merged> {
+    let customs = parse_customs(&job.tools().customs)?;
+    let specs = parse_list(job.pipelines(), &customs)?;
     let runs = plan.out.join("runs");
-    let mut executed: BTreeMap<String, usize> = BTreeMap::new();
-    let mut without_result = Vec::new();
-    let mut runs_seconds = 0.0;
+    let mut m = Merged {
+        executed: BTreeMap::new(),
+        without_result: Vec::new(),
+        runs_seconds: 0.0,
+    };
     for (k, cell) in plan.cells.iter().enumerate() {
         let dest = runs.join(&cell.dataset).join(&cell.pipeline);
         let src = plan.task_runs(k).join(&cell.dataset).join(&cell.pipeline);
@@ -129,8 +142,10 @@ pub fn collect(plan: &Plan) -> Result<()> {
         }
         if src.join("run.json").is_file() {
             let rec = read_record(&src)?;
-            *executed.entry(rec.status.label().to_string()).or_default() += 1;
-            runs_seconds += rec.wall_seconds;
+            *m.executed
+                .entry(rec.status.label().to_string())
+                .or_default() += 1;
+            m.runs_seconds += rec.wall_seconds;
             let same = std::fs::read(dest.join("run.json")).ok()
                 == std::fs::read(src.join("run.json")).ok();
             if !same {
@@ -148,10 +163,10 @@ pub fn collect(plan: &Plan) -> Result<()> {
             why.0.label(),
             why.1
         );
-        without_result.push(
-            json!({"task": k, "dataset": cell.dataset, "pipeline": cell.pipeline,
-                                   "status": why.0.label(), "reason": why.1}),
-        );
+        m.without_result
+            .push(json!({"task": k, "dataset": cell.dataset,
+                                     "pipeline": cell.pipeline, "status": why.0.label(),
+                                     "reason": why.1}));
         let spec = specs.iter().find(|s| s.name == cell.pipeline);
         let kind_tool = match spec.map(|s| (s, s.adapter(&customs))) {
             Some((s, Ok(ad))) => (s.kind.clone(), ad.tool().to_string()),
@@ -160,18 +175,17 @@ pub fn collect(plan: &Plan) -> Result<()> {
         let options = spec.map(|s| s.options.clone()).unwrap_or_default();
         write_missing_run(plan, cell, kind_tool, options, why, &dest)?;
     }
-    let table = plan.out.join("table");
-    let t_rep = Instant::now();
-    let rows = report(&ReportArgs {
-        runs: vec![runs],
-        out: table.clone(),
-        datasets: Vec::new(),
-        eval: a.eval.eval_options()?,
-        align: a.eval.align_request()?,
-        verbose: false,
-    })?;
-    let report_seconds = t_rep.elapsed().as_secs_f64();
-    // Render times as the generator measured them (timing.json), per dataset.
+    Ok(m)
+}
+
+/// Render times as the generator measured them (`timing.json`): (total, mean per view) per
+/// dataset.
+fn render_times(
+    plan: &Plan,
+) -> (
+    serde_json::Map<String, serde_json::Value>,
+    serde_json::Map<String, serde_json::Value>,
+) {
     let mut frame_seconds = serde_json::Map::new();
     let mut per_view = serde_json::Map::new();
     for d in &plan.datasets {
@@ -184,18 +198,81 @@ pub fn collect(plan: &Plan) -> Result<()> {
             per_view.insert(d.name.clone(), t["render_seconds_mean"].clone());
         }
     }
+    (frame_seconds, per_view)
+}
+
+/// Merges the runs, marks the missing ones, evaluates and writes what the local command
+/// writes: `table/` and `table1.json` for `table1`; `table/`, `sweep.csv`, `charts/`,
+/// `sweep.html` and `sweep.json` for `sweep`.
+pub fn collect(plan: &Plan) -> Result<()> {
+    let t0 = Instant::now();
+    let job = plan.job()?;
+    let merged = merge_runs(plan, &job)?;
+    match &job {
+        Job::Table1(a) => table1_results(plan, a, &merged, t0),
+        Job::Sweep(a) => sweep_results(plan, a, &merged, t0),
+    }
+}
+
+/// The sweep's outputs: a variant whose dataset was not finalized is a failed variant.
+fn sweep_results(plan: &Plan, a: &SweepArgs, merged: &Merged, t0: Instant) -> Result<()> {
+    let sweep_plan = SweepPlan::new(a, &plan.python, &plan.blender_scripts)?;
+    let (frame_seconds, _) = render_times(plan);
+    let variants: Vec<Variant> = sweep_plan
+        .planned
+        .iter()
+        .map(|pl| {
+            let done = dataset_done(plan, &pl.dataset);
+            Variant {
+                value: pl.text.clone(),
+                dataset: pl.dataset.clone(),
+                overrides: pl.overrides.clone(),
+                status: if done { "rendered" } else { "failed" }.into(),
+                reason: (!done)
+                    .then(|| "not rendered by its Slurm tasks (see OUT/slurm/logs/)".into()),
+                seconds: frame_seconds.get(&pl.dataset).and_then(|v| v.as_f64()),
+            }
+        })
+        .collect();
+    write_results(
+        a,
+        &sweep_plan,
+        &variants,
+        &plan.pipelines,
+        &plan.out,
+        t0,
+        json!({"executor": "slurm", "render_frame_seconds": frame_seconds,
+               "runs_seconds": merged.runs_seconds,
+               "tasks_without_result": merged.without_result}),
+    )
+}
+
+/// `table/` and `table1.json`.
+fn table1_results(plan: &Plan, a: &Table1Args, merged: &Merged, t0: Instant) -> Result<()> {
+    let table = plan.out.join("table");
+    let t_rep = Instant::now();
+    let rows = report(&ReportArgs {
+        runs: vec![plan.out.join("runs")],
+        out: table.clone(),
+        datasets: Vec::new(),
+        eval: a.eval.eval_options()?,
+        align: a.eval.align_request()?,
+        verbose: false,
+    })?;
+    let report_seconds = t_rep.elapsed().as_secs_f64();
+    let (frame_seconds, per_view) = render_times(plan);
     let doc = json!({
         "quick": a.quick,
         "presets": plan.datasets.iter().map(|d| d.preset.clone()).collect::<Vec<_>>(),
         "pipelines": plan.pipelines,
         "executor": "slurm",
-        "runs_executed": executed,
+        "runs_executed": merged.executed,
         "runs_reused": 0,
-        "tasks_without_result": without_result,
+        "tasks_without_result": merged.without_result,
         "timing": {
             "render_frame_seconds": frame_seconds,
             "render_seconds_per_view": per_view,
-            "runs_seconds": runs_seconds,
+            "runs_seconds": merged.runs_seconds,
             "report_seconds": report_seconds,
             "collect_seconds": t0.elapsed().as_secs_f64(),
         },
@@ -208,7 +285,7 @@ pub fn collect(plan: &Plan) -> Result<()> {
     eprintln!(
         "collect: {} run(s), {} without result; tables in {}",
         rows.len(),
-        without_result.len(),
+        merged.without_result.len(),
         table.display()
     );
     Ok(())

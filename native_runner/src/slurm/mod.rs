@@ -1,4 +1,4 @@
-//! `sfmeval-runner table1 --executor slurm`: the seed experiment as Slurm job arrays on a
+//! `sfmeval-runner table1|sweep --executor slurm`: the seed experiment or a sweep as Slurm job arrays on a
 //! cluster whose nodes share the output folder, the runner binary, `blender_scripts` and the
 //! venv. Four stages, one sbatch script each under `OUT/slurm/`:
 //!
@@ -27,7 +27,9 @@ use std::collections::BTreeSet;
 use anyhow::{Context, Result, bail};
 use sfmeval_fs::write_atomic;
 
-use crate::args::Table1Args;
+use std::path::Path;
+
+use crate::args::{SlurmArgs, SweepArgs, Table1Args, ToolArgs};
 use crate::env::find_python;
 use crate::generator::find_blender_scripts;
 use crate::pipelines::{parse_customs, parse_list};
@@ -35,37 +37,37 @@ use crate::slurm::plan::{CellPlan, DatasetPlan, PLAN_SCHEMA, Plan, Stage};
 use crate::slurm::resources::resources;
 use crate::slurm::script::{Dependency, Submission, sbatch_script, submit_sh};
 use crate::slurm::state::missing_tasks;
+use crate::sweep::SweepPlan;
 use crate::table1::{dataset_name, generator_args, presets};
 
-/// The plan of a `table1` command line (`argv`, as given).
-fn make_plan(a: &Table1Args, argv: Vec<String>) -> Result<Plan> {
-    if a.slurm.render_shards == 0 {
+/// The plan of a batch: its command line `argv`, output folder, tools, generator, pipelines
+/// and datasets; the cells are the datasets by name × the pipelines (as `run`'s grid).
+fn make_plan(
+    argv: Vec<String>,
+    out: &Path,
+    tools: &ToolArgs,
+    blender_scripts: Option<&Path>,
+    pipelines: &[String],
+    datasets: Vec<DatasetPlan>,
+    render_shards: usize,
+) -> Result<Plan> {
+    if render_shards == 0 {
         bail!("--render-shards must be at least 1");
     }
-    let out = std::path::absolute(&a.out)
-        .with_context(|| format!("resolving --out {}", a.out.display()))?;
+    let out =
+        std::path::absolute(out).with_context(|| format!("resolving --out {}", out.display()))?;
     // absolute when given as a path; a bare name is looked up on each node's PATH
-    let python = find_python(a.tools.python.as_deref())?;
-    let blender_scripts = std::path::absolute(find_blender_scripts(
-        a.generator.blender_scripts.as_deref(),
-    )?)?;
+    let python = find_python(tools.python.as_deref())?;
+    let blender_scripts = std::path::absolute(find_blender_scripts(blender_scripts)?)?;
     let runner = std::env::current_exe().context("locating the sfmeval-runner binary")?;
-    let customs = parse_customs(&a.tools.customs)?;
-    let specs = parse_list(&a.pipelines, &customs)?;
-    let mut datasets: Vec<DatasetPlan> = Vec::new();
+    let customs = parse_customs(&tools.customs)?;
+    let specs = parse_list(pipelines, &customs)?;
     let mut names = BTreeSet::new();
-    for p in presets(a) {
-        let name = dataset_name(&p, a.quick);
-        if !names.insert(name.clone()) {
-            bail!("preset {p} is given twice");
+    for d in &datasets {
+        if !names.insert(d.name.clone()) {
+            bail!("two datasets are named {}", d.name);
         }
-        datasets.push(DatasetPlan {
-            generator_args: generator_args(&p, a.quick, &a.generator.sets),
-            preset: p,
-            name,
-        });
     }
-    // The cells in `run`'s grid order: datasets by name, pipelines as given.
     let mut cells = Vec::new();
     for name in &names {
         for s in &specs {
@@ -83,7 +85,7 @@ fn make_plan(a: &Table1Args, argv: Vec<String>) -> Result<Plan> {
         python,
         blender_scripts,
         out,
-        render_shards: a.slurm.render_shards,
+        render_shards,
         datasets,
         pipelines: specs.iter().map(|s| s.name.clone()).collect(),
         cells,
@@ -141,42 +143,104 @@ fn submissions(plan: &Plan) -> Vec<Submission> {
     subs
 }
 
-/// Plans the batch (or checks a resumed one against its plan), writes the scripts and, unless
-/// `--dry-run`, submits them.
+/// `table1 --executor slurm`: one dataset per preset.
 pub fn submit_table1(a: &Table1Args) -> Result<()> {
     a.exec.check()?;
-    if a.generator.fresh {
+    let mut datasets: Vec<DatasetPlan> = Vec::new();
+    for p in presets(a) {
+        datasets.push(DatasetPlan {
+            generator_args: generator_args(&p, a.quick, &a.generator.sets),
+            name: dataset_name(&p, a.quick),
+            preset: p,
+        });
+    }
+    let plan = make_plan(
+        std::env::args().collect(),
+        &a.out,
+        &a.tools,
+        a.generator.blender_scripts.as_deref(),
+        &a.pipelines,
+        datasets,
+        a.slurm.render_shards,
+    )?;
+    submit_plan(&plan, &a.slurm, a.generator.fresh)
+}
+
+/// `sweep --executor slurm`: one dataset per factor value, made by the same generator
+/// arguments as a local sweep's variant.
+pub fn submit_sweep(a: &SweepArgs) -> Result<()> {
+    a.exec.check()?;
+    a.eval.eval_options()?;
+    let python = find_python(a.tools.python.as_deref())?;
+    let scripts = std::path::absolute(find_blender_scripts(
+        a.generator.blender_scripts.as_deref(),
+    )?)?;
+    let sweep_plan = SweepPlan::new(a, &python, &scripts)?;
+    let datasets = sweep_plan
+        .planned
+        .iter()
+        .map(|pl| {
+            let mut args = sweep_plan.base_args.clone();
+            for o in pl
+                .overrides
+                .iter()
+                .cloned()
+                .chain([format!("dataset.name=\"{}\"", pl.dataset)])
+            {
+                args.extend(["--set".to_string(), o]);
+            }
+            DatasetPlan {
+                preset: pl.text.clone(),
+                name: pl.dataset.clone(),
+                generator_args: args,
+            }
+        })
+        .collect();
+    let plan = make_plan(
+        std::env::args().collect(),
+        &a.out,
+        &a.tools,
+        Some(&scripts),
+        &a.pipelines,
+        datasets,
+        a.slurm.render_shards,
+    )?;
+    submit_plan(&plan, &a.slurm, a.generator.fresh)
+}
+
+/// Checks a resumed batch against its plan (or refuses to overwrite one), writes the plan
+/// and the scripts and, unless `--dry-run`, submits them.
+fn submit_plan(plan: &Plan, slurm: &SlurmArgs, fresh: bool) -> Result<()> {
+    if fresh {
         bail!("--fresh does not go with --executor slurm: choose a new --out");
     }
-    let res = resources(&a.slurm)?;
-    let argv: Vec<String> = std::env::args().collect();
-    let plan = make_plan(a, argv)?;
+    let res = resources(slurm)?;
     let plan_path = Plan::path(&plan.out);
     if plan_path.is_file() {
         let old = Plan::read(&plan_path)?;
-        if !a.slurm.resume {
+        if !slurm.resume {
             bail!(
                 "{} holds a Slurm batch already: add --resume to submit what is missing, or \
                  choose another --out",
                 plan.out.display()
             );
         }
-        if !old.same_work(&plan) {
+        if !old.same_work(plan) {
             bail!(
                 "--resume: {} was planned with other presets, pipelines or --render-shards; \
                  give the same ones, or choose another --out",
                 plan.out.display()
             );
         }
-    } else if a.slurm.resume {
+    } else if slurm.resume {
         bail!(
             "--resume: {} holds no Slurm batch (no {})",
             plan.out.display(),
             plan_path.display()
         );
     }
-    if a.slurm.resume && !a.slurm.dry_run {
-        let queued = submit::still_queued(&plan, &a.slurm.sbatch)?;
+    if slurm.resume && !slurm.dry_run {
+        let queued = submit::still_queued(plan, &slurm.sbatch)?;
         if !queued.is_empty() {
             bail!(
                 "--resume: jobs {} of this batch are still in the queue: wait for them (or \
@@ -188,22 +252,22 @@ pub fn submit_table1(a: &Table1Args) -> Result<()> {
     for dir in [plan.slurm_dir().join("logs"), plan.out.join("datasets")] {
         std::fs::create_dir_all(&dir).with_context(|| format!("creating {}", dir.display()))?;
     }
-    let subs = submissions(&plan);
+    let subs = submissions(plan);
     for stage in Stage::ALL {
         let r = res
             .get(&stage)
             .with_context(|| format!("no resources for stage {}", stage.name()))?;
         write_atomic(
             &plan.script(stage),
-            sbatch_script(&plan, stage, r)?.as_bytes(),
+            sbatch_script(plan, stage, r)?.as_bytes(),
         )?;
     }
     let submit_path = plan.slurm_dir().join("submit.sh");
     write_atomic(
         &submit_path,
-        submit_sh(&plan, &subs, &a.slurm.sbatch).as_bytes(),
+        submit_sh(plan, &subs, &slurm.sbatch).as_bytes(),
     )?;
-    let mut text = serde_json::to_string_pretty(&plan)?;
+    let mut text = serde_json::to_string_pretty(plan)?;
     text.push('\n');
     write_atomic(&plan_path, text.as_bytes())?;
     let summary: Vec<String> = Stage::ALL
@@ -217,7 +281,7 @@ pub fn submit_table1(a: &Table1Args) -> Result<()> {
             (k > 0).then(|| format!("{} {k}/{}", st.name(), plan.task_count(st)))
         })
         .collect();
-    if a.slurm.dry_run {
+    if slurm.dry_run {
         eprintln!(
             "slurm: --dry-run: scripts in {} ({}); submit them with bash {}",
             plan.slurm_dir().display(),
@@ -226,8 +290,8 @@ pub fn submit_table1(a: &Table1Args) -> Result<()> {
         );
         return Ok(());
     }
-    let jobs = submit::submit(&plan, &subs, &a.slurm.sbatch)?;
-    submit::record(&plan, &subs, &jobs)?;
+    let jobs = submit::submit(plan, &subs, &slurm.sbatch)?;
+    submit::record(plan, &subs, &jobs)?;
     eprintln!(
         "slurm: submitted {} (tasks to run / in the stage); the table will be in {} (logs in {})",
         summary.join(", "),

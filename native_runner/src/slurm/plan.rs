@@ -9,7 +9,7 @@ use anyhow::{Context, Result, bail};
 use clap::Parser;
 use serde::{Deserialize, Serialize};
 
-use crate::args::{Cli, Command, Table1Args};
+use crate::args::{Cli, Command, ExecArgs, SweepArgs, Table1Args, ToolArgs};
 
 /// `schema` of `plan.json`.
 pub const PLAN_SCHEMA: &str = "sfmeval.slurm-plan/1";
@@ -51,10 +51,44 @@ impl Stage {
     }
 }
 
+/// The command a batch runs.
+pub enum Job {
+    /// `table1`: the seed experiment.
+    Table1(Box<Table1Args>),
+    /// `sweep`: one condition varied.
+    Sweep(Box<SweepArgs>),
+}
+
+impl Job {
+    /// Where the tools are.
+    pub fn tools(&self) -> &ToolArgs {
+        match self {
+            Job::Table1(a) => &a.tools,
+            Job::Sweep(a) => &a.tools,
+        }
+    }
+
+    /// How the runs execute.
+    pub fn exec(&self) -> &ExecArgs {
+        match self {
+            Job::Table1(a) => &a.exec,
+            Job::Sweep(a) => &a.exec,
+        }
+    }
+
+    /// The `--pipelines` arguments.
+    pub fn pipelines(&self) -> &[String] {
+        match self {
+            Job::Table1(a) => &a.pipelines,
+            Job::Sweep(a) => &a.pipelines,
+        }
+    }
+}
+
 /// One dataset of the batch.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct DatasetPlan {
-    /// Generator preset.
+    /// What it stands for: the generator preset (`table1`) or the factor value (`sweep`).
     pub preset: String,
     /// Folder name under `OUT/datasets/`.
     pub name: String,
@@ -76,7 +110,7 @@ pub struct CellPlan {
 pub struct Plan {
     /// Always [`PLAN_SCHEMA`].
     pub schema: String,
-    /// The `sfmeval-runner table1 ...` command line; every task reads its options from it.
+    /// The `sfmeval-runner table1|sweep ...` command line; every task reads its options from it.
     pub argv: Vec<String>,
     /// The folder it was given in: the tasks start there.
     pub cwd: PathBuf,
@@ -115,12 +149,13 @@ impl Plan {
         Ok(plan)
     }
 
-    /// The `table1` options of the batch, parsed again from [`Plan::argv`].
-    pub fn table1_args(&self) -> Result<Table1Args> {
+    /// The command of the batch (`table1` or `sweep`), parsed again from [`Plan::argv`].
+    pub fn job(&self) -> Result<Job> {
         let cli = Cli::try_parse_from(&self.argv).context("the plan's command line")?;
         match cli.command {
-            Command::Table1(a) => Ok(a),
-            _ => bail!("the plan's command line is not a table1 command"),
+            Command::Table1(a) => Ok(Job::Table1(Box::new(a))),
+            Command::Sweep(a) => Ok(Job::Sweep(Box::new(a))),
+            _ => bail!("the plan's command line is neither table1 nor sweep"),
         }
     }
 

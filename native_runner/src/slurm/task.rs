@@ -79,13 +79,13 @@ fn generator(plan: &Plan, ds: &DatasetPlan, extra: &[&str]) -> Result<()> {
 /// Run task `k`: its pipeline on its dataset, into the task's own runs folder.
 fn run_cell(plan: &Plan, k: usize) -> Result<()> {
     let cell = plan.run_task(k)?;
-    let t1 = plan.table1_args()?;
+    let job = plan.job()?;
     if !dataset_done(plan, &cell.dataset) {
         bail!("dataset {} is not finalized", cell.dataset);
     }
     let dataset = Dataset::open(&plan.dataset_dir(&cell.dataset))?;
-    let customs = parse_customs(&t1.tools.customs)?;
-    let specs = parse_list(&t1.pipelines, &customs)?;
+    let customs = parse_customs(&job.tools().customs)?;
+    let specs = parse_list(job.pipelines(), &customs)?;
     let spec = specs
         .into_iter()
         .find(|s| s.name == cell.pipeline)
@@ -93,10 +93,10 @@ fn run_cell(plan: &Plan, k: usize) -> Result<()> {
     let out = plan.task_runs(k);
     let tools = ToolArgs {
         python: Some(plan.python.clone()),
-        ..t1.tools.clone()
+        ..job.tools().clone()
     };
     let env = make_env(&tools, &out)?;
-    let opts = t1.exec.batch_options(&out, true, false)?;
+    let opts = job.exec().batch_options(&out, true, false)?;
     let summary = run_batch(&[dataset], &[spec], &customs, &env, &opts)?;
     eprintln!(
         "run task {k}: {}/{}: {:?}",
