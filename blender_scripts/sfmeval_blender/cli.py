@@ -19,6 +19,12 @@ def parser():
     p.add_argument("--overwrite", action="store_true", help="replace a dataset already in --out")
     p.add_argument("--no-render", action="store_true",
                    help="build the scene and export the ground truth without rendering images")
+    p.add_argument("--views", metavar="i/n|A:B",
+                   help="render only these views into --out (every n-th from i, or A to B-1) and "
+                        "record the part in --out/.parts/; then --finalize")
+    p.add_argument("--finalize", action="store_true",
+                   help="after every --views part is rendered: check them and write the ground "
+                        "truth, cameras.json, dataset.json and timing.json")
     p.add_argument("--print-config", action="store_true",
                    help="print the resolved configuration as JSON and exit")
     p.add_argument("--list-presets", action="store_true", help="list the presets and exit")
@@ -40,8 +46,18 @@ def main(argv):
             return 0
         if not args.out:
             raise cfgmod.ConfigError("--out DIR is required")
-        from . import pipeline
-        pipeline.check_out_dir(args.out, args.overwrite)
+        from . import parts, pipeline
+        if args.views and args.finalize:
+            raise cfgmod.ConfigError("--views and --finalize are separate steps")
+        if args.views:
+            parts.parse_views(args.views)
+        if args.views or args.finalize:
+            if args.overwrite or args.no_render:
+                raise cfgmod.ConfigError("--overwrite and --no-render do not go with --views "
+                                         "or --finalize")
+            pipeline.check_not_finalized(args.out)
+        else:
+            pipeline.check_out_dir(args.out, args.overwrite)
     except cfgmod.ConfigError as exc:
         sys.stderr.write("sfmeval: config error: %s\n" % exc)
         return 2
@@ -53,7 +69,12 @@ def main(argv):
                          "with the PyPI bpy module\n" % exc)
         return 3
     try:
-        pipeline.generate(cfg, args.out, render=not args.no_render, overwrite=args.overwrite)
+        if args.views:
+            pipeline.render_part(cfg, args.out, args.views)
+        elif args.finalize:
+            pipeline.finalize(cfg, args.out)
+        else:
+            pipeline.generate(cfg, args.out, render=not args.no_render, overwrite=args.overwrite)
     except (cfgmod.ConfigError, steps.GenerationError) as exc:
         sys.stderr.write("sfmeval: error: %s\n" % exc)
         return 1

@@ -830,7 +830,8 @@ def render_aux(cfg, out_dir, meta, progress=None, after_frame=None):
         for o in holdouts:
             o.is_holdout = True
         _set_output(scene, "EXR", cfg)
-        tmp = os.path.join(out_dir, ".aux.exr")
+        # one name per process: parts of a dataset may render into the same folder at once
+        tmp = os.path.join(out_dir, ".aux-%d.exr" % os.getpid())
         depth_dir = os.path.join(out_dir, "depth")
         mask_dir = os.path.join(out_dir, "masks")
         if cfg["outputs"]["depth"]:
@@ -986,8 +987,9 @@ def _export_selected_glb(obj, path):
         raise GenerationError("glTF export did not write %s" % path)
 
 
-def step_export(cfg, out_dir):
-    """ground_truth.glb, cameras.json, dataset.json, sparse_gt/ (and scene.blend on request)."""
+def step_export(cfg, out_dir, timing_parts=None):
+    """ground_truth.glb, cameras.json, dataset.json, timing.json, sparse_gt/ (and scene.blend on
+    request). `timing_parts`: the measured times of each rendered part (finalize)."""
     scene = bpy.context.scene
     obj = get_object()
     os.makedirs(out_dir, exist_ok=True)
@@ -1024,10 +1026,6 @@ def step_export(cfg, out_dir):
                    "postprocess": info.get("postprocess"),
                    "views_without_object": info.get("views_without_object")},
         "other_objects": info.get("other_objects") or other_objects_record(scene, cfg),
-        "timing": {"render_seconds_per_frame": [round(t, 3) for t in times],
-                   "render_seconds_mean": round(sum(times) / len(times), 3) if times else None,
-                   "render_seconds_total": round(sum(times), 3),
-                   "depth_mask_seconds_total": round(info.get("aux_seconds_total", 0.0), 3)},
         "images": len(views),
         "views": views,
         "files": {"images": "images/", "ground_truth": "ground_truth.glb", "cameras": "cameras.json",
@@ -1035,9 +1033,18 @@ def step_export(cfg, out_dir):
                   "depth": "depth/<image stem>.npy" if cfg["outputs"]["depth"] else None,
                   "masks": "masks/<image stem>.png" if cfg["outputs"]["masks"] else None,
                   "blend": "scene.blend" if cfg["outputs"]["save_blend"] else None},
-        "created_utc": time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime()),
     }
     dump_json(ds, os.path.join(out_dir, "dataset.json"))
+    # What was measured goes beside it: dataset.json is the same bytes for the same config
+    # (and Blender), however and wherever the views were rendered.
+    timing = {"schema": "sfmeval.timing/1",
+              "render_seconds_per_frame": [round(t, 3) for t in times],
+              "render_seconds_mean": round(sum(times) / len(times), 3) if times else None,
+              "render_seconds_total": round(sum(times), 3),
+              "depth_mask_seconds_total": round(info.get("aux_seconds_total", 0.0), 3),
+              "parts": timing_parts,
+              "created_utc": time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime())}
+    dump_json(timing, os.path.join(out_dir, "timing.json"))
     if cfg["outputs"]["save_blend"]:
         bpy.ops.wm.save_as_mainfile(filepath=os.path.abspath(os.path.join(out_dir, "scene.blend")),
                                     copy=True)

@@ -29,6 +29,8 @@ def small_dataset(tmp_path_factory):
     assert proc.returncode == 0, proc.stdout[-3000:] + proc.stderr[-3000:]
     with open(os.path.join(out, "dataset.json")) as f:
         ds = json.load(f)
+    with open(os.path.join(out, "timing.json")) as f:
+        timing = json.load(f)
     sys.stderr.write("\n[small dataset] %d images, %.2f s/frame, wall %.1f s\n"
-                     % (ds["images"], ds["timing"]["render_seconds_mean"], proc.seconds))
+                     % (ds["images"], timing["render_seconds_mean"], proc.seconds))
     return out

@@ -45,7 +45,11 @@ def test_files_and_schemas(small_dataset):
     assert meta["seed"] == 0 and meta["images"] == 36
     assert meta["source"] == {"kind": "builtin", "name": "statue", "seed": 0}
     assert meta["settings"]["render"]["samples"] == 16
-    assert len(meta["timing"]["render_seconds_per_frame"]) == 36
+    assert "timing" not in meta and "created_utc" not in meta  # measured: in timing.json
+    timing = load_json(os.path.join(ds, "timing.json"))
+    assert timing["schema"] == "sfmeval.timing/1" and timing["parts"] is None
+    assert len(timing["render_seconds_per_frame"]) == 36
+    assert all(t > 0 for t in timing["render_seconds_per_frame"])
     assert meta["render"]["denoise_used"] is False
     # The headless generator starts from an empty scene: nothing of the user's to hide.
     assert meta["other_objects"] == {"keep_other_objects": False, "keep_other_lights": False,

@@ -38,12 +38,20 @@ def main():
                               extraction_options=extraction, device=pycolmap.Device.cpu)
     matcher = o.get("matcher", "exhaustive")
     common.log("match_%s" % matcher)
+    matching = pycolmap.FeatureMatchingOptions()
+    matching.num_threads = threads
+    # Every pair's RANSAC from the seed: otherwise each matching thread draws from its own
+    # generator, and which pairs a thread verifies (so the models found) depends on the load.
+    verification = pycolmap.TwoViewGeometryOptions()
+    verification.ransac.random_seed = a.seed
     if matcher == "sequential":
         pairing = pycolmap.SequentialPairingOptions()
         pairing.overlap = int(o.get("overlap", 10))
-        pycolmap.match_sequential(db, pairing_options=pairing, device=pycolmap.Device.cpu)
+        pycolmap.match_sequential(db, matching_options=matching, pairing_options=pairing,
+                                  verification_options=verification, device=pycolmap.Device.cpu)
     elif matcher == "exhaustive":
-        pycolmap.match_exhaustive(db, device=pycolmap.Device.cpu)
+        pycolmap.match_exhaustive(db, matching_options=matching,
+                                  verification_options=verification, device=pycolmap.Device.cpu)
     else:
         common.fail("unknown matcher %r (exhaustive, sequential)" % matcher, 2)
     sparse = os.path.join(work, "sparse")

@@ -44,6 +44,9 @@ pub enum Command {
     Sweep(SweepArgs),
     /// List the pipelines and whether each is installed here.
     Pipelines(PipelinesArgs),
+    /// One task of a Slurm batch (what the sbatch scripts of `table1 --executor slurm` run).
+    #[command(hide = true)]
+    SlurmTask(SlurmTaskArgs),
 }
 
 /// Where the tools are, and the custom pipelines.
@@ -336,6 +339,74 @@ pub struct Table1Args {
     /// How every run is measured.
     #[command(flatten)]
     pub eval: EvalArgs,
+    /// Where the stages run (this machine, or a Slurm cluster).
+    #[command(flatten)]
+    pub slurm: SlurmArgs,
+}
+
+/// Where `table1` and `sweep` run: here, or as Slurm job arrays (`--executor slurm`).
+#[derive(Args, Clone)]
+pub struct SlurmArgs {
+    /// `local` (everything in this process) or `slurm`: write sbatch scripts for the stages
+    /// (render shards, finalize, one task per dataset × pipeline, collect) into OUT/slurm/ and
+    /// submit them as job arrays chained by dependencies.
+    #[arg(long, default_value = "local", value_parser = ["local", "slurm"])]
+    pub executor: String,
+    /// Slurm: render tasks per dataset (task i renders the views k with k % n == i).
+    #[arg(long, default_value_t = 4)]
+    pub render_shards: usize,
+    /// Slurm: partition of every stage (a `--stage` partition overrides it).
+    #[arg(long)]
+    pub partition: Option<String>,
+    /// Slurm: account of every stage (a `--stage` account overrides it).
+    #[arg(long)]
+    pub account: Option<String>,
+    /// Slurm: resources of one stage, STAGE:KEY=VALUE,... with STAGE render, finalize, run or
+    /// collect and KEY cpus, mem, time, partition or account (repeatable), e.g.
+    /// `--stage run:cpus=8,mem=32G,time=08:00:00`.
+    #[arg(long = "stage", value_name = "STAGE:KEY=VALUE,...")]
+    pub stages: Vec<String>,
+    /// Slurm: only write the scripts (OUT/slurm/*.sbatch and submit.sh), submit nothing.
+    #[arg(long)]
+    pub dry_run: bool,
+    /// Slurm: complete the batch already planned in OUT (after a node failure, a cancelled or
+    /// timed-out task): submit only the tasks whose results are missing, then collect again.
+    #[arg(long)]
+    pub resume: bool,
+    /// Slurm: the sbatch executable.
+    #[arg(long, default_value = "sbatch")]
+    pub sbatch: String,
+}
+
+impl SlurmArgs {
+    /// Fails when a Slurm-only option is given without `--executor slurm`.
+    pub fn check_local(&self) -> Result<()> {
+        if self.dry_run
+            || self.resume
+            || !self.stages.is_empty()
+            || self.partition.is_some()
+            || self.account.is_some()
+        {
+            anyhow::bail!(
+                "--dry-run, --resume, --stage, --partition and --account go with --executor slurm"
+            );
+        }
+        Ok(())
+    }
+}
+
+/// Arguments of the hidden `slurm-task`: one task of a planned batch.
+#[derive(Args)]
+pub struct SlurmTaskArgs {
+    /// The batch's plan (OUT/slurm/plan.json).
+    #[arg(long)]
+    pub plan: PathBuf,
+    /// The stage: render, finalize, run or collect.
+    #[arg(long)]
+    pub stage: String,
+    /// The task's index in its stage (the array task id; 0 for collect).
+    #[arg(long, default_value_t = 0)]
+    pub index: usize,
 }
 
 /// Arguments of `sweep`.
@@ -380,6 +451,9 @@ pub struct SweepArgs {
     /// How every run is measured.
     #[command(flatten)]
     pub eval: EvalArgs,
+    /// Where the stages run (this machine, or a Slurm cluster).
+    #[command(flatten)]
+    pub slurm: SlurmArgs,
 }
 
 #[cfg(test)]

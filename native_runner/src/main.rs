@@ -6,8 +6,8 @@
 //! sfmeval-runner run --datasets DIR... --pipelines LIST --out runs/ [--jobs N] [--resume] [--shard i/n]
 //! sfmeval-runner merge runs-0/ runs-1/ ... --out runs/
 //! sfmeval-runner report runs/ --out table/
-//! sfmeval-runner table1 [--quick] [--out table1/]
-//! sfmeval-runner sweep --factor views=12,24,36 --dataset-preset statue --pipelines LIST --out sweep/
+//! sfmeval-runner table1 [--quick] [--out table1/] [--executor slurm [--dry-run] [--resume]]
+//! sfmeval-runner sweep --factor views=12,24,36 --dataset-preset statue --pipelines LIST --out sweep/ [--executor slurm ...]
 //! ```
 
 mod adapters;
@@ -24,6 +24,7 @@ mod pipelines;
 mod report;
 mod run;
 mod setup;
+mod slurm;
 mod sweep;
 mod table;
 mod table1;
@@ -42,7 +43,10 @@ fn main() -> ExitCode {
         Command::Run(a) => commands::run(&a),
         Command::Merge(a) => commands::merge(&a),
         Command::Report(a) => commands::report(&a),
+        Command::Table1(a) if a.slurm.executor == "slurm" => slurm::submit_table1(&a),
         Command::Table1(a) => table1::table1(&a),
+        Command::SlurmTask(a) => slurm::task::slurm_task(&a),
+        Command::Sweep(a) if a.slurm.executor == "slurm" => slurm::submit_sweep(&a),
         Command::Sweep(a) => sweep::sweep(&a),
         Command::Pipelines(a) => commands::pipelines(&a),
     };

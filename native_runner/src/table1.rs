@@ -28,15 +28,18 @@ pub const QUICK: [&str; 6] = [
     "views.sphere.count=0",
 ];
 
-/// Renders one preset into `dest` (through a temporary folder), returning the seconds spent.
-fn generate(
-    python: &Path,
-    scripts: &Path,
-    preset: &str,
-    quick: bool,
-    sets: &[String],
-    dest: &Path,
-) -> Result<f64> {
+/// The dataset (folder) name of a preset: `<preset>-quick` with `--quick`.
+pub fn dataset_name(preset: &str, quick: bool) -> String {
+    if quick {
+        format!("{preset}-quick")
+    } else {
+        preset.to_string()
+    }
+}
+
+/// The generator's arguments for one preset (without `--out`): the preset, no depth maps or
+/// masks, `--quick`'s overrides and the user's `--set`s.
+pub fn generator_args(preset: &str, quick: bool, sets: &[String]) -> Vec<String> {
     let mut args: Vec<String> = vec![
         "--preset".into(),
         preset.into(),
@@ -55,6 +58,28 @@ fn generate(
         args.push("--set".into());
         args.push(s);
     }
+    args
+}
+
+/// The presets of a `table1` command: `--presets`, or all five.
+pub fn presets(a: &Table1Args) -> Vec<String> {
+    if a.presets.is_empty() {
+        PRESETS.iter().map(|s| s.to_string()).collect()
+    } else {
+        a.presets.clone()
+    }
+}
+
+/// Renders one preset into `dest` (through a temporary folder), returning the seconds spent.
+fn generate(
+    python: &Path,
+    scripts: &Path,
+    preset: &str,
+    quick: bool,
+    sets: &[String],
+    dest: &Path,
+) -> Result<f64> {
+    let args = generator_args(preset, quick, sets);
     render_dataset("table1", python, scripts, &args, dest)
 }
 
@@ -62,15 +87,12 @@ fn generate(
 pub fn table1(a: &Table1Args) -> Result<()> {
     let t0 = Instant::now();
     a.exec.check()?;
+    a.slurm.check_local()?;
     let python = crate::env::find_python(a.tools.python.as_deref())?;
     let scripts = std::path::absolute(find_blender_scripts(
         a.generator.blender_scripts.as_deref(),
     )?)?;
-    let presets: Vec<String> = if a.presets.is_empty() {
-        PRESETS.iter().map(|s| s.to_string()).collect()
-    } else {
-        a.presets.clone()
-    };
+    let presets = presets(a);
     // Absolute: the generator runs inside the datasets folder, so a relative --out would
     // land one level too deep.
     let out = std::path::absolute(&a.out)
@@ -83,11 +105,7 @@ pub fn table1(a: &Table1Args) -> Result<()> {
     let mut gen_times = serde_json::Map::new();
     let mut datasets = Vec::new();
     for p in &presets {
-        let name = if a.quick {
-            format!("{p}-quick")
-        } else {
-            p.clone()
-        };
+        let name = dataset_name(p, a.quick);
         let dest = ds_root.join(&name);
         let complete = dest.join("dataset.json").is_file() && dest.join("cameras.json").is_file();
         if complete && !a.generator.fresh {

@@ -19,6 +19,7 @@ pub mod page;
 pub mod table;
 pub mod variants;
 
+use std::path::Path;
 use std::time::Instant;
 
 use anyhow::{Context, Result};
@@ -33,16 +34,54 @@ use crate::generator::{find_blender_scripts, resolved_config};
 use crate::pipelines::{parse_customs, parse_list};
 use crate::report::{ReportArgs, report};
 use crate::run::run_batch;
-use crate::sweep::factor::parse_factor;
+use crate::sweep::factor::{Factor, parse_factor};
 use crate::sweep::metrics::metric_file;
 use sfmeval_table::Row;
+
+/// A sweep before anything is rendered: its factor and values, the base dataset's generator
+/// arguments and each value's variant (every value checked first: a bad one stops the sweep
+/// before anything is rendered).
+pub struct SweepPlan {
+    /// The factor.
+    pub factor: Factor,
+    /// Its values, as given and as numbers.
+    pub values: Vec<(String, f64)>,
+    /// The base dataset's generator arguments.
+    pub base_args: Vec<String>,
+    /// One variant per value.
+    pub planned: Vec<variants::Planned>,
+}
+
+impl SweepPlan {
+    /// Plans the sweep of `a` with the generator (`python`, `scripts`), which resolves the
+    /// base config.
+    pub fn new(a: &SweepArgs, python: &Path, scripts: &Path) -> Result<SweepPlan> {
+        let (factor, values) = parse_factor(&a.factor)?;
+        // base: preset/config, no masks, depth maps only with --visibility, the user's --set
+        let base_args = variants::base_args(
+            a.dataset_preset.as_deref(),
+            a.dataset_config.as_deref(),
+            a.visibility,
+            &a.generator.sets,
+        )?;
+        let base = resolved_config(python, scripts, &base_args)?;
+        let planned = variants::plan(factor, &values, &base)?;
+        Ok(SweepPlan {
+            factor,
+            values,
+            base_args,
+            planned,
+        })
+    }
+}
 
 /// The whole sweep: plan and render the variants, run the pipelines, evaluate, write
 /// `sweep.csv`, `charts/`, `sweep.html` and `sweep.json`.
 pub fn sweep(a: &SweepArgs) -> Result<()> {
     let t0 = Instant::now();
-    let (factor, values) = parse_factor(&a.factor)?;
+    parse_factor(&a.factor)?;
     a.exec.check()?;
+    a.slurm.check_local()?;
     // absolute paths: the generator runs in the datasets folder
     let python = find_python(a.tools.python.as_deref())?;
     let scripts = std::path::absolute(find_blender_scripts(
@@ -50,23 +89,14 @@ pub fn sweep(a: &SweepArgs) -> Result<()> {
     )?)?;
     let customs = parse_customs(&a.tools.customs)?;
     let specs = parse_list(&a.pipelines, &customs)?;
-    let eval = a.eval.eval_options()?;
-    // base: preset/config, no masks, depth maps only with --visibility, the user's --set
-    let base_args = variants::base_args(
-        a.dataset_preset.as_deref(),
-        a.dataset_config.as_deref(),
-        a.visibility,
-        &a.generator.sets,
-    )?;
-    let base = resolved_config(&python, &scripts, &base_args)?;
-    // every value's overrides first: a bad value stops the sweep before anything is rendered
-    let planned = variants::plan(factor, &values, &base)?;
+    a.eval.eval_options()?;
+    let plan = SweepPlan::new(a, &python, &scripts)?;
     let out = std::path::absolute(&a.out)
         .with_context(|| format!("output folder {}", a.out.display()))?;
     let ds_root = out.join("datasets");
     let (variants, datasets) = variants::render(
-        &planned,
-        &base_args,
+        &plan.planned,
+        &plan.base_args,
         &ds_root,
         a.generator.fresh,
         &python,
@@ -75,7 +105,6 @@ pub fn sweep(a: &SweepArgs) -> Result<()> {
     let render_seconds = t0.elapsed().as_secs_f64();
     // runs
     let runs = out.join("runs");
-    let table_dir = out.join("table");
     let t_runs = Instant::now();
     if !datasets.is_empty() {
         let env = make_env(&a.tools, &runs)?;
@@ -90,30 +119,56 @@ pub fn sweep(a: &SweepArgs) -> Result<()> {
         );
     }
     let runs_seconds = t_runs.elapsed().as_secs_f64();
-    // report
+    let pipes: Vec<String> = specs.iter().map(|s| s.name.clone()).collect();
+    write_results(
+        a,
+        &plan,
+        &variants,
+        &pipes,
+        &out,
+        t0,
+        serde_json::json!({"datasets_seconds": render_seconds, "runs_seconds": runs_seconds}),
+    )
+}
+
+/// After the runs: evaluates them (unless no variant rendered) and writes `table/`,
+/// `sweep.csv`, `charts/`, `sweep.html` and `sweep.json` (`timing` plus the report's and the
+/// total seconds since `t0`).
+pub fn write_results(
+    a: &SweepArgs,
+    plan: &SweepPlan,
+    variants: &[variants::Variant],
+    pipes: &[String],
+    out: &Path,
+    t0: Instant,
+    timing: serde_json::Value,
+) -> Result<()> {
+    let (factor, values) = (plan.factor, &plan.values);
+    let runs = out.join("runs");
+    let table_dir = out.join("table");
     let t_rep = Instant::now();
-    let rows: Vec<Row> = if datasets.is_empty() {
+    let rendered = variants.iter().any(|v| v.status != "failed");
+    let rows: Vec<Row> = if !rendered {
         Vec::new()
     } else {
         report(&ReportArgs {
             runs: vec![runs.clone()],
             out: table_dir.clone(),
             datasets: Vec::new(),
-            eval,
+            eval: a.eval.eval_options()?,
             align: a.eval.align_request()?,
             verbose: true,
         })?
     };
     let report_seconds = t_rep.elapsed().as_secs_f64();
     // cells
-    let pipes: Vec<String> = specs.iter().map(|s| s.name.clone()).collect();
-    let cells = cells::collect(&planned, &variants, &pipes, &rows, &table_dir);
+    let cells = cells::collect(&plan.planned, variants, pipes, &rows, &table_dir);
     let metrics = metrics::metrics(&a.metrics, &cells);
     write_atomic(
         &out.join("sweep.csv"),
         table::csv(factor, &cells, &metrics).as_bytes(),
     )?;
-    let charts = charts::charts(factor, &values, &pipes, &cells, &metrics);
+    let charts = charts::charts(factor, values, pipes, &cells, &metrics);
     let mut files = Vec::new();
     for (c, m) in charts.iter().zip(&metrics) {
         let f = format!("charts/{}.svg", metric_file(&m.path));
@@ -126,31 +181,35 @@ pub fn sweep(a: &SweepArgs) -> Result<()> {
         .join(" ");
     write_atomic(
         &out.join("sweep.html"),
-        page::page(factor, &command, &variants, &pipes, &charts, &files).as_bytes(),
+        page::page(factor, &command, variants, pipes, &charts, &files).as_bytes(),
     )?;
     let total = t0.elapsed().as_secs_f64();
+    let mut timing = timing;
+    if let Some(t) = timing.as_object_mut() {
+        t.insert("report_seconds".into(), report_seconds.into());
+        t.insert("total_seconds".into(), total.into());
+    }
     let doc = serde_json::json!({
         "schema": "sfmeval.sweep/1",
         "factor": factor.name(),
         "definition": factor.description(),
         "values": values.iter().map(|v| v.0.clone()).collect::<Vec<_>>(),
-        "base_generator_args": base_args,
+        "base_generator_args": plan.base_args,
         "variants": variants,
         "pipelines": pipes,
         "metrics": metrics.iter().map(|m| serde_json::json!({"path": m.path, "label": m.label, "chart": metric_file(&m.path) + ".svg"})).collect::<Vec<_>>(),
         "command": command,
-        "timing": {"datasets_seconds": render_seconds, "runs_seconds": runs_seconds,
-                   "report_seconds": report_seconds, "total_seconds": total},
+        "timing": timing,
     });
     let mut json = serde_json::to_string_pretty(&doc)?;
     json.push('\n');
     write_atomic(&out.join("sweep.json"), json.as_bytes())?;
     let ok = cells.iter().filter(|c| c.status == "ok").count();
     eprintln!(
-        "sweep: {} value(s) × {} pipeline(s), {ok} ok; datasets {render_seconds:.0} s, runs {runs_seconds:.0} s, report {report_seconds:.0} s, total {total:.0} s → {}/{{sweep.csv,sweep.html,sweep.json,charts/}}",
+        "sweep: {} value(s) × {} pipeline(s), {ok} ok; report {report_seconds:.0} s, total {total:.0} s → {}/{{sweep.csv,sweep.html,sweep.json,charts/}}",
         values.len(),
         pipes.len(),
-        a.out.display()
+        out.display()
     );
     Ok(())
 }

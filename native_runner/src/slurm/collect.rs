@@ -1,0 +1,292 @@
+//! The last stage of a batch: every run task's result is merged into `OUT/runs/`; a task that
+//! left none (cancelled, timed out, its node failed, its dataset never rendered) becomes a run
+//! with status `failed` or `timeout` and the reason from its Slurm output file, so the table
+//! is written with that cell marked; then every run is evaluated and the tables written, as a
+//! local `table1` does.
+
+use std::collections::BTreeMap;
+use std::path::Path;
+use std::time::Instant;
+
+use anyhow::{Context, Result};
+use serde_json::json;
+use sfmeval_fs::write_atomic;
+
+use crate::args::{SweepArgs, Table1Args};
+use crate::dataset::Dataset;
+use crate::files::{copy_dir, partial_name, replace_dir};
+use crate::pipelines::{parse_customs, parse_list};
+use crate::report::{ReportArgs, report};
+use crate::run::{RUN_SCHEMA, RunRecord, Status, read_record};
+use crate::slurm::plan::{CellPlan, Job, Plan, Stage};
+use crate::slurm::state::{dataset_done, end_reason, task_done};
+use crate::sweep::variants::Variant;
+use crate::sweep::{SweepPlan, write_results};
+
+/// Why run task `k` has no result: its dataset's missing render or finalize task, or itself.
+fn why_missing(plan: &Plan, k: usize, cell: &CellPlan) -> (Status, String) {
+    if dataset_done(plan, &cell.dataset) {
+        let (st, why) = end_reason(&plan.log(Stage::Run, k));
+        return (st, format!("Slurm run task {k}: {why}"));
+    }
+    let n = plan.render_shards;
+    let d = plan
+        .datasets
+        .iter()
+        .position(|d| d.name == cell.dataset)
+        .unwrap_or(0);
+    for r in d * n..(d + 1) * n {
+        if !task_done(plan, Stage::Render, r) {
+            let (st, why) = end_reason(&plan.log(Stage::Render, r));
+            return (
+                st,
+                format!(
+                    "dataset {} not rendered: Slurm render task {r}: {why}",
+                    cell.dataset
+                ),
+            );
+        }
+    }
+    let (st, why) = end_reason(&plan.log(Stage::Finalize, d));
+    (
+        st,
+        format!(
+            "dataset {} not finalized: Slurm finalize task {d}: {why}",
+            cell.dataset
+        ),
+    )
+}
+
+/// The run folder of a cell without result: `run.json` (status, reason) and `log.txt`.
+fn write_missing_run(
+    plan: &Plan,
+    cell: &CellPlan,
+    kind_tool: (String, String),
+    options: BTreeMap<String, String>,
+    (status, reason): (Status, String),
+    dest: &Path,
+) -> Result<()> {
+    let dataset_dir = plan.dataset_dir(&cell.dataset);
+    let now = std::time::SystemTime::now()
+        .duration_since(std::time::UNIX_EPOCH)
+        .map(|d| d.as_secs_f64())
+        .unwrap_or(0.0);
+    let rec = RunRecord {
+        schema: RUN_SCHEMA.into(),
+        dataset: cell.dataset.clone(),
+        dataset_dir: dataset_dir.to_string_lossy().to_string(),
+        pipeline: cell.pipeline.clone(),
+        kind: kind_tool.0,
+        tool: kind_tool.1,
+        version: None,
+        status,
+        reason: Some(reason.clone()),
+        command: Vec::new(),
+        options,
+        wall_seconds: 0.0,
+        cpu_seconds: 0.0,
+        peak_memory_bytes: 0,
+        exit_status: None,
+        images_total: Dataset::open(&dataset_dir).map_or(0, |d| d.image_count),
+        images_registered: 0,
+        points: 0,
+        models: 0,
+        started_unix: 0.0,
+        finished_unix: now,
+        log: "log.txt".into(),
+        steps: Vec::new(),
+        warnings: vec![
+            "no result from its Slurm task: `sfmeval-runner table1 --executor slurm --resume` redoes it"
+                .into(),
+        ],
+        tool_report: serde_json::Value::Null,
+    };
+    let tmp = partial_name(dest);
+    std::fs::create_dir_all(&tmp).with_context(|| format!("creating {}", tmp.display()))?;
+    write_atomic(
+        &tmp.join("log.txt"),
+        format!("# {}: {reason}\n", status.label()).as_bytes(),
+    )?;
+    let mut text = serde_json::to_string_pretty(&rec)?;
+    text.push('\n');
+    write_atomic(&tmp.join("run.json"), text.as_bytes())?;
+    replace_dir(&tmp, dest)
+}
+
+/// What the merge found.
+struct Merged {
+    /// Runs with a result, by status.
+    executed: BTreeMap<String, usize>,
+    /// The tasks without result (task, dataset, pipeline, status, reason).
+    without_result: Vec<serde_json::Value>,
+    /// Wall seconds of the runs with a result.
+    runs_seconds: f64,
+}
+
+/// Merges every run task's result into `OUT/runs/`; a task without result becomes a failed
+/// run there.
+fn merge_runs(plan: &Plan, job: &Job) -> Result<Merged> {
+    let customs = parse_customs(&job.tools().customs)?;
+    let specs = parse_list(job.pipelines(), &customs)?;
+    let runs = plan.out.join("runs");
+    let mut m = Merged {
+        executed: BTreeMap::new(),
+        without_result: Vec::new(),
+        runs_seconds: 0.0,
+    };
+    for (k, cell) in plan.cells.iter().enumerate() {
+        let dest = runs.join(&cell.dataset).join(&cell.pipeline);
+        let src = plan.task_runs(k).join(&cell.dataset).join(&cell.pipeline);
+        if let Some(p) = dest.parent() {
+            std::fs::create_dir_all(p).with_context(|| format!("creating {}", p.display()))?;
+        }
+        if src.join("run.json").is_file() {
+            let rec = read_record(&src)?;
+            *m.executed
+                .entry(rec.status.label().to_string())
+                .or_default() += 1;
+            m.runs_seconds += rec.wall_seconds;
+            let same = std::fs::read(dest.join("run.json")).ok()
+                == std::fs::read(src.join("run.json")).ok();
+            if !same {
+                let tmp = partial_name(&dest);
+                copy_dir(&src, &tmp)?;
+                replace_dir(&tmp, &dest)?;
+            }
+            continue;
+        }
+        let why = why_missing(plan, k, cell);
+        eprintln!(
+            "{}/{}: {}: {}",
+            cell.dataset,
+            cell.pipeline,
+            why.0.label(),
+            why.1
+        );
+        m.without_result
+            .push(json!({"task": k, "dataset": cell.dataset,
+                                     "pipeline": cell.pipeline, "status": why.0.label(),
+                                     "reason": why.1}));
+        let spec = specs.iter().find(|s| s.name == cell.pipeline);
+        let kind_tool = match spec.map(|s| (s, s.adapter(&customs))) {
+            Some((s, Ok(ad))) => (s.kind.clone(), ad.tool().to_string()),
+            _ => (cell.pipeline.clone(), cell.pipeline.clone()),
+        };
+        let options = spec.map(|s| s.options.clone()).unwrap_or_default();
+        write_missing_run(plan, cell, kind_tool, options, why, &dest)?;
+    }
+    Ok(m)
+}
+
+/// Render times as the generator measured them (`timing.json`): (total, mean per view) per
+/// dataset.
+fn render_times(
+    plan: &Plan,
+) -> (
+    serde_json::Map<String, serde_json::Value>,
+    serde_json::Map<String, serde_json::Value>,
+) {
+    let mut frame_seconds = serde_json::Map::new();
+    let mut per_view = serde_json::Map::new();
+    for d in &plan.datasets {
+        let p = plan.dataset_dir(&d.name).join("timing.json");
+        if let Some(t) = std::fs::read(&p)
+            .ok()
+            .and_then(|b| serde_json::from_slice::<serde_json::Value>(&b).ok())
+        {
+            frame_seconds.insert(d.name.clone(), t["render_seconds_total"].clone());
+            per_view.insert(d.name.clone(), t["render_seconds_mean"].clone());
+        }
+    }
+    (frame_seconds, per_view)
+}
+
+/// Merges the runs, marks the missing ones, evaluates and writes what the local command
+/// writes: `table/` and `table1.json` for `table1`; `table/`, `sweep.csv`, `charts/`,
+/// `sweep.html` and `sweep.json` for `sweep`.
+pub fn collect(plan: &Plan) -> Result<()> {
+    let t0 = Instant::now();
+    let job = plan.job()?;
+    let merged = merge_runs(plan, &job)?;
+    match &job {
+        Job::Table1(a) => table1_results(plan, a, &merged, t0),
+        Job::Sweep(a) => sweep_results(plan, a, &merged, t0),
+    }
+}
+
+/// The sweep's outputs: a variant whose dataset was not finalized is a failed variant.
+fn sweep_results(plan: &Plan, a: &SweepArgs, merged: &Merged, t0: Instant) -> Result<()> {
+    let sweep_plan = SweepPlan::new(a, &plan.python, &plan.blender_scripts)?;
+    let (frame_seconds, _) = render_times(plan);
+    let variants: Vec<Variant> = sweep_plan
+        .planned
+        .iter()
+        .map(|pl| {
+            let done = dataset_done(plan, &pl.dataset);
+            Variant {
+                value: pl.text.clone(),
+                dataset: pl.dataset.clone(),
+                overrides: pl.overrides.clone(),
+                status: if done { "rendered" } else { "failed" }.into(),
+                reason: (!done)
+                    .then(|| "not rendered by its Slurm tasks (see OUT/slurm/logs/)".into()),
+                seconds: frame_seconds.get(&pl.dataset).and_then(|v| v.as_f64()),
+            }
+        })
+        .collect();
+    write_results(
+        a,
+        &sweep_plan,
+        &variants,
+        &plan.pipelines,
+        &plan.out,
+        t0,
+        json!({"executor": "slurm", "render_frame_seconds": frame_seconds,
+               "runs_seconds": merged.runs_seconds,
+               "tasks_without_result": merged.without_result}),
+    )
+}
+
+/// `table/` and `table1.json`.
+fn table1_results(plan: &Plan, a: &Table1Args, merged: &Merged, t0: Instant) -> Result<()> {
+    let table = plan.out.join("table");
+    let t_rep = Instant::now();
+    let rows = report(&ReportArgs {
+        runs: vec![plan.out.join("runs")],
+        out: table.clone(),
+        datasets: Vec::new(),
+        eval: a.eval.eval_options()?,
+        align: a.eval.align_request()?,
+        verbose: false,
+    })?;
+    let report_seconds = t_rep.elapsed().as_secs_f64();
+    let (frame_seconds, per_view) = render_times(plan);
+    let doc = json!({
+        "quick": a.quick,
+        "presets": plan.datasets.iter().map(|d| d.preset.clone()).collect::<Vec<_>>(),
+        "pipelines": plan.pipelines,
+        "executor": "slurm",
+        "runs_executed": merged.executed,
+        "runs_reused": 0,
+        "tasks_without_result": merged.without_result,
+        "timing": {
+            "render_frame_seconds": frame_seconds,
+            "render_seconds_per_view": per_view,
+            "runs_seconds": merged.runs_seconds,
+            "report_seconds": report_seconds,
+            "collect_seconds": t0.elapsed().as_secs_f64(),
+        },
+    });
+    let mut text = serde_json::to_string_pretty(&doc)?;
+    text.push('\n');
+    write_atomic(&plan.out.join("table1.json"), text.as_bytes())?;
+    let t1 = std::fs::read_to_string(table.join("table1.md")).unwrap_or_default();
+    println!("{t1}");
+    eprintln!(
+        "collect: {} run(s), {} without result; tables in {}",
+        rows.len(),
+        merged.without_result.len(),
+        table.display()
+    );
+    Ok(())
+}

@@ -1,0 +1,398 @@
+//! `sfmeval-runner table1|sweep --executor slurm`: the seed experiment or a sweep as Slurm job arrays on a
+//! cluster whose nodes share the output folder, the runner binary, `blender_scripts` and the
+//! venv. Four stages, one sbatch script each under `OUT/slurm/`:
+//!
+//! 1. `render`: one task per dataset and render shard (`generate.py --views i/n`);
+//! 2. `finalize` (`afterok` on render): one task per dataset (`generate.py --finalize`);
+//! 3. `run` (`afterok` on finalize): one task per dataset × pipeline, each into its own folder;
+//! 4. `collect` (`afterany` on all): merge the runs into `OUT/runs/` (a task that left no
+//!    result becomes a failed or timed-out cell with Slurm's reason), evaluate and write the
+//!    tables, as a local `table1` does.
+//!
+//! The modules: [`plan`] (what task k of a stage does, where it writes), [`resources`](mod@resources) (the
+//! per-stage `--cpus-per-task`, `--mem`, `--time`, partition, account), [`script`] (the sbatch
+//! scripts and `submit.sh`), [`submit`] (`sbatch` and `jobs.json`), [`state`] (which tasks left
+//! their result, why one did not), [`task`] (running one task) and [`collect`].
+
+pub mod collect;
+pub mod plan;
+pub mod resources;
+pub mod script;
+pub mod state;
+pub mod submit;
+pub mod task;
+
+use std::collections::BTreeSet;
+
+use anyhow::{Context, Result, bail};
+use sfmeval_fs::write_atomic;
+
+use std::path::Path;
+
+use crate::args::{SlurmArgs, SweepArgs, Table1Args, ToolArgs};
+use crate::env::find_python;
+use crate::generator::find_blender_scripts;
+use crate::pipelines::{parse_customs, parse_list};
+use crate::slurm::plan::{CellPlan, DatasetPlan, PLAN_SCHEMA, Plan, Stage};
+use crate::slurm::resources::resources;
+use crate::slurm::script::{Dependency, Submission, sbatch_script, submit_sh};
+use crate::slurm::state::missing_tasks;
+use crate::sweep::SweepPlan;
+use crate::table1::{dataset_name, generator_args, presets};
+
+/// The plan of a batch: its command line `argv`, output folder, tools, generator, pipelines
+/// and datasets; the cells are the datasets by name × the pipelines (as `run`'s grid).
+fn make_plan(
+    argv: Vec<String>,
+    out: &Path,
+    tools: &ToolArgs,
+    blender_scripts: Option<&Path>,
+    pipelines: &[String],
+    datasets: Vec<DatasetPlan>,
+    render_shards: usize,
+) -> Result<Plan> {
+    if render_shards == 0 {
+        bail!("--render-shards must be at least 1");
+    }
+    let out =
+        std::path::absolute(out).with_context(|| format!("resolving --out {}", out.display()))?;
+    // absolute when given as a path; a bare name is looked up on each node's PATH
+    let python = find_python(tools.python.as_deref())?;
+    let blender_scripts = std::path::absolute(find_blender_scripts(blender_scripts)?)?;
+    let runner = std::env::current_exe().context("locating the sfmeval-runner binary")?;
+    let customs = parse_customs(&tools.customs)?;
+    let specs = parse_list(pipelines, &customs)?;
+    let mut names = BTreeSet::new();
+    for d in &datasets {
+        if !names.insert(d.name.clone()) {
+            bail!("two datasets are named {}", d.name);
+        }
+    }
+    let mut cells = Vec::new();
+    for name in &names {
+        for s in &specs {
+            cells.push(CellPlan {
+                dataset: name.clone(),
+                pipeline: s.name.clone(),
+            });
+        }
+    }
+    Ok(Plan {
+        schema: PLAN_SCHEMA.into(),
+        argv,
+        cwd: std::env::current_dir().context("the working directory")?,
+        runner,
+        python,
+        blender_scripts,
+        out,
+        render_shards,
+        datasets,
+        pipelines: specs.iter().map(|s| s.name.clone()).collect(),
+        cells,
+    })
+}
+
+/// What to submit: per dataset, its render tasks without result, then its finalize task, then
+/// its run tasks, each `afterok` on the one before it that is submitted; last the collect,
+/// `afterany` on everything submitted (always: the tables are rewritten on every submission).
+fn submissions(plan: &Plan) -> Vec<Submission> {
+    let missing: Vec<Vec<usize>> = [Stage::Render, Stage::Finalize, Stage::Run]
+        .into_iter()
+        .map(|st| missing_tasks(plan, st))
+        .collect();
+    let n = plan.render_shards.max(1);
+    let mut subs: Vec<Submission> = Vec::new();
+    for (d, ds) in plan.datasets.iter().enumerate() {
+        let mut previous: Option<usize> = None;
+        for (stage, tasks) in [Stage::Render, Stage::Finalize, Stage::Run]
+            .into_iter()
+            .zip(&missing)
+        {
+            let mine: Vec<usize> = tasks
+                .iter()
+                .copied()
+                .filter(|&k| match stage {
+                    Stage::Render => k / n == d,
+                    Stage::Finalize => k == d,
+                    _ => plan.cells.get(k).is_some_and(|c| c.dataset == ds.name),
+                })
+                .collect();
+            if mine.is_empty() {
+                continue;
+            }
+            subs.push(Submission {
+                stage,
+                label: format!("{}_{d}", stage.name()),
+                tasks: mine,
+                dependency: previous.map_or(Dependency::None, Dependency::AfterOk),
+            });
+            previous = Some(subs.len() - 1);
+        }
+    }
+    let before: Vec<usize> = (0..subs.len()).collect();
+    subs.push(Submission {
+        stage: Stage::Collect,
+        label: "collect".into(),
+        tasks: vec![0],
+        dependency: if before.is_empty() {
+            Dependency::None
+        } else {
+            Dependency::AfterAny(before)
+        },
+    });
+    subs
+}
+
+/// `table1 --executor slurm`: one dataset per preset.
+pub fn submit_table1(a: &Table1Args) -> Result<()> {
+    a.exec.check()?;
+    if !a.scenes.is_empty() {
+        bail!(
+            "--scene (a Tanks and Temples scene) runs with the local executor only: run it with `table1 --scene DIR` or `run` + `report`"
+        );
+    }
+    let mut datasets: Vec<DatasetPlan> = Vec::new();
+    for p in presets(a) {
+        datasets.push(DatasetPlan {
+            generator_args: generator_args(&p, a.quick, &a.generator.sets),
+            name: dataset_name(&p, a.quick),
+            preset: p,
+        });
+    }
+    let plan = make_plan(
+        std::env::args().collect(),
+        &a.out,
+        &a.tools,
+        a.generator.blender_scripts.as_deref(),
+        &a.pipelines,
+        datasets,
+        a.slurm.render_shards,
+    )?;
+    submit_plan(&plan, &a.slurm, a.generator.fresh)
+}
+
+/// `sweep --executor slurm`: one dataset per factor value, made by the same generator
+/// arguments as a local sweep's variant.
+pub fn submit_sweep(a: &SweepArgs) -> Result<()> {
+    a.exec.check()?;
+    a.eval.eval_options()?;
+    let python = find_python(a.tools.python.as_deref())?;
+    let scripts = std::path::absolute(find_blender_scripts(
+        a.generator.blender_scripts.as_deref(),
+    )?)?;
+    let sweep_plan = SweepPlan::new(a, &python, &scripts)?;
+    let datasets = sweep_plan
+        .planned
+        .iter()
+        .map(|pl| {
+            let mut args = sweep_plan.base_args.clone();
+            for o in pl
+                .overrides
+                .iter()
+                .cloned()
+                .chain([format!("dataset.name=\"{}\"", pl.dataset)])
+            {
+                args.extend(["--set".to_string(), o]);
+            }
+            DatasetPlan {
+                preset: pl.text.clone(),
+                name: pl.dataset.clone(),
+                generator_args: args,
+            }
+        })
+        .collect();
+    let plan = make_plan(
+        std::env::args().collect(),
+        &a.out,
+        &a.tools,
+        Some(&scripts),
+        &a.pipelines,
+        datasets,
+        a.slurm.render_shards,
+    )?;
+    submit_plan(&plan, &a.slurm, a.generator.fresh)
+}
+
+/// Checks a resumed batch against its plan (or refuses to overwrite one), writes the plan
+/// and the scripts and, unless `--dry-run`, submits them.
+fn submit_plan(plan: &Plan, slurm: &SlurmArgs, fresh: bool) -> Result<()> {
+    if fresh {
+        bail!("--fresh does not go with --executor slurm: choose a new --out");
+    }
+    let res = resources(slurm)?;
+    let plan_path = Plan::path(&plan.out);
+    if plan_path.is_file() {
+        let old = Plan::read(&plan_path)?;
+        if !slurm.resume {
+            bail!(
+                "{} holds a Slurm batch already: add --resume to submit what is missing, or \
+                 choose another --out",
+                plan.out.display()
+            );
+        }
+        if !old.same_work(plan) {
+            bail!(
+                "--resume: {} was planned with other presets, pipelines or --render-shards; \
+                 give the same ones, or choose another --out",
+                plan.out.display()
+            );
+        }
+    } else if slurm.resume {
+        bail!(
+            "--resume: {} holds no Slurm batch (no {})",
+            plan.out.display(),
+            plan_path.display()
+        );
+    }
+    if slurm.resume && !slurm.dry_run {
+        let queued = submit::still_queued(plan, &slurm.sbatch)?;
+        if !queued.is_empty() {
+            bail!(
+                "--resume: jobs {} of this batch are still in the queue: wait for them (or \
+                 scancel them), then resume",
+                queued.join(" ")
+            );
+        }
+    }
+    for dir in [plan.slurm_dir().join("logs"), plan.out.join("datasets")] {
+        std::fs::create_dir_all(&dir).with_context(|| format!("creating {}", dir.display()))?;
+    }
+    let subs = submissions(plan);
+    for stage in Stage::ALL {
+        let r = res
+            .get(&stage)
+            .with_context(|| format!("no resources for stage {}", stage.name()))?;
+        write_atomic(
+            &plan.script(stage),
+            sbatch_script(plan, stage, r)?.as_bytes(),
+        )?;
+    }
+    let submit_path = plan.slurm_dir().join("submit.sh");
+    write_atomic(
+        &submit_path,
+        submit_sh(plan, &subs, &slurm.sbatch).as_bytes(),
+    )?;
+    let mut text = serde_json::to_string_pretty(plan)?;
+    text.push('\n');
+    write_atomic(&plan_path, text.as_bytes())?;
+    let summary: Vec<String> = Stage::ALL
+        .into_iter()
+        .filter_map(|st| {
+            let k: usize = subs
+                .iter()
+                .filter(|s| s.stage == st)
+                .map(|s| s.tasks.len())
+                .sum();
+            (k > 0).then(|| format!("{} {k}/{}", st.name(), plan.task_count(st)))
+        })
+        .collect();
+    if slurm.dry_run {
+        eprintln!(
+            "slurm: --dry-run: scripts in {} ({}); submit them with bash {}",
+            plan.slurm_dir().display(),
+            summary.join(", "),
+            submit_path.display()
+        );
+        return Ok(());
+    }
+    let jobs = submit::submit(plan, &subs, &slurm.sbatch)?;
+    submit::record(plan, &subs, &jobs)?;
+    eprintln!(
+        "slurm: submitted {} (tasks to run / in the stage); the table will be in {} (logs in {})",
+        summary.join(", "),
+        plan.out.join("table").display(),
+        plan.slurm_dir().join("logs").display()
+    );
+    Ok(())
+}
+
+#[cfg(test)]
+#[allow(clippy::unwrap_used, clippy::expect_used)]
+mod tests {
+    use super::*;
+
+    fn plan(out: &std::path::Path) -> Plan {
+        let ds = |n: &str| DatasetPlan {
+            preset: n.into(),
+            name: n.into(),
+            generator_args: Vec::new(),
+        };
+        let cell = |d: &str, p: &str| CellPlan {
+            dataset: d.into(),
+            pipeline: p.into(),
+        };
+        Plan {
+            schema: PLAN_SCHEMA.into(),
+            argv: Vec::new(),
+            cwd: out.into(),
+            runner: out.join("sfmeval-runner"),
+            python: out.join("python"),
+            blender_scripts: out.into(),
+            out: out.into(),
+            render_shards: 2,
+            datasets: vec![ds("b"), ds("a")],
+            pipelines: vec!["p".into(), "q".into()],
+            cells: vec![
+                cell("a", "p"),
+                cell("a", "q"),
+                cell("b", "p"),
+                cell("b", "q"),
+            ],
+        }
+    }
+
+    #[test]
+    fn each_dataset_is_chained_alone_and_resume_submits_what_is_missing() {
+        let out = std::env::temp_dir().join(format!("sfmeval-slurm-plan-{}", std::process::id()));
+        let p = plan(&out);
+        let subs = submissions(&p);
+        let shape: Vec<(String, Vec<usize>, Dependency)> = subs
+            .iter()
+            .map(|s| (s.label.clone(), s.tasks.clone(), s.dependency.clone()))
+            .collect();
+        assert_eq!(
+            shape,
+            vec![
+                ("render_0".into(), vec![0, 1], Dependency::None),
+                ("finalize_0".into(), vec![0], Dependency::AfterOk(0)),
+                ("run_0".into(), vec![2, 3], Dependency::AfterOk(1)),
+                ("render_1".into(), vec![2, 3], Dependency::None),
+                ("finalize_1".into(), vec![1], Dependency::AfterOk(3)),
+                ("run_1".into(), vec![0, 1], Dependency::AfterOk(4)),
+                (
+                    "collect".into(),
+                    vec![0],
+                    Dependency::AfterAny(vec![0, 1, 2, 3, 4, 5])
+                ),
+            ]
+        );
+        // Dataset b finalized, one shard of a rendered, a's run of q finished.
+        std::fs::create_dir_all(p.dataset_dir("b")).unwrap();
+        std::fs::write(p.dataset_dir("b").join("dataset.json"), "{}").unwrap();
+        let parts = p.dataset_dir("a").join(".parts");
+        std::fs::create_dir_all(&parts).unwrap();
+        std::fs::write(parts.join("views-1-of-2.json"), "{}").unwrap();
+        let run = p.task_runs(1).join("a").join("q");
+        std::fs::create_dir_all(&run).unwrap();
+        std::fs::write(run.join("run.json"), "{}").unwrap();
+        let shape: Vec<(String, Vec<usize>, Dependency)> = submissions(&p)
+            .iter()
+            .map(|s| (s.label.clone(), s.tasks.clone(), s.dependency.clone()))
+            .collect();
+        assert_eq!(
+            shape,
+            vec![
+                ("run_0".into(), vec![2, 3], Dependency::None),
+                ("render_1".into(), vec![2], Dependency::None),
+                ("finalize_1".into(), vec![1], Dependency::AfterOk(1)),
+                ("run_1".into(), vec![0], Dependency::AfterOk(2)),
+                (
+                    "collect".into(),
+                    vec![0],
+                    Dependency::AfterAny(vec![0, 1, 2, 3])
+                ),
+            ]
+        );
+        let _ = std::fs::remove_dir_all(&out);
+    }
+}
