@@ -92,23 +92,33 @@ impl Statistics {
     /// tail is long: an end farther than 0.5 × (p99 − p1) beyond p99 (or below p1)
     /// is replaced by p99 (p1), and the values beyond are counted in `overflow` (`underflow`).
     pub fn of(values: &[f64], bins: usize) -> Statistics {
+        Statistics::of_owned(values.to_vec(), bins)
+    }
+
+    /// [`Statistics::of`] on values it may reorder: the sums run in the given order first, then
+    /// the values are sorted in place (no copy).
+    pub fn of_owned(values: Vec<f64>, bins: usize) -> Statistics {
         let n = values.len();
         if n == 0 {
             return Statistics::default();
         }
-        let mut sorted = values.to_vec();
-        sorted.sort_unstable_by(f64::total_cmp);
         // Scale-safe: values whose squares (or sums) could overflow are divided by the largest
         // magnitude first and the results multiplied back; ordinary values are divided by 1
         // (bit-identical to the plain sums).
-        let largest = sorted[0].abs().max(sorted[n - 1].abs());
+        let (lowest, highest) = values.iter().fold((values[0], values[0]), |(lo, hi), &v| {
+            (
+                if v.total_cmp(&lo).is_lt() { v } else { lo },
+                if v.total_cmp(&hi).is_gt() { v } else { hi },
+            )
+        });
+        let largest = lowest.abs().max(highest.abs());
         let k = if largest.is_finite() && largest > 1e100 {
             largest
         } else {
             1.0
         };
         let (mut sum, mut sum_sq) = (0.0f64, 0.0f64);
-        for &v in values {
+        for &v in &values {
             let v = v / k;
             sum += v;
             sum_sq += v * v;
@@ -116,10 +126,12 @@ impl Statistics {
         let nf = n as f64;
         let mean_k = sum / nf;
         let mut dev = 0.0f64;
-        for &v in values {
+        for &v in &values {
             let v = v / k;
             dev += (v - mean_k) * (v - mean_k);
         }
+        let mut sorted = values;
+        sorted.sort_unstable_by(f64::total_cmp);
         let mean = mean_k * k;
         let min = sorted[0];
         let max = sorted[n - 1];
