@@ -251,16 +251,6 @@ impl Evaluation {
     }
 }
 
-/// The values of the points the crop kept, in input order.
-fn kept<T: Copy>(values: &[T], status: &[PointStatus]) -> Vec<T> {
-    values
-        .iter()
-        .zip(status)
-        .filter(|(_, s)| **s == PointStatus::Kept)
-        .map(|(v, _)| *v)
-        .collect()
-}
-
 /// Slots per block of accuracy queries: results are scattered into input order a block at a
 /// time, so the queries hold no per-point buffer beyond the outputs.
 const BLOCK: usize = 1 << 20;
@@ -379,12 +369,18 @@ pub fn evaluate(
 
     let diagonal = gt.aabb.diagonal();
     let resolved = options.thresholds(diagonal);
-    let kept_distances = kept(&distances, &status);
+    let is_kept = |i: usize| status[i] == PointStatus::Kept;
     let thresholds = resolved
         .taus
         .iter()
         .map(|&tau| {
-            let precision = share_below(&kept_distances, tau);
+            // share_below over the kept distances, without a copy of them.
+            let precision = if kept_n == 0 {
+                0.0
+            } else {
+                let below = (0..n).filter(|&i| is_kept(i) && distances[i] < tau).count();
+                below as f64 / kept_n as f64
+            };
             let recall = share_below(&completeness_distances, tau);
             ThresholdReport {
                 tau,
@@ -402,10 +398,10 @@ pub fn evaluate(
         .copied()
         .filter(|d| d.is_finite())
         .collect();
-    let accuracy_stats = Statistics::of_owned(kept_distances, bins);
+    let accuracy_stats = Statistics::of_kept(&distances, is_kept, bins);
     let signed_stats = signed_distances
         .as_ref()
-        .map(|s| Statistics::of_owned(kept(s, &status), bins));
+        .map(|s| Statistics::of_kept(s, is_kept, bins));
     let report = Report {
         schema: REPORT_SCHEMA.into(),
         tool: Tool::default(),
