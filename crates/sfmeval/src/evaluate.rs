@@ -491,3 +491,116 @@ pub fn evaluate(
         track_errors: None,
     })
 }
+
+#[cfg(test)]
+#[allow(clippy::unwrap_used)]
+mod tests {
+    use super::*;
+    use crate::crop::Volume;
+    use crate::geometry::{GroundTruth, TriangleMesh};
+    use crate::progress::NoProgress;
+
+    /// Points stored in `f32` give the report and per-point data of the same points in `f64`,
+    /// and both equal an independent brute-force evaluation: distances from the mesh index per
+    /// point in input order, completeness as the minimum over every kept point.
+    #[test]
+    fn f32_storage_and_tree_order_match_brute_force() {
+        let mesh = TriangleMesh {
+            vertices: vec![
+                [0.0, 0.0, 0.0],
+                [1.0, 0.0, 0.0],
+                [0.0, 1.0, 0.0],
+                [1.0, 1.0, 0.3],
+            ],
+            triangles: vec![[0, 1, 2], [1, 3, 2]],
+        };
+        let gt = PreparedGroundTruth::new(&GroundTruth::Mesh(mesh.clone()), 500, 3, &NoProgress)
+            .unwrap();
+        let index = crate::distance::MeshIndex::new(&mesh).unwrap();
+        let raw: Vec<[f32; 3]> = (0..3000u32)
+            .map(|i| {
+                let h = u64::from(i).wrapping_mul(0x9e37_79b9_7f4a_7c15);
+                let f = |s: u32| ((h >> s) & 0xffff) as f32 / 65535.0;
+                [f(0) * 1.4 - 0.2, f(16) * 1.4 - 0.2, f(32) * 0.4 - 0.2]
+            })
+            .collect();
+        let t = Similarity::from_matrix([
+            [0.0, -1.1, 0.0, 1.0],
+            [1.1, 0.0, 0.0, 0.05],
+            [0.0, 0.0, 1.1, 0.01],
+            [0.0, 0.0, 0.0, 1.0],
+        ])
+        .unwrap();
+        let alignment = AlignmentInput::given(t);
+        let options = EvalOptions {
+            samples: 500,
+            seed: 3,
+            signed: true,
+            crop: Crop {
+                volume: Some(Volume::Sphere {
+                    center: [0.5, 0.5, 0.0],
+                    radius: 0.6,
+                }),
+                max_distance: Some(0.1),
+                ..Crop::default()
+            },
+            ..EvalOptions::default()
+        };
+        let info = InputInfo::default();
+        let wide: Vec<Point3> = raw.iter().map(|p| p.map(f64::from)).collect();
+        let a = evaluate(
+            &gt,
+            Positions::F32(raw),
+            &alignment,
+            &options,
+            &info,
+            &NoProgress,
+        )
+        .unwrap();
+        let b = evaluate(
+            &gt,
+            Positions::F64(wide.clone()),
+            &alignment,
+            &options,
+            &info,
+            &NoProgress,
+        )
+        .unwrap();
+        assert_eq!(a.report.to_json(), b.report.to_json());
+        assert_eq!(a.points_in_gt(), b.points_in_gt());
+        // Independent: per input point, straight through the mesh index.
+        let in_gt: Vec<Point3> = wide.iter().map(|&p| t.apply(p)).collect();
+        assert_eq!(a.points_in_gt(), in_gt);
+        let mut kept = Vec::new();
+        for (i, p) in in_gt.iter().enumerate() {
+            let hit = index.closest(*p);
+            assert_eq!(a.distances[i].to_bits(), hit.distance.to_bits());
+            let sd = a.signed_distances.as_ref().unwrap()[i];
+            assert_eq!(sd.to_bits(), index.signed(*p, &hit).to_bits());
+            if a.status[i] == PointStatus::Kept {
+                kept.push(*p);
+            }
+        }
+        assert!(!kept.is_empty() && kept.len() < in_gt.len());
+        for (q, d) in a.completeness_points.iter().zip(&a.completeness_distances) {
+            let brute = kept
+                .iter()
+                .map(|p| {
+                    (p[0] - q[0]) * (p[0] - q[0])
+                        + (p[1] - q[1]) * (p[1] - q[1])
+                        + (p[2] - q[2]) * (p[2] - q[2])
+                })
+                .fold(f64::INFINITY, f64::min)
+                .sqrt();
+            assert_eq!(d.to_bits(), brute.to_bits());
+        }
+        let mut csv_points = Vec::new();
+        a.for_each_point_in_gt(|i, p| csv_points.push((i, p)));
+        assert!(
+            csv_points
+                .iter()
+                .enumerate()
+                .all(|(k, (i, p))| k == *i && *p == in_gt[k])
+        );
+    }
+}

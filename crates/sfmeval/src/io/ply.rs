@@ -760,6 +760,43 @@ mod tests {
         }
     }
 
+    /// Binary `float` x y z stay `f32` (either endianness, colours read alongside); the same
+    /// points written as text with the digits of their exact `f64` value (text is read as
+    /// `f64`, every digit kept) are equal point for point.
+    #[test]
+    fn binary_float_positions_stay_f32() {
+        let pts: [[f32; 3]; 3] = [[0.1, -2.5, 3.0e-7], [1.0e30, 0.0, -0.0], [7.25, 8.5, 9.125]];
+        let mut text = String::from(
+            "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\nproperty uchar red\nproperty uchar green\nproperty uchar blue\nend_header\n",
+        );
+        for p in &pts {
+            let [x, y, z] = p.map(f64::from);
+            text.push_str(&format!("{x} {y} {z} 1 2 3\n"));
+        }
+        let ascii = read_ply(text.as_bytes()).unwrap();
+        assert!(matches!(ascii.vertices, Positions::F64(_)));
+        for (fmt, big) in [("binary_little_endian", false), ("binary_big_endian", true)] {
+            let mut b = format!(
+                "ply\nformat {fmt} 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\nproperty uchar red\nproperty uchar green\nproperty uchar blue\nend_header\n"
+            )
+            .into_bytes();
+            for p in &pts {
+                for v in p {
+                    b.extend(if big {
+                        v.to_be_bytes()
+                    } else {
+                        v.to_le_bytes()
+                    });
+                }
+                b.extend([1u8, 2, 3]);
+            }
+            let ply = read_ply(&b).unwrap();
+            assert_eq!(ply.vertices, Positions::F32(pts.to_vec()));
+            assert_eq!(ply.vertices, ascii.vertices);
+            assert_eq!(ply.colors, Some(vec![[1, 2, 3]; 3]));
+        }
+    }
+
     #[test]
     fn truncated_binary_is_an_error() {
         let b = binary_cloud(false, 5);
