@@ -28,8 +28,13 @@ ground truth's box corners, within ALIGN_OK of the diagonal: the clouds' noise l
 "fastest anchor"; the script exits 1 when any tool crashes or disagrees, or sfmeval's alignment
 misses the truth by more than ALIGN_OK.
 
+Dense rows (--dense, default 10m; `--dense 10m,100m` in the full run, `--dense ''` for none):
+the whole eval only, on cloud_10m.ply / cloud_100m.ply (bench/generate.py --dense writes them
+when missing), sfmeval with all threads against the --dense-tools anchors (default Open3D), one
+round each, wall time and peak memory.
+
 --quick (CI): 50k-triangle mesh and 10k points generated into a temporary directory, 10k
-samples, one round, no CloudCompare ICP (a minute on its own).
+samples, one round, no CloudCompare ICP (a minute on its own), no dense rows.
 """
 import argparse
 import json
@@ -55,7 +60,8 @@ ALIGN_OK = 5e-3      # RMS displacement of the GT box corners after alignment / 
 GNU_TIME = "/usr/bin/time"  # Debian package `time`
 SLOW_S = 60.0        # a run longer than this is not repeated (its row says "1 round")
 OPS = ["load", "bvh", "kdtree", "accuracy", "completeness", "c2c", "align", "eval"]
-SIZES = {"10k": 10_000, "100k": 100_000, "1m": 1_000_000}
+SIZES = {"10k": 10_000, "100k": 100_000, "1m": 1_000_000, "10m": 10_000_000, "100m": 100_000_000}
+DENSE = ("10m", "100m")  # eval-only sizes: no moved cloud, no c2c queries
 PY_ANCHORS = {"Open3D": "open3d_ops.py", "trimesh+scipy": "trimesh_ops.py", "point-cloud-utils": "pcu_ops.py"}
 ANCHORS = list(PY_ANCHORS) + ["CloudCompare"]
 # The perturbed alignment start: the known gt_from_recon followed (in the ground-truth frame) by
@@ -251,7 +257,11 @@ def prepare(data, mesh_name, size, work, ctx):
     work.mkdir(parents=True, exist_ok=True)
     files = {"mesh": f"mesh_{mesh_name}.ply", "cloud": f"cloud_{size}.ply", "moved": f"cloud_{size}_moved.ply",
              "queries": f"queries_{size}.ply", "start": "start.txt"}
-    for k in ("mesh", "cloud", "moved"):
+    dense = size in DENSE
+    if dense and not (data / files["cloud"]).exists():
+        subprocess.run([sys.executable, str(ROOT / "bench" / "generate.py"), "--out", str(data), "--dense", size],
+                       check=True, stdout=subprocess.DEVNULL)
+    for k in ("mesh", "cloud") if dense else ("mesh", "cloud", "moved"):
         link = work / files[k]
         if not link.exists():
             link.symlink_to((data / files[k]).resolve())
@@ -264,7 +274,7 @@ def prepare(data, mesh_name, size, work, ctx):
         ctx["corners"] = np.array([[x, y, z] for x in (lo[0], hi[0]) for y in (lo[1], hi[1]) for z in (lo[2], hi[2])])
         ctx["truth"] = np.loadtxt(data / "gt_from_recon.txt", comments="#").reshape(4, 4)
     v, fa = ctx["mesh"]
-    if not (work / files["queries"]).exists():
+    if not dense and not (work / files["queries"]).exists():
         rng = np.random.default_rng(7)
         n = SIZES.get(size) or len(trimesh.load(data / files["cloud"]).vertices)
         q = sample(v, fa, n, rng) + rng.normal(scale=0.005 * ctx["diag"], size=(n, 3))
@@ -318,6 +328,8 @@ def main():
     ap.add_argument("--ops", default=",".join(OPS))
     ap.add_argument("--tools", default=",".join(ANCHORS), help="anchors to run when installed")
     ap.add_argument("--threads", type=int, default=os.cpu_count())
+    ap.add_argument("--dense", default="10m", help="eval-only dense rows: 10m, 100m (comma-separated, '' for none)")
+    ap.add_argument("--dense-tools", default="Open3D", help="anchors that run the dense rows")
     ap.add_argument("--slow-max", type=int, default=10_000,
                     help="trimesh accuracy/eval only up to this many points (closest_point is very slow)")
     ap.add_argument("--no-build", action="store_true")
@@ -332,6 +344,7 @@ def main():
         subprocess.run([sys.executable, str(ROOT / "bench" / "generate.py"), "--quick", "--out", str(data)],
                        check=True, stdout=subprocess.DEVNULL)
         args.rounds, args.sizes, args.mesh, args.samples, args.align_size = 1, "10k", "50k", 10_000, "10k"
+        args.dense = ""
     build(args.no_build)
     anchors = installed_anchors(args.tools.split(","))
     tools = ["sfmeval", "sfmeval 1 thread"] + anchors
@@ -348,6 +361,9 @@ def main():
             plan.append((op, args.align_size))
         else:
             plan += [(op, s) for s in sizes]
+    dense = [d for d in args.dense.split(",") if d]
+    if "eval" in ops:
+        plan += [("eval", d) for d in dense]
 
     print(f"bench: tools {', '.join(tools)}; {args.threads} threads; {args.rounds} round(s); data {data}", file=sys.stderr)
     failures, sections, records = [], [], []
@@ -358,11 +374,14 @@ def main():
         for tool in tools:
             if tool == "trimesh+scipy" and op in ("accuracy", "eval") and isinstance(n, int) and n > args.slow_max:
                 continue
+            if size in DENSE and (tool == "sfmeval 1 thread" or
+                                  (not tool.startswith("sfmeval") and tool not in args.dense_tools.split(","))):
+                continue
             if tool == "CloudCompare" and op == "align" and args.quick:
                 continue  # ~100 C2M passes: a minute even on the quick data
             print(f"bench: {op} {size} {tool} ...", file=sys.stderr, flush=True)
             try:
-                row = measure(tool, op, ctx, args.rounds)
+                row = measure(tool, op, ctx, 1 if size in DENSE else args.rounds)
             except Exception as e:  # noqa: BLE001 - a crashing tool is a row, not the end of the run
                 row = {"crash": str(e)[:300]}
                 failures.append(f"{op} {size} {tool}: crashed: {str(e)[:300]}")

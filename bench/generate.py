@@ -8,7 +8,10 @@ Writes into OUT (default bench/data):
                                 diagonal) Gaussian noise, 5 % uniform outliers in the bbox
   cloud_{...}_moved.ply         the same clouds moved by a known similarity (recon frame)
   gt_from_recon.txt             that similarity's inverse mapping moved clouds back (row-major 4x4)
-Usage: bench/generate.py [--out DIR] [--quick]   (--quick: 50k mesh and 10k/100k clouds only)
+  cloud_{10m,100m}.ply          with --dense 10m[,100m]: dense clouds of the same kind on mesh_1m
+                                (not moved), written in chunks of 5M points (1.2 GB for 100m)
+Usage: bench/generate.py [--out DIR] [--quick] [--dense 10m,100m]
+       (--quick: 50k mesh and 10k/100k clouds only; --dense: only the dense clouds)
 """
 import argparse
 import json
@@ -91,13 +94,44 @@ def write_glb(path, v, f):
         fh.write(struct.pack("<II", len(binary), 0x004E4942) + binary)
 
 
+DENSE = {"10m": 10_000_000, "100m": 100_000_000}
+CHUNK = 5_000_000
+
+
+def write_dense(out, name, n):
+    """cloud_{name}.ply: n points like cloud_1m (0.5 % noise, 5 % outliers, shuffled within each
+    chunk), drawn and written CHUNK points at a time so that memory stays bounded."""
+    v, f = bumpy_sphere(500, 1000)
+    v = np.asarray(v, "<f4").astype(np.float64)
+    lo, hi = v.min(0), v.max(0)
+    diag = np.linalg.norm(hi - lo)
+    rng = np.random.default_rng([20261125, n])
+    path = out / f"cloud_{name}.ply"
+    with open(path, "wb") as fh:
+        fh.write((f"ply\nformat binary_little_endian 1.0\ncomment sfmeval bench/generate.py\nelement vertex {n}\n"
+                  "property float x\nproperty float y\nproperty float z\nend_header\n").encode())
+        for start in range(0, n, CHUNK):
+            m = min(CHUNK, n - start)
+            m_out = int(0.05 * m)
+            pts = sample(v, f, m - m_out, rng) + rng.normal(scale=0.005 * diag, size=(m - m_out, 3))
+            pts = np.vstack([pts, rng.uniform(lo, hi, size=(m_out, 3))])
+            rng.shuffle(pts)
+            fh.write(np.asarray(pts, dtype="<f4").tobytes())
+    print(f"cloud_{name}: {n} points")
+
+
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--out", default=str(Path(__file__).resolve().parent / "data"))
     ap.add_argument("--quick", action="store_true")
+    ap.add_argument("--dense", default="", help="only write these dense clouds: 10m, 100m (comma-separated)")
     args = ap.parse_args()
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
+    if args.dense:
+        for name in args.dense.split(","):
+            write_dense(out, name, DENSE[name])
+        return
     rng = np.random.default_rng(20261125)
     meshes = {"50k": (112, 224)} if args.quick else {"50k": (112, 224), "1m": (500, 1000)}
     for name, (nl, nn) in meshes.items():

@@ -604,7 +604,8 @@ fn collect(work: &Path, output: &Path, rec: &mut RunRecord) -> Result<()> {
             }
         }
     }
-    let ply = sfmeval::export::points_ply(&input.cloud.points, input.cloud.colors.as_deref());
+    let ply =
+        sfmeval::export::points_ply(&input.cloud.points.as_f64(), input.cloud.colors.as_deref());
     write_atomic(&work.join("sparse.ply"), &ply)?;
     Ok(())
 }

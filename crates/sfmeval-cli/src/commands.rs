@@ -417,7 +417,7 @@ fn eval(args: &EvalArgs) -> Result<()> {
         &ReadLimits::triangles(args.input.max_triangles),
     )?;
     let recon = read_recon(&args.input)?;
-    let evaluation = pipeline::run(&mut dataset, &recon, &request, &bars)
+    let evaluation = pipeline::run_owned(&mut dataset, recon, &request, &bars)
         .map_err(|e| run_error(e, &args.input))?;
     if let Some(path) = &args.samples_csv {
         write_atomic(path, export::samples_csv(&evaluation).as_bytes())?;
@@ -561,7 +561,7 @@ fn info(path: &Path, limits: &ReadLimits) -> Result<()> {
         println!("triangles {tris}");
         println!("area      {area}");
     }
-    if let Some(b) = Aabb::of(gt.ground_truth.points()) {
+    if let Some(b) = Aabb::of(&gt.ground_truth.points()) {
         println!("bounds    min {:?}", b.min);
         println!("          max {:?}", b.max);
         println!("diagonal  {}", b.diagonal());

@@ -141,7 +141,7 @@ impl GroundTruth {
 
     /// Vertices (or cloud points), `x0, y0, z0, x1, ...`, in the ground-truth frame.
     pub fn vertices(&self) -> Float64Array {
-        points_f64(self.dataset.loaded.ground_truth.points())
+        points_f64(&self.dataset.loaded.ground_truth.points())
     }
 
     /// Triangle vertex indices (empty for a cloud).
@@ -157,7 +157,7 @@ impl GroundTruth {
 
     /// Bounding box `[xmin, ymin, zmin, xmax, ymax, zmax]`.
     pub fn bounds(&self) -> Vec<f64> {
-        Aabb::of(self.dataset.loaded.ground_truth.points())
+        Aabb::of(&self.dataset.loaded.ground_truth.points())
             .map(|b| b.min.iter().chain(&b.max).copied().collect())
             .unwrap_or_default()
     }
@@ -266,7 +266,7 @@ impl Reconstruction {
 
     /// Points in the reconstruction's own frame, `x0, y0, z0, x1, ...`.
     pub fn positions(&self) -> Float64Array {
-        points_f64(&self.input.cloud.points)
+        points_f64(&self.input.cloud.points.as_f64())
     }
 
     /// Per-point RGB colours (`r0, g0, b0, ...`), when the file has them.
@@ -490,13 +490,13 @@ impl Evaluation {
     /// Every reconstructed point in the ground-truth frame (`x0, y0, z0, ...`), input order.
     #[wasm_bindgen(js_name = pointsInGt)]
     pub fn points_in_gt(&self) -> Float64Array {
-        points_f64(&self.inner.points_in_gt)
+        points_f64(&self.inner.points_in_gt())
     }
 
     /// The same points as 32-bit floats (for WebGL buffers).
     #[wasm_bindgen(js_name = pointsInGtF32)]
     pub fn points_in_gt_f32(&self) -> Float32Array {
-        points_f32(&self.inner.points_in_gt)
+        points_f32(&self.inner.points_in_gt())
     }
 
     /// Unsigned distance of every point to the ground truth.

@@ -90,7 +90,10 @@ fn expected(points: &[[f32; 3]], colors: &[[u8; 3]], ascii: bool) -> Cloud {
 
 fn sfmeval_parse(bytes: &[u8]) -> Cloud {
     let ply = sfmeval::io::ply::read_ply(bytes).expect("sfmeval reads the bench PLY");
-    (ply.vertices, ply.colors.expect("the bench PLY has colours"))
+    (
+        ply.vertices.into_f64(),
+        ply.colors.expect("the bench PLY has colours"),
+    )
 }
 
 /// One vertex for ply-rs's typed path.

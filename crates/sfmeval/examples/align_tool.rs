@@ -43,7 +43,8 @@ fn load_cloud(path: &str) -> Result<Vec<[f64; 3]>, String> {
     Ok(sfmeval::io::read_point_cloud(path, &bytes)
         .map_err(|e| e.to_string())?
         .cloud
-        .points)
+        .points
+        .into_f64())
 }
 
 fn run(args: &[String]) -> Result<serde_json::Value, String> {

@@ -88,7 +88,10 @@ fn read_mesh(path: &str) -> Res<TriangleMesh> {
 
 fn read_cloud(path: &str) -> Res<Vec<Point3>> {
     let bytes = std::fs::read(path)?;
-    Ok(sfmeval::io::read_point_cloud(path, &bytes)?.cloud.points)
+    Ok(sfmeval::io::read_point_cloud(path, &bytes)?
+        .cloud
+        .points
+        .into_f64())
 }
 
 /// `n`, mean and max of distances, summed in input order.

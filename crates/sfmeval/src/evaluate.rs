@@ -5,9 +5,9 @@ use serde::{Deserialize, Serialize};
 
 use crate::align::AlignMode;
 use crate::crop::Crop;
-use crate::distance::CloudIndex;
+use crate::distance::slot_tree::{SlotTree, kd_order};
 use crate::error::{Error, Result};
-use crate::geometry::{Point3, PointCloud};
+use crate::geometry::{Point3, Positions};
 use crate::metrics::{Thresholds, f_score, share_below};
 use crate::parallel;
 use crate::prepared::PreparedGroundTruth;
@@ -126,11 +126,19 @@ pub enum PointStatus {
 }
 
 /// An evaluation: the report plus per-point data for exports and the viewer.
+///
+/// The reconstructed points are kept once, as read (`f32` where the file stored `f32`), in the
+/// storage order of the k-d tree the completeness queries used; [`Evaluation::points_in_gt`]
+/// maps them into the ground-truth frame on demand. Per-point arrays are in input order.
 pub struct Evaluation {
     /// The report.
     pub report: Report,
-    /// Every reconstructed point in the ground-truth frame, in input order.
-    pub points_in_gt: Vec<Point3>,
+    /// The reconstruction's points in its own frame, slot `k` holding input point
+    /// `slot_input[k]`.
+    recon: Positions,
+    slot_input: Vec<u32>,
+    /// The transform the points were measured in.
+    pub gt_from_recon: Similarity,
     /// Unsigned distance of every point to the ground truth.
     pub distances: Vec<f64>,
     /// Signed distances, when asked for.
@@ -212,20 +220,51 @@ impl AlignmentInput {
     }
 }
 
-/// The values of the points the crop kept, in input order.
-fn kept<T: Copy>(values: &[T], status: &[PointStatus]) -> Vec<T> {
-    values
-        .iter()
-        .zip(status)
-        .filter(|(_, s)| **s == PointStatus::Kept)
-        .map(|(v, _)| *v)
-        .collect()
+impl Evaluation {
+    /// Number of reconstructed points.
+    pub fn point_count(&self) -> usize {
+        self.recon.len()
+    }
+
+    /// Every reconstructed point in the ground-truth frame, in input order (a new vector of
+    /// 24 bytes a point; exports use [`Evaluation::for_each_point_in_gt`]).
+    pub fn points_in_gt(&self) -> Vec<Point3> {
+        let t = self.gt_from_recon;
+        let mut out = vec![[0.0; 3]; self.recon.len()];
+        for (k, &i) in self.slot_input.iter().enumerate() {
+            out[i as usize] = t.apply(self.recon.get(k));
+        }
+        out
+    }
+
+    /// Calls `f(index, point in the ground-truth frame)` for every reconstructed point in input
+    /// order (4 bytes a point of extra memory).
+    pub fn for_each_point_in_gt(&self, mut f: impl FnMut(usize, Point3)) {
+        let t = self.gt_from_recon;
+        let mut slot_of = vec![0u32; self.slot_input.len()];
+        for (k, &i) in self.slot_input.iter().enumerate() {
+            slot_of[i as usize] = k as u32;
+        }
+        for (i, &k) in slot_of.iter().enumerate() {
+            f(i, t.apply(self.recon.get(k as usize)));
+        }
+    }
 }
 
-/// Runs the evaluation of `recon` against a prepared ground truth.
+/// Slots per block of accuracy queries: results are scattered into input order a block at a
+/// time, so the queries hold no per-point buffer beyond the outputs.
+const BLOCK: usize = 1 << 20;
+
+/// Runs the evaluation of the reconstruction's points `recon` (its own frame; kept, reordered,
+/// in the [`Evaluation`]) against a prepared ground truth.
+///
+/// Memory, `n` points: the points as read (12 bytes a point in `f32`, 24 in `f64`), their input
+/// indices in tree order (4), the distances (8; 8 more signed), the status (1), the live mask
+/// (1/8) and the tree boxes (about 2), plus 16 bytes a point while the tree order is computed
+/// and 8 while the statistics sort the kept distances.
 pub fn evaluate(
     gt: &PreparedGroundTruth,
-    recon: &PointCloud,
+    mut recon: Positions,
     alignment: &AlignmentInput,
     options: &EvalOptions,
     info: &InputInfo,
@@ -238,49 +277,69 @@ pub fn evaluate(
             gt.requested_samples, options.samples
         )));
     }
-    if recon.points.is_empty() {
+    if recon.is_empty() {
         return Err(Error::Empty {
             what: "reconstruction (no points)".into(),
         });
     }
+    let n = recon.len();
     let mut warnings = info.warnings.clone();
     let t = alignment.gt_from_recon;
-    let points_in_gt: Vec<Point3> = recon.points.iter().map(|&p| t.apply(p)).collect();
-    crate::geometry::check_finite("aligned reconstruction", "point", &points_in_gt)?;
+    crate::geometry::check_finite_with("aligned reconstruction", "point", n, |i| {
+        t.apply(recon.get(i))
+    })?;
 
-    progress.start(Stage::Accuracy, points_in_gt.len() as u64);
-    let pairs = parallel::map_points(&points_in_gt, progress, |&p| gt.distance(p, options.signed));
+    // The storage in k-d tree order: the completeness index, and the visiting order of the
+    // accuracy queries (neighbours in space one after the other keep the BVH in cache).
+    let slot_input = kd_order(n, |i| t.apply(recon.get(i)));
+    recon.permute(&slot_input);
+    let in_gt = |k: usize| t.apply(recon.get(k));
+
+    progress.start(Stage::Accuracy, n as u64);
+    let signed_wanted = options.signed && gt.is_mesh();
+    let mut distances = vec![0.0f64; n];
+    let mut signed_distances = signed_wanted.then(|| vec![0.0f64; n]);
+    for start in (0..n).step_by(BLOCK) {
+        let end = (start + BLOCK).min(n);
+        let block = parallel::map_range_progress(start, end, progress, |k| {
+            gt.distance(in_gt(k), options.signed)
+        });
+        for (k, (d, s)) in (start..end).zip(block) {
+            let i = slot_input[k] as usize;
+            distances[i] = d;
+            if let Some(sd) = signed_distances.as_mut() {
+                sd[i] = s.unwrap_or(d);
+            }
+        }
+    }
     progress.finish();
-    let distances: Vec<f64> = pairs.iter().map(|d| d.0).collect();
-    let signed_distances: Option<Vec<f64>> = (options.signed && gt.is_mesh())
-        .then(|| pairs.iter().map(|d| d.1.unwrap_or(d.0)).collect());
     if options.signed && !gt.is_mesh() {
         warnings.push("signed distances need a mesh ground truth; reported unsigned only".into());
     }
 
     let crop = &options.crop;
-    let status: Vec<PointStatus> = points_in_gt
-        .iter()
-        .zip(&distances)
-        .map(|(&p, &d)| {
-            if !crop.in_volume(p) {
-                PointStatus::OutsideVolume
-            } else if crop.max_distance.is_some_and(|m| d > m) {
-                PointStatus::TooFar
-            } else {
-                PointStatus::Kept
-            }
-        })
-        .collect();
+    let mut status = vec![PointStatus::Kept; n];
+    let mut live = vec![0u64; n.div_ceil(64)];
+    for (k, &i) in slot_input.iter().enumerate() {
+        let i = i as usize;
+        let s = if !crop.in_volume(in_gt(k)) {
+            PointStatus::OutsideVolume
+        } else if crop.max_distance.is_some_and(|m| distances[i] > m) {
+            PointStatus::TooFar
+        } else {
+            live[k / 64] |= 1 << (k % 64);
+            PointStatus::Kept
+        };
+        status[i] = s;
+    }
+    let is_live = |k: usize| live[k / 64] >> (k % 64) & 1 == 1;
     let count = |s: PointStatus| status.iter().filter(|&&x| x == s).count() as u64;
     let (kept_n, outside, too_far) = (
         count(PointStatus::Kept),
         count(PointStatus::OutsideVolume),
         count(PointStatus::TooFar),
     );
-    let kept_distances = kept(&distances, &status);
-    let kept_points = kept(&points_in_gt, &status);
-    if kept_points.is_empty() {
+    if kept_n == 0 {
         warnings.push("the crop discarded every reconstructed point".into());
     }
 
@@ -290,15 +349,16 @@ pub fn evaluate(
         .copied()
         .filter(|&p| crop.in_volume(p))
         .collect();
-    let completeness_distances: Vec<f64> = if kept_points.is_empty() {
+    let completeness_distances: Vec<f64> = if kept_n == 0 {
         vec![f64::INFINITY; completeness_points.len()]
     } else {
         progress.start(Stage::IndexReconstruction, 1);
-        let recon_index = CloudIndex::new(&kept_points)?;
+        let tree = SlotTree::new(n, in_gt, is_live);
         progress.finish();
         progress.start(Stage::Completeness, completeness_points.len() as u64);
         let d = parallel::map_points(&completeness_points, progress, |&p| {
-            recon_index.nearest(p).0
+            tree.nearest(p, in_gt, is_live)
+                .map_or(f64::NAN, |(d2, _)| d2.sqrt())
         });
         progress.finish();
         d
@@ -309,11 +369,18 @@ pub fn evaluate(
 
     let diagonal = gt.aabb.diagonal();
     let resolved = options.thresholds(diagonal);
+    let is_kept = |i: usize| status[i] == PointStatus::Kept;
     let thresholds = resolved
         .taus
         .iter()
         .map(|&tau| {
-            let precision = share_below(&kept_distances, tau);
+            // share_below over the kept distances, without a copy of them.
+            let precision = if kept_n == 0 {
+                0.0
+            } else {
+                let below = (0..n).filter(|&i| is_kept(i) && distances[i] < tau).count();
+                below as f64 / kept_n as f64
+            };
             let recall = share_below(&completeness_distances, tau);
             ThresholdReport {
                 tau,
@@ -331,9 +398,10 @@ pub fn evaluate(
         .copied()
         .filter(|d| d.is_finite())
         .collect();
+    let accuracy_stats = Statistics::of_kept(&distances, is_kept, bins);
     let signed_stats = signed_distances
         .as_ref()
-        .map(|s| Statistics::of(&kept(s, &status), bins));
+        .map(|s| Statistics::of_kept(s, is_kept, bins));
     let report = Report {
         schema: REPORT_SCHEMA.into(),
         tool: Tool::default(),
@@ -341,7 +409,7 @@ pub fn evaluate(
             reconstruction: ReconstructionInput {
                 name: info.recon_name.clone(),
                 format: info.recon_format.clone(),
-                points: recon.points.len() as u64,
+                points: n as u64,
                 images: info.recon_images,
             },
             ground_truth: GroundTruthInput {
@@ -386,7 +454,7 @@ pub fn evaluate(
                 "point_to_point"
             }
             .into(),
-            stats: Statistics::of(&kept_distances, bins),
+            stats: accuracy_stats,
             signed: signed_stats,
         },
         completeness: CompletenessReport {
@@ -399,7 +467,7 @@ pub fn evaluate(
             .into(),
             samples: completeness_points.len() as u64,
             seed: gt.sample_seed,
-            stats: Statistics::of(&finite_completeness, bins),
+            stats: Statistics::of_owned(finite_completeness, bins),
         },
         thresholds,
         cameras: None,
@@ -409,7 +477,9 @@ pub fn evaluate(
     };
     Ok(Evaluation {
         report,
-        points_in_gt,
+        recon,
+        slot_input,
+        gt_from_recon: t,
         distances,
         signed_distances,
         status,
@@ -420,4 +490,117 @@ pub fn evaluate(
         sample_labels: None,
         track_errors: None,
     })
+}
+
+#[cfg(test)]
+#[allow(clippy::unwrap_used)]
+mod tests {
+    use super::*;
+    use crate::crop::Volume;
+    use crate::geometry::{GroundTruth, TriangleMesh};
+    use crate::progress::NoProgress;
+
+    /// Points stored in `f32` give the report and per-point data of the same points in `f64`,
+    /// and both equal an independent brute-force evaluation: distances from the mesh index per
+    /// point in input order, completeness as the minimum over every kept point.
+    #[test]
+    fn f32_storage_and_tree_order_match_brute_force() {
+        let mesh = TriangleMesh {
+            vertices: vec![
+                [0.0, 0.0, 0.0],
+                [1.0, 0.0, 0.0],
+                [0.0, 1.0, 0.0],
+                [1.0, 1.0, 0.3],
+            ],
+            triangles: vec![[0, 1, 2], [1, 3, 2]],
+        };
+        let gt = PreparedGroundTruth::new(&GroundTruth::Mesh(mesh.clone()), 500, 3, &NoProgress)
+            .unwrap();
+        let index = crate::distance::MeshIndex::new(&mesh).unwrap();
+        let raw: Vec<[f32; 3]> = (0..3000u32)
+            .map(|i| {
+                let h = u64::from(i).wrapping_mul(0x9e37_79b9_7f4a_7c15);
+                let f = |s: u32| ((h >> s) & 0xffff) as f32 / 65535.0;
+                [f(0) * 1.4 - 0.2, f(16) * 1.4 - 0.2, f(32) * 0.4 - 0.2]
+            })
+            .collect();
+        let t = Similarity::from_matrix([
+            [0.0, -1.1, 0.0, 1.0],
+            [1.1, 0.0, 0.0, 0.05],
+            [0.0, 0.0, 1.1, 0.01],
+            [0.0, 0.0, 0.0, 1.0],
+        ])
+        .unwrap();
+        let alignment = AlignmentInput::given(t);
+        let options = EvalOptions {
+            samples: 500,
+            seed: 3,
+            signed: true,
+            crop: Crop {
+                volume: Some(Volume::Sphere {
+                    center: [0.5, 0.5, 0.0],
+                    radius: 0.6,
+                }),
+                max_distance: Some(0.1),
+                ..Crop::default()
+            },
+            ..EvalOptions::default()
+        };
+        let info = InputInfo::default();
+        let wide: Vec<Point3> = raw.iter().map(|p| p.map(f64::from)).collect();
+        let a = evaluate(
+            &gt,
+            Positions::F32(raw),
+            &alignment,
+            &options,
+            &info,
+            &NoProgress,
+        )
+        .unwrap();
+        let b = evaluate(
+            &gt,
+            Positions::F64(wide.clone()),
+            &alignment,
+            &options,
+            &info,
+            &NoProgress,
+        )
+        .unwrap();
+        assert_eq!(a.report.to_json(), b.report.to_json());
+        assert_eq!(a.points_in_gt(), b.points_in_gt());
+        // Independent: per input point, straight through the mesh index.
+        let in_gt: Vec<Point3> = wide.iter().map(|&p| t.apply(p)).collect();
+        assert_eq!(a.points_in_gt(), in_gt);
+        let mut kept = Vec::new();
+        for (i, p) in in_gt.iter().enumerate() {
+            let hit = index.closest(*p);
+            assert_eq!(a.distances[i].to_bits(), hit.distance.to_bits());
+            let sd = a.signed_distances.as_ref().unwrap()[i];
+            assert_eq!(sd.to_bits(), index.signed(*p, &hit).to_bits());
+            if a.status[i] == PointStatus::Kept {
+                kept.push(*p);
+            }
+        }
+        assert!(!kept.is_empty() && kept.len() < in_gt.len());
+        for (q, d) in a.completeness_points.iter().zip(&a.completeness_distances) {
+            let brute = kept
+                .iter()
+                .map(|p| {
+                    (p[0] - q[0]) * (p[0] - q[0])
+                        + (p[1] - q[1]) * (p[1] - q[1])
+                        + (p[2] - q[2]) * (p[2] - q[2])
+                })
+                .fold(f64::INFINITY, f64::min)
+                .sqrt();
+            assert_eq!(d.to_bits(), brute.to_bits());
+        }
+        let mut csv_points = Vec::new();
+        a.for_each_point_in_gt(|i, p| csv_points.push((i, p)));
+        assert!(
+            csv_points
+                .iter()
+                .enumerate()
+                .all(|(k, (i, p))| k == *i && *p == in_gt[k])
+        );
+    }
 }

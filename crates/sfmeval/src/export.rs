@@ -9,23 +9,28 @@ use crate::evaluate::{Evaluation, PointStatus};
 /// Binary little-endian PLY of every kept point in the ground-truth frame, coloured by its
 /// distance clipped at `clip` (viridis), with `float distance` (and `float signed_distance`).
 pub fn colored_ply(eval: &Evaluation, clip: f64) -> Vec<u8> {
-    let kept: Vec<usize> = (0..eval.points_in_gt.len())
-        .filter(|&i| eval.status[i] == PointStatus::Kept)
-        .collect();
+    let kept = eval
+        .status
+        .iter()
+        .filter(|&&s| s == PointStatus::Kept)
+        .count();
     let signed = eval.signed_distances.as_ref();
     let mut header = format!(
         "ply\nformat binary_little_endian 1.0\ncomment sfmeval {} error heat map, distances clipped at {clip} for colour\nelement vertex {}\nproperty double x\nproperty double y\nproperty double z\nproperty uchar red\nproperty uchar green\nproperty uchar blue\nproperty float distance\n",
         env!("CARGO_PKG_VERSION"),
-        kept.len()
+        kept
     );
     if signed.is_some() {
         header.push_str("property float signed_distance\n");
     }
     header.push_str("end_header\n");
     let mut out = header.into_bytes();
-    out.reserve(kept.len() * 35);
-    for i in kept {
-        for c in eval.points_in_gt[i] {
+    out.reserve(kept * 35);
+    eval.for_each_point_in_gt(|i, p| {
+        if eval.status[i] != PointStatus::Kept {
+            return;
+        }
+        for c in p {
             out.extend(c.to_le_bytes());
         }
         out.extend(distance_color(eval.distances[i], clip));
@@ -33,7 +38,7 @@ pub fn colored_ply(eval: &Evaluation, clip: f64) -> Vec<u8> {
         if let Some(s) = signed {
             out.extend((s[i] as f32).to_le_bytes());
         }
-    }
+    });
     out
 }
 
@@ -42,7 +47,7 @@ pub fn colored_ply(eval: &Evaluation, clip: f64) -> Vec<u8> {
 /// `too_far`); with depth maps and tracks, a last column `track_error` (empty when the point
 /// was not measured).
 pub fn distances_csv(eval: &Evaluation) -> String {
-    let mut s = String::with_capacity(eval.points_in_gt.len() * 64);
+    let mut s = String::with_capacity(eval.point_count() * 64);
     s.push_str("index,x,y,z,distance,signed_distance,status");
     let track = eval.track_errors.as_ref();
     s.push_str(if track.is_some() {
@@ -50,7 +55,7 @@ pub fn distances_csv(eval: &Evaluation) -> String {
     } else {
         "\n"
     });
-    for (i, p) in eval.points_in_gt.iter().enumerate() {
+    eval.for_each_point_in_gt(|i, p| {
         let signed = eval
             .signed_distances
             .as_ref()
@@ -71,7 +76,7 @@ pub fn distances_csv(eval: &Evaluation) -> String {
             let _ = write!(s, ",{}", v.map(|v| v.to_string()).unwrap_or_default());
         }
         s.push('\n');
-    }
+    });
     s
 }
 

@@ -25,11 +25,132 @@ pub(crate) fn show(v: f64) -> String {
     }
 }
 
+/// Point positions as stored: `f32` where the file stores `f32` (half the memory of `f64`; a
+/// dense cloud of 100M points takes 1.2 GB), `f64` otherwise. Every position is read out as the
+/// [`Point3`] it stands for (`f32` widens exactly), so all arithmetic stays in `f64`. Equal
+/// when the points are (whatever the storage).
+#[derive(Debug, Clone)]
+pub enum Positions {
+    /// Double precision.
+    F64(Vec<Point3>),
+    /// Single precision, as the file stored them.
+    F32(Vec<[f32; 3]>),
+}
+
+impl PartialEq for Positions {
+    fn eq(&self, other: &Self) -> bool {
+        self.len() == other.len() && self.iter().zip(other.iter()).all(|(a, b)| a == b)
+    }
+}
+
+impl Default for Positions {
+    fn default() -> Self {
+        Positions::F64(Vec::new())
+    }
+}
+
+impl From<Vec<Point3>> for Positions {
+    fn from(v: Vec<Point3>) -> Self {
+        Positions::F64(v)
+    }
+}
+
+impl Positions {
+    /// Number of points.
+    pub fn len(&self) -> usize {
+        match self {
+            Positions::F64(v) => v.len(),
+            Positions::F32(v) => v.len(),
+        }
+    }
+
+    /// Whether there are no points.
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// Point `i` in `f64` (panics when out of range, as indexing does).
+    #[inline]
+    pub fn get(&self, i: usize) -> Point3 {
+        match self {
+            Positions::F64(v) => v[i],
+            Positions::F32(v) => v[i].map(f64::from),
+        }
+    }
+
+    /// The points in order, in `f64`.
+    pub fn iter(&self) -> impl ExactSizeIterator<Item = Point3> + '_ {
+        (0..self.len()).map(|i| self.get(i))
+    }
+
+    /// The points as an `f64` slice: borrowed when stored in `f64`, widened into a new vector
+    /// otherwise.
+    pub fn as_f64(&self) -> std::borrow::Cow<'_, [Point3]> {
+        match self {
+            Positions::F64(v) => std::borrow::Cow::Borrowed(v),
+            Positions::F32(v) => {
+                std::borrow::Cow::Owned(v.iter().map(|p| p.map(f64::from)).collect())
+            }
+        }
+    }
+
+    /// The points in `f64`, consuming the storage.
+    pub fn into_f64(self) -> Vec<Point3> {
+        match self {
+            Positions::F64(v) => v,
+            Positions::F32(v) => v.into_iter().map(|p| p.map(f64::from)).collect(),
+        }
+    }
+
+    /// Keeps the points whose `keep(i)` is true, in order, in place.
+    pub(crate) fn retain_indices(&mut self, keep: impl Fn(usize) -> bool) {
+        let mut i = 0;
+        match self {
+            Positions::F64(v) => v.retain(|_| (keep(i), i += 1).0),
+            Positions::F32(v) => v.retain(|_| (keep(i), i += 1).0),
+        }
+    }
+
+    /// Reorders the points so that new slot `k` holds old point `order[k]` (`order` is a
+    /// permutation of `0..len`).
+    /// In place: one bit a point of extra memory.
+    pub(crate) fn permute(&mut self, order: &[u32]) {
+        match self {
+            Positions::F64(v) => permute_in_place(v, order),
+            Positions::F32(v) => permute_in_place(v, order),
+        }
+    }
+}
+
+/// Reorders `v` in place so that new slot `k` holds old item `order[k]`, following the
+/// permutation's cycles (a bit a slot marks the slots done).
+pub(crate) fn permute_in_place<T: Copy>(v: &mut [T], order: &[u32]) {
+    debug_assert_eq!(v.len(), order.len());
+    let mut done = vec![0u64; v.len().div_ceil(64)];
+    for start in 0..v.len() {
+        if done[start / 64] >> (start % 64) & 1 == 1 {
+            continue;
+        }
+        let first = v[start];
+        let mut k = start;
+        loop {
+            done[k / 64] |= 1 << (k % 64);
+            let from = order[k] as usize;
+            if from == start {
+                v[k] = first;
+                break;
+            }
+            v[k] = v[from];
+            k = from;
+        }
+    }
+}
+
 /// A point cloud with optional per-point colours.
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct PointCloud {
     /// Point positions.
-    pub points: Vec<Point3>,
+    pub points: Positions,
     /// Per-point RGB colours, when the file has them.
     pub colors: Option<Vec<[u8; 3]>>,
 }
@@ -131,11 +252,11 @@ impl TriangleMesh {
 }
 
 impl GroundTruth {
-    /// The points that bound the ground truth (mesh vertices or cloud points).
-    pub fn points(&self) -> &[Point3] {
+    /// The points that bound the ground truth (mesh vertices or cloud points), in `f64`.
+    pub fn points(&self) -> std::borrow::Cow<'_, [Point3]> {
         match self {
-            GroundTruth::Mesh(m) => &m.vertices,
-            GroundTruth::Cloud(c) => &c.points,
+            GroundTruth::Mesh(m) => std::borrow::Cow::Borrowed(&m.vertices),
+            GroundTruth::Cloud(c) => c.points.as_f64(),
         }
     }
 }
@@ -148,21 +269,33 @@ pub(crate) fn check_finite(
     what: &'static str,
     points: &[Point3],
 ) -> Result<()> {
-    check_not_nan_inf(format, what, points)?;
-    check_coordinate_range(format, what, points)
+    check_finite_with(format, what, points.len(), |i| points[i])
+}
+
+/// [`check_finite`] on the `n` points `point(0..n)`, computed on the fly.
+pub(crate) fn check_finite_with(
+    format: &'static str,
+    what: &'static str,
+    n: usize,
+    point: impl Fn(usize) -> Point3,
+) -> Result<()> {
+    check_not_nan_inf(format, what, n, &point)?;
+    check_coordinate_range_with(format, what, n, &point)
 }
 
 /// Fails with [`Error::OutOfRange`] on the first coordinate beyond ±[`MAX_COORDINATE`] (the
 /// coordinates must be finite).
-pub(crate) fn check_coordinate_range(
+fn check_coordinate_range_with(
     format: &'static str,
     what: &'static str,
-    points: &[Point3],
+    n: usize,
+    point: impl Fn(usize) -> Point3,
 ) -> Result<()> {
-    for (i, p) in points.iter().enumerate() {
+    for i in 0..n {
+        let p = point(i);
         if let Some(k) = (0..3).find(|&k| !(p[k].abs() <= MAX_COORDINATE)) {
-            let count = points
-                .iter()
+            let count = (0..n)
+                .map(&point)
                 .filter(|p| p.iter().any(|v| !(v.abs() <= MAX_COORDINATE)))
                 .count();
             return Err(Error::out_of_range(
@@ -180,10 +313,34 @@ pub(crate) fn check_coordinate_range(
     Ok(())
 }
 
-fn check_not_nan_inf(format: &'static str, what: &'static str, points: &[Point3]) -> Result<()> {
+/// [`check_finite`] on `f32` positions (every finite `f32` is within range).
+pub(crate) fn check_finite_f32(
+    format: &'static str,
+    what: &'static str,
+    points: &[[f32; 3]],
+) -> Result<()> {
+    let bad = |p: &[f32; 3]| !p.iter().all(|v| v.is_finite());
+    let Some(first_index) = points.iter().position(bad) else {
+        return Ok(());
+    };
+    Err(Error::NonFinite {
+        format,
+        what,
+        count: points.iter().filter(|p| bad(p)).count(),
+        first_index,
+    })
+}
+
+fn check_not_nan_inf(
+    format: &'static str,
+    what: &'static str,
+    n: usize,
+    point: impl Fn(usize) -> Point3,
+) -> Result<()> {
     let mut count = 0;
     let mut first_index = 0;
-    for (i, p) in points.iter().enumerate() {
+    for i in 0..n {
+        let p = point(i);
         if !(p[0].is_finite() && p[1].is_finite() && p[2].is_finite()) {
             if count == 0 {
                 first_index = i;

@@ -45,6 +45,55 @@ where
     }
 }
 
+/// Maps `f` over `0..n`, keeping order (no progress).
+pub(crate) fn map_range<R, F>(n: usize, f: F) -> Vec<R>
+where
+    R: Send,
+    F: Fn(usize) -> R + Sync + Send,
+{
+    #[cfg(feature = "parallel")]
+    {
+        use rayon::prelude::*;
+        (0..n).into_par_iter().with_min_len(1024).map(f).collect()
+    }
+    #[cfg(not(feature = "parallel"))]
+    {
+        (0..n).map(f).collect()
+    }
+}
+
+/// Maps `f` over `start..end`, keeping order, reporting progress per chunk.
+pub(crate) fn map_range_progress<R, F>(
+    start: usize,
+    end: usize,
+    progress: &dyn Progress,
+    f: F,
+) -> Vec<R>
+where
+    R: Send,
+    F: Fn(usize) -> R + Sync + Send,
+{
+    let starts: Vec<usize> = (start..end).step_by(CHUNK).collect();
+    let chunk = |&s: &usize| {
+        let e = (s + CHUNK).min(end);
+        let out: Vec<R> = (s..e).map(&f).collect();
+        progress.advance((e - s) as u64);
+        out
+    };
+    #[cfg(feature = "parallel")]
+    let chunks: Vec<Vec<R>> = {
+        use rayon::prelude::*;
+        starts.par_iter().map(chunk).collect()
+    };
+    #[cfg(not(feature = "parallel"))]
+    let chunks: Vec<Vec<R>> = starts.iter().map(chunk).collect();
+    let mut out = Vec::with_capacity(end - start);
+    for c in chunks {
+        out.extend(c);
+    }
+    out
+}
+
 /// Maps `f` over 3D points visited in Morton order (a Z-curve: neighbours in space are
 /// queried one after the other, which keeps a BVH or k-d tree in cache) and returns the results
 /// in input order, like [`map`]. Worth it for closest-point queries on large inputs.

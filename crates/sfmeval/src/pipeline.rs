@@ -102,7 +102,7 @@ pub fn read_reconstruction(name: &str, files: &BTreeMap<String, Vec<u8>>) -> Res
     let (file_name, bytes) = point_cloud_file(name, files)?;
     let loaded = io::read_point_cloud(file_name, bytes)?;
     let mut warnings = loaded.warnings;
-    let stripped = model::strip::strip_camera_points(&loaded.cloud, None, name);
+    let stripped = model::strip::strip_camera_points(loaded.cloud, None, name);
     warnings.extend(stripped.warning);
     Ok(ReconInput {
         cloud: stripped.cloud,
@@ -177,7 +177,7 @@ fn cloud_with_cameras(
         cameras.format
     ));
     let centers = cameras.camera_centers();
-    let stripped = model::strip::strip_camera_points(&loaded.cloud, Some(&centers), file_name);
+    let stripped = model::strip::strip_camera_points(loaded.cloud, Some(&centers), file_name);
     if !stripped.by_centers {
         warnings.push(format!(
             "no point of '{file_name}' lies at one of the {} camera centres of '{cameras_name}' (fine for a cloud without camera points; otherwise they are not in one frame)",
@@ -238,6 +238,17 @@ pub fn run(
     request: &EvalRequest,
     progress: &dyn Progress,
 ) -> Result<Evaluation> {
+    run_owned(dataset, recon.clone(), request, progress)
+}
+
+/// [`run`] on a reconstruction it may keep: its points move into the [`Evaluation`] instead
+/// of being copied (what a front end that reads a dense cloud once wants).
+pub fn run_owned(
+    dataset: &mut Dataset,
+    mut recon: ReconInput,
+    request: &EvalRequest,
+    progress: &dyn Progress,
+) -> Result<Evaluation> {
     request.eval.validate()?;
     request.align.validate()?;
     dataset.prepare(request.eval.samples, request.eval.seed, progress)?;
@@ -282,7 +293,7 @@ pub fn run(
     }
     let alignment = align_recon(
         gt,
-        recon,
+        &recon,
         &pairs,
         no_match.as_deref(),
         gt_cameras.is_some(),
@@ -298,7 +309,9 @@ pub fn run(
         gt_format: dataset.loaded.format.name().into(),
         warnings,
     };
-    let mut evaluation = evaluate(gt, &recon.cloud, &alignment, &request.eval, &info, progress)?;
+    let points = std::mem::take(&mut recon.cloud.points);
+    recon.cloud.colors = None;
+    let mut evaluation = evaluate(gt, points, &alignment, &request.eval, &info, progress)?;
     if let (Some(g), Some(e), Some(m), None) = (gt_cameras, &recon.model, &matches, &no_match) {
         evaluation.report.cameras = Some(camera_section(
             g,
@@ -347,8 +360,10 @@ fn align_recon(
         return Err(cameras_unavailable(have_gt_cameras, recon, no_match));
     }
     progress.start(Stage::Alignment, 1);
+    // The stages read `f64` points (a widened copy of an `f32` cloud while they run).
+    let points = recon.cloud.points.as_f64();
     let input = AlignInput {
-        recon: &recon.cloud.points,
+        recon: &points,
         cameras: pairs,
         point_pairs: &a.pairs,
         start: a.transform,

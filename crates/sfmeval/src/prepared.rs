@@ -34,7 +34,7 @@ impl PreparedGroundTruth {
         seed: u64,
         progress: &dyn Progress,
     ) -> Result<Self> {
-        let aabb = Aabb::of(gt.points()).ok_or_else(|| Error::Empty {
+        let aabb = Aabb::of(&gt.points()).ok_or_else(|| Error::Empty {
             what: "ground truth".into(),
         })?;
         if !(aabb.diagonal() > 0.0) {
@@ -58,8 +58,8 @@ impl PreparedGroundTruth {
                 )
             }
             GroundTruth::Cloud(c) => (
-                GtIndex::Cloud(CloudIndex::new(&c.points)?),
-                c.points.clone(),
+                GtIndex::Cloud(CloudIndex::new(&c.points.as_f64())?),
+                c.points.as_f64().into_owned(),
                 c.points.len(),
                 0,
                 0.0,

@@ -65,7 +65,9 @@ pub struct Statistics {
 /// Default number of histogram bins.
 pub const DEFAULT_BINS: usize = 50;
 
-/// Linear-interpolated percentile `q` in [0, 100] of sorted values.
+/// Linear-interpolated percentile `q` in [0, 100] of sorted values (the reference the tests
+/// hold [`percentile_by`] to).
+#[cfg(test)]
 pub(crate) fn percentile_sorted(sorted: &[f64], q: f64) -> f64 {
     match sorted.len() {
         0 => 0.0,
@@ -92,23 +94,47 @@ impl Statistics {
     /// tail is long: an end farther than 0.5 × (p99 − p1) beyond p99 (or below p1)
     /// is replaced by p99 (p1), and the values beyond are counted in `overflow` (`underflow`).
     pub fn of(values: &[f64], bins: usize) -> Statistics {
-        let n = values.len();
-        if n == 0 {
+        Statistics::of_owned(values.to_vec(), bins)
+    }
+
+    /// [`Statistics::of`] on values it may reorder (the sums run in the given order).
+    pub fn of_owned(values: Vec<f64>, bins: usize) -> Statistics {
+        Statistics::of_kept(&values, |_| true, bins)
+    }
+
+    /// [`Statistics::of`] on the values `values[i]` with `keep(i)`, in that order, without a copy
+    /// of them: the sums run in input order as in [`Statistics::of`], and the order statistics
+    /// are selected exactly by [`select_rank`] (a few counting passes), so the results are the
+    /// same bits as sorting a copy would give.
+    pub fn of_kept(values: &[f64], keep: impl Fn(usize) -> bool, bins: usize) -> Statistics {
+        let kept = || {
+            values
+                .iter()
+                .enumerate()
+                .filter(|(i, _)| keep(*i))
+                .map(|(_, &v)| v)
+        };
+        let Some(first) = kept().next() else {
             return Statistics::default();
-        }
-        let mut sorted = values.to_vec();
-        sorted.sort_unstable_by(f64::total_cmp);
+        };
+        let n = kept().count();
         // Scale-safe: values whose squares (or sums) could overflow are divided by the largest
         // magnitude first and the results multiplied back; ordinary values are divided by 1
         // (bit-identical to the plain sums).
-        let largest = sorted[0].abs().max(sorted[n - 1].abs());
+        let (min, max) = kept().fold((first, first), |(lo, hi), v| {
+            (
+                if v.total_cmp(&lo).is_lt() { v } else { lo },
+                if v.total_cmp(&hi).is_gt() { v } else { hi },
+            )
+        });
+        let largest = min.abs().max(max.abs());
         let k = if largest.is_finite() && largest > 1e100 {
             largest
         } else {
             1.0
         };
         let (mut sum, mut sum_sq) = (0.0f64, 0.0f64);
-        for &v in values {
+        for v in kept() {
             let v = v / k;
             sum += v;
             sum_sq += v * v;
@@ -116,17 +142,16 @@ impl Statistics {
         let nf = n as f64;
         let mean_k = sum / nf;
         let mut dev = 0.0f64;
-        for &v in values {
+        for v in kept() {
             let v = v / k;
             dev += (v - mean_k) * (v - mean_k);
         }
         let mean = mean_k * k;
-        let min = sorted[0];
-        let max = sorted[n - 1];
-        let p50 = percentile_sorted(&sorted, 50.0);
+        let mut at = |r: usize| select_rank(kept, r);
+        let p50 = percentile_by(n, 50.0, &mut at);
         let (p1, p99) = (
-            percentile_sorted(&sorted, 1.0),
-            percentile_sorted(&sorted, 99.0),
+            percentile_by(n, 1.0, &mut at),
+            percentile_by(n, 99.0, &mut at),
         );
         let (lo, hi) = histogram_range(min, max, p1, p99);
         Statistics {
@@ -139,11 +164,89 @@ impl Statistics {
             rms: (sum_sq / nf).sqrt() * k,
             percentiles: Percentiles {
                 p50,
-                p90: percentile_sorted(&sorted, 90.0),
-                p95: percentile_sorted(&sorted, 95.0),
+                p90: percentile_by(n, 90.0, &mut at),
+                p95: percentile_by(n, 95.0, &mut at),
                 p99,
             },
-            histogram: histogram(&sorted, lo, hi, bins),
+            histogram: histogram_of(kept(), lo, hi, bins),
+        }
+    }
+}
+
+/// `v`'s position in the total order of `f64` as an unsigned integer (monotone).
+fn order_key(v: f64) -> u64 {
+    let b = v.to_bits();
+    if b >> 63 == 1 { !b } else { b | 1 << 63 }
+}
+
+/// Candidates collected and sorted at most, per rank: a bucket larger than this is split by
+/// the next 16 bits of the key in one more counting pass.
+const SELECT_LIMIT: u64 = 1 << 16;
+
+/// The value of rank `r` (0-based, in `total_cmp` order) among the values `values()` yields:
+/// counting passes over the top bits of [`order_key`], 16 bits a pass, narrow the rank to
+/// one bucket of at most [`SELECT_LIMIT`] values, which are sorted. Exact; memory is the
+/// 65 536 counters and the one bucket.
+pub(crate) fn select_rank<I: Iterator<Item = f64>>(values: impl Fn() -> I, r: usize) -> f64 {
+    let mut r = r as u64;
+    let mut prefix = 0u64;
+    let mut fixed = 0u32; // top bits of the key fixed so far
+    loop {
+        let matches = |key: u64| fixed == 0 || key >> (64 - fixed) == prefix >> (64 - fixed);
+        let shift = 64 - fixed - 16;
+        let mut counts = vec![0u64; 1 << 16];
+        for v in values() {
+            let key = order_key(v);
+            if matches(key) {
+                counts[((key >> shift) & 0xffff) as usize] += 1;
+            }
+        }
+        let mut bucket = counts.len() - 1;
+        for (b, &c) in counts.iter().enumerate() {
+            if r < c {
+                bucket = b;
+                break;
+            }
+            r -= c;
+        }
+        prefix |= (bucket as u64) << shift;
+        fixed += 16;
+        if counts[bucket] <= SELECT_LIMIT || fixed == 64 {
+            let mut candidates: Vec<f64> = values()
+                .filter(|&v| {
+                    let key = order_key(v);
+                    fixed == 64 || key >> (64 - fixed) == prefix >> (64 - fixed)
+                })
+                .collect();
+            candidates.sort_unstable_by(f64::total_cmp);
+            return candidates
+                .get(r as usize)
+                .or(candidates.last())
+                .copied()
+                .unwrap_or(f64::NAN);
+        }
+    }
+}
+
+/// Linear-interpolated percentile `q` in [0, 100] of `n` values, `at(r)` giving the value of
+/// rank `r` (numpy's default).
+fn percentile_by(n: usize, q: f64, at: &mut impl FnMut(usize) -> f64) -> f64 {
+    match n {
+        0 => 0.0,
+        1 => at(0),
+        n => {
+            let pos = (q / 100.0).clamp(0.0, 1.0) * (n - 1) as f64;
+            let lo = pos.floor() as usize;
+            let hi = (lo + 1).min(n - 1);
+            let frac = pos - lo as f64;
+            let (a, b) = (at(lo), at(hi));
+            let v = a + (b - a) * frac;
+            if v.is_finite() {
+                v
+            } else {
+                // The difference overflowed (values near ±f64::MAX): interpolate the halves.
+                2.0 * (a / 2.0 + (b / 2.0 - a / 2.0) * frac)
+            }
         }
     }
 }
@@ -171,7 +274,14 @@ fn histogram_range(min: f64, max: f64, p1: f64, p99: f64) -> (f64, f64) {
 
 /// Histogram of values into `bins` equal bins over `[lo, hi]`; values outside are counted in
 /// `underflow` / `overflow`.
+#[cfg(test)]
 pub(crate) fn histogram(values: &[f64], lo: f64, hi: f64, bins: usize) -> Histogram {
+    histogram_of(values.iter().copied(), lo, hi, bins)
+}
+
+/// Histogram of the values an iterator yields into `bins` equal bins over `[lo, hi]`; values
+/// outside are counted in `underflow` / `overflow`.
+fn histogram_of(values: impl Iterator<Item = f64>, lo: f64, hi: f64, bins: usize) -> Histogram {
     let bins = bins.max(1);
     let width = if hi > lo {
         let w = (hi - lo) / bins as f64;
@@ -200,7 +310,7 @@ pub(crate) fn histogram(values: &[f64], lo: f64, hi: f64, bins: usize) -> Histog
         .collect();
     let mut counts = vec![0u64; bins];
     let (mut underflow, mut overflow) = (0u64, 0u64);
-    for &v in values {
+    for v in values {
         if v < lo {
             underflow += 1;
         } else if v > hi {
@@ -250,6 +360,63 @@ mod tests {
         );
         let s = Statistics::of(&[1e200, 1e200], 4);
         assert!((s.rms / 1e200 - 1.0).abs() < 1e-15 && s.std == 0.0 && s.mean == 1e200);
+    }
+
+    /// The copy-free statistics equal those of a sorted copy bit for bit: clustered values
+    /// (one bucket holding more than [`SELECT_LIMIT`] values, so the selection refines), ties,
+    /// negatives and signed zeros, huge values, and a filter.
+    #[test]
+    fn kept_statistics_equal_the_sorted_copy() {
+        let n = 300_000u64;
+        let mut v: Vec<f64> = (0..n)
+            .map(|i| {
+                let h = i.wrapping_mul(0x9e37_79b9_7f4a_7c15) >> 11;
+                let u = h as f64 / (1u64 << 53) as f64;
+                match i % 10 {
+                    0 => 0.25,
+                    1 => -0.0,
+                    2 => 0.0,
+                    3 => -u,
+                    _ => 0.5 + u * 1e-9,
+                }
+            })
+            .collect();
+        v[17] = 1e300;
+        v[18] = -1.5e308;
+        for (keep_every, bins) in [(1u64, 50usize), (3, 7)] {
+            let keep = |i: usize| i as u64 % keep_every != 1;
+            let copy: Vec<f64> = (0..v.len()).filter(|&i| keep(i)).map(|i| v[i]).collect();
+            let mut sorted = copy.clone();
+            sorted.sort_unstable_by(f64::total_cmp);
+            for r in [0, 1, copy.len() / 2, copy.len() - 2, copy.len() - 1] {
+                let got = select_rank(|| copy.iter().copied(), r);
+                assert_eq!(got.to_bits(), sorted[r].to_bits(), "rank {r}");
+            }
+            let got = Statistics::of_kept(&v, keep, bins);
+            assert_eq!(
+                format!("{got:?}"),
+                format!("{:?}", Statistics::of_owned(copy, bins))
+            );
+            // Order statistics and histogram as a sorted copy gives them.
+            let bits = |x: f64| x.to_bits();
+            assert_eq!(bits(got.min), bits(sorted[0]));
+            assert_eq!(bits(got.max), bits(sorted[sorted.len() - 1]));
+            for (q, g) in [
+                (50.0, got.percentiles.p50),
+                (90.0, got.percentiles.p90),
+                (95.0, got.percentiles.p95),
+                (99.0, got.percentiles.p99),
+            ] {
+                assert_eq!(bits(g), bits(percentile_sorted(&sorted, q)), "p{q}");
+            }
+            let (lo, hi) = histogram_range(
+                sorted[0],
+                sorted[sorted.len() - 1],
+                percentile_sorted(&sorted, 1.0),
+                percentile_sorted(&sorted, 99.0),
+            );
+            assert_eq!(got.histogram, histogram(&sorted, lo, hi, bins));
+        }
     }
 
     #[test]

@@ -121,7 +121,7 @@ fn degenerate_ground_truth_and_empty_reconstruction() {
     assert_eq!(e, Some("geometry"));
     // A single point as ground truth has zero extent.
     let dot = GroundTruth::Cloud(PointCloud {
-        points: vec![[1.0, 2.0, 3.0]],
+        points: vec![[1.0, 2.0, 3.0]].into(),
         colors: None,
     });
     assert_eq!(
@@ -142,7 +142,7 @@ fn degenerate_ground_truth_and_empty_reconstruction() {
     };
     let r = evaluate(
         &gt,
-        &PointCloud::default(),
+        PointCloud::default().points,
         &AlignmentInput::none(),
         &options,
         &InputInfo::default(),
@@ -156,12 +156,12 @@ fn degenerate_ground_truth_and_empty_reconstruction() {
         ..EvalOptions::default()
     };
     let cloud = PointCloud {
-        points: vec![[0.1, 0.1, 0.0]],
+        points: vec![[0.1, 0.1, 0.0]].into(),
         colors: None,
     };
     let r = evaluate(
         &gt,
-        &cloud,
+        cloud.points.clone(),
         &AlignmentInput::none(),
         &bad,
         &InputInfo::default(),

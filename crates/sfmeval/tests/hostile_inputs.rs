@@ -332,7 +332,7 @@ fn evaluate_cloud(label: &str, gt: &PreparedGroundTruth, cloud: &PointCloud, ali
     let info = InputInfo::default();
     match evaluate(
         gt,
-        cloud,
+        cloud.points.clone(),
         &AlignmentInput::none(),
         &options(),
         &info,
@@ -345,7 +345,7 @@ fn evaluate_cloud(label: &str, gt: &PreparedGroundTruth, cloud: &PointCloud, ali
         return;
     }
     let input = AlignInput {
-        recon: &cloud.points,
+        recon: &cloud.points.as_f64(),
         ..AlignInput::default()
     };
     let opts = AlignOptions {
@@ -365,7 +365,14 @@ fn evaluate_cloud(label: &str, gt: &PreparedGroundTruth, cloud: &PointCloud, ali
                 report,
                 requested: sfmeval::align::AlignMode::Auto,
             };
-            match evaluate(gt, cloud, &alignment, &options(), &info, &NoProgress) {
+            match evaluate(
+                gt,
+                cloud.points.clone(),
+                &alignment,
+                &options(),
+                &info,
+                &NoProgress,
+            ) {
                 Ok(e) => check_report(&format!("{label} (aligned)"), &e.report),
                 Err(e) => check_err(label, &e),
             }
@@ -393,7 +400,7 @@ fn use_ground_truth(label: &str, gt: &GroundTruth) {
         label,
         &prepared,
         &PointCloud {
-            points,
+            points: points.into(),
             colors: None,
         },
         false,
@@ -1498,12 +1505,12 @@ fn small_files_body() -> usize {
             Ok(crop) => {
                 let options = EvalOptions { crop, ..options() };
                 let cloud = PointCloud {
-                    points: vec![[0.1, 0.2, 0.3], [2.0, 0.0, 0.0], [0.0, 0.0, 0.9]],
+                    points: vec![[0.1, 0.2, 0.3], [2.0, 0.0, 0.0], [0.0, 0.0, 0.9]].into(),
                     colors: None,
                 };
                 match evaluate(
                     &gt,
-                    &cloud,
+                    cloud.points.clone(),
                     &AlignmentInput::none(),
                     &options,
                     &InputInfo::default(),
@@ -1530,12 +1537,12 @@ fn small_files_body() -> usize {
             Ok(t) => {
                 let alignment = AlignmentInput::given(t);
                 let cloud = PointCloud {
-                    points: vec![[0.1, 0.2, 0.3], [2.0, 0.0, 0.0], [1e10, 0.0, 0.9]],
+                    points: vec![[0.1, 0.2, 0.3], [2.0, 0.0, 0.0], [1e10, 0.0, 0.9]].into(),
                     colors: None,
                 };
                 match evaluate(
                     &gt,
-                    &cloud,
+                    cloud.points.clone(),
                     &alignment,
                     &options(),
                     &InputInfo::default(),
@@ -1585,12 +1592,12 @@ fn small_files_body() -> usize {
                     assert_no_null("pairs", &serde_json::to_value(&stage).unwrap(), "/stage");
                     let alignment = AlignmentInput::given(t);
                     let cloud = PointCloud {
-                        points: p.iter().map(|p| p.recon).collect(),
+                        points: p.iter().map(|p| p.recon).collect::<Vec<_>>().into(),
                         colors: None,
                     };
                     match evaluate(
                         &gt,
-                        &cloud,
+                        cloud.points.clone(),
                         &alignment,
                         &options(),
                         &InputInfo::default(),

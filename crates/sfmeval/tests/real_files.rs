@@ -33,7 +33,7 @@ fn every_fixture_matches_its_writers_manifest() {
             want["triangles"].as_u64().unwrap(),
             "{name}: triangles"
         );
-        let b = Aabb::of(gt.ground_truth.points()).unwrap();
+        let b = Aabb::of(&gt.ground_truth.points()).unwrap();
         for k in 0..3 {
             let (lo, hi) = (
                 want["min"][k].as_f64().unwrap(),

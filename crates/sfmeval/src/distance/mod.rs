@@ -3,6 +3,7 @@
 mod bvh;
 mod cloud;
 mod mesh;
+pub(crate) mod slot_tree;
 
 pub use cloud::CloudIndex;
 pub use mesh::{MeshHit, MeshIndex};

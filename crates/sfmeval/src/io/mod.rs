@@ -186,7 +186,7 @@ pub fn read_ground_truth_with_limits(
             }
             if p.has_faces && !p.triangles.is_empty() {
                 let mesh = TriangleMesh {
-                    vertices: p.vertices,
+                    vertices: p.vertices.into_f64(),
                     triangles: p.triangles,
                 };
                 mesh.validate("PLY")?;
@@ -254,7 +254,7 @@ pub fn read_point_cloud_with_limits(
         Format::Obj => {
             warnings.push("the reconstruction is a mesh; only its vertices are evaluated".into());
             PointCloud {
-                points: obj::read_obj(bytes)?.vertices,
+                points: obj::read_obj(bytes)?.vertices.into(),
                 colors: None,
             }
         }
@@ -263,7 +263,8 @@ pub fn read_point_cloud_with_limits(
             PointCloud {
                 points: gltf::read_gltf_with_limits(bytes, &BTreeMap::new(), limits)?
                     .mesh
-                    .vertices,
+                    .vertices
+                    .into(),
                 colors: None,
             }
         }

@@ -19,7 +19,7 @@
 //! (any list types); polygons are fan-triangulated. Every other element and property is skipped.
 
 use crate::error::{Error, Result};
-use crate::geometry::Point3;
+use crate::geometry::Positions;
 
 const FMT: &str = "PLY";
 
@@ -40,8 +40,9 @@ pub enum PlyEncoding {
 pub struct PlyData {
     /// Body encoding.
     pub encoding: PlyEncoding,
-    /// Vertex positions.
-    pub vertices: Vec<Point3>,
+    /// Vertex positions: `f32` when the file is binary with `float` x, y and z (as stored),
+    /// `f64` otherwise (ascii keeps every digit written).
+    pub vertices: Positions,
     /// Vertex colours, when the vertex element has red/green/blue.
     pub colors: Option<Vec<[u8; 3]>>,
     /// Triangles (polygons fan-triangulated).
@@ -350,7 +351,7 @@ pub fn read_ply(bytes: &[u8]) -> Result<PlyData> {
     let layout = vertex_layout(&header.elements[vertex_idx])?;
     let mut out = PlyData {
         encoding: header.encoding,
-        vertices: Vec::new(),
+        vertices: Positions::default(),
         colors: None,
         triangles: Vec::new(),
         has_faces: header.elements.iter().any(|e| e.name == "face"),
@@ -369,7 +370,10 @@ pub fn read_ply(bytes: &[u8]) -> Result<PlyData> {
         }
         PlyEncoding::BinaryBigEndian => read_binary_body(&header, body, &layout, true, &mut out)?,
     }
-    crate::geometry::check_finite(FMT, "vertex", &out.vertices)?;
+    match &out.vertices {
+        Positions::F64(v) => crate::geometry::check_finite(FMT, "vertex", v)?,
+        Positions::F32(v) => crate::geometry::check_finite_f32(FMT, "vertex", v)?,
+    }
     let n = out.vertices.len() as u64;
     if let Some((i, bad)) = out
         .triangles
@@ -423,21 +427,31 @@ fn read_binary_body(
                 )
             })?;
             let offsets = prefix_offsets(element);
-            let mut vertices = Vec::with_capacity(count);
             let mut colors = layout.rgb.map(|_| Vec::with_capacity(count));
             let xyz = layout.xyz.map(|(i, ty)| (offsets[i], ty));
             let rgb = layout.rgb.map(|c| c.map(|(i, ty)| (offsets[i], ty)));
             let data = body
                 .get(pos..pos + stride * count)
                 .ok_or_else(|| Error::truncated(FMT, "vertex data ends early"))?;
-            for rec in data.chunks_exact(stride) {
-                vertices.push(xyz.map(|(o, ty)| ty.read(&rec[o..], big)));
-                if let (Some(colors), Some(rgb)) = (colors.as_mut(), rgb) {
+            if xyz.iter().all(|&(_, ty)| ty == Scalar::F32) {
+                let mut vertices = Vec::with_capacity(count);
+                for rec in data.chunks_exact(stride) {
+                    vertices.push(xyz.map(|(o, _)| read_f32(&rec[o..], big)));
+                }
+                out.vertices = Positions::F32(vertices);
+            } else {
+                let mut vertices = Vec::with_capacity(count);
+                for rec in data.chunks_exact(stride) {
+                    vertices.push(xyz.map(|(o, ty)| ty.read(&rec[o..], big)));
+                }
+                out.vertices = Positions::F64(vertices);
+            }
+            if let (Some(colors), Some(rgb)) = (colors.as_mut(), rgb) {
+                for rec in data.chunks_exact(stride) {
                     colors.push(rgb.map(|(o, ty)| to_u8(ty.read(&rec[o..], big), ty)));
                 }
             }
             pos += stride * count;
-            out.vertices = vertices;
             out.colors = colors;
         } else if let Some(stride) = element.fixed_stride() {
             let len = stride
@@ -505,6 +519,17 @@ fn read_binary_body(
         }
     }
     Ok(())
+}
+
+/// An `f32` from the first 4 bytes of `b` (callers check the length).
+#[inline]
+fn read_f32(b: &[u8], big: bool) -> f32 {
+    let a = [b[0], b[1], b[2], b[3]];
+    if big {
+        f32::from_be_bytes(a)
+    } else {
+        f32::from_le_bytes(a)
+    }
 }
 
 fn truncated_entry(element: &Element, entry: usize) -> Error {
@@ -602,8 +627,9 @@ fn read_ascii_body(
         let face_list = (element.name == "face")
             .then(|| face_list_index(element))
             .flatten();
+        let mut vertices: Vec<[f64; 3]> = Vec::new();
         if is_vertex {
-            out.vertices.reserve(count);
+            vertices.reserve(count);
             if layout.rgb.is_some() {
                 out.colors = Some(Vec::with_capacity(count));
             }
@@ -658,11 +684,14 @@ fn read_ascii_body(
                 }
             }
             if is_vertex {
-                out.vertices.push(layout.xyz.map(|(i, _)| values[i]));
+                vertices.push(layout.xyz.map(|(i, _)| values[i]));
                 if let (Some(colors), Some(rgb)) = (out.colors.as_mut(), layout.rgb) {
                     colors.push(rgb.map(|(i, ty)| to_u8(values[i], ty)));
                 }
             }
+        }
+        if is_vertex {
+            out.vertices = Positions::F64(vertices);
         }
     }
     Ok(())
@@ -725,9 +754,46 @@ mod tests {
     fn binary_both_endians_mixed_types() {
         for big in [false, true] {
             let ply = read_ply(&binary_cloud(big, 5)).unwrap();
-            assert_eq!(ply.vertices[3], [3.0, 6.0, -3.0]);
+            assert_eq!(ply.vertices.get(3), [3.0, 6.0, -3.0]);
             assert_eq!(ply.colors.as_ref().unwrap()[1], [255, 0, 128]);
             assert!(!ply.has_faces);
+        }
+    }
+
+    /// Binary `float` x y z stay `f32` (either endianness, colours read alongside); the same
+    /// points written as text with the digits of their exact `f64` value (text is read as
+    /// `f64`, every digit kept) are equal point for point.
+    #[test]
+    fn binary_float_positions_stay_f32() {
+        let pts: [[f32; 3]; 3] = [[0.1, -2.5, 3.0e-7], [1.0e30, 0.0, -0.0], [7.25, 8.5, 9.125]];
+        let mut text = String::from(
+            "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\nproperty uchar red\nproperty uchar green\nproperty uchar blue\nend_header\n",
+        );
+        for p in &pts {
+            let [x, y, z] = p.map(f64::from);
+            text.push_str(&format!("{x} {y} {z} 1 2 3\n"));
+        }
+        let ascii = read_ply(text.as_bytes()).unwrap();
+        assert!(matches!(ascii.vertices, Positions::F64(_)));
+        for (fmt, big) in [("binary_little_endian", false), ("binary_big_endian", true)] {
+            let mut b = format!(
+                "ply\nformat {fmt} 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\nproperty uchar red\nproperty uchar green\nproperty uchar blue\nend_header\n"
+            )
+            .into_bytes();
+            for p in &pts {
+                for v in p {
+                    b.extend(if big {
+                        v.to_be_bytes()
+                    } else {
+                        v.to_le_bytes()
+                    });
+                }
+                b.extend([1u8, 2, 3]);
+            }
+            let ply = read_ply(&b).unwrap();
+            assert_eq!(ply.vertices, Positions::F32(pts.to_vec()));
+            assert_eq!(ply.vertices, ascii.vertices);
+            assert_eq!(ply.colors, Some(vec![[1, 2, 3]; 3]));
         }
     }
 

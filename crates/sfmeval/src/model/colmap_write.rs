@@ -223,6 +223,6 @@ mod tests {
         }
         let ply = crate::export::points_ply(&[[1.0, 2.0, 3.0]], None);
         let cloud = crate::io::read_point_cloud("x.ply", &ply).unwrap();
-        assert_eq!(cloud.cloud.points, vec![[1.0, 2.0, 3.0]]);
+        assert_eq!(cloud.cloud.points, vec![[1.0, 2.0, 3.0]].into());
     }
 }

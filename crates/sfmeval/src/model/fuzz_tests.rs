@@ -222,7 +222,7 @@ fn strip_and_pose_metrics_never_panic_on_mutated_models() {
         let m = mutate(&mut rng, &src[0]);
         if let Ok(est) = nvm::read_nvm(&m) {
             let cloud = est.to_point_cloud();
-            let _ = strip::strip_camera_points(&cloud, Some(&est.camera_centers()), "x");
+            let _ = strip::strip_camera_points(cloud.clone(), Some(&est.camera_centers()), "x");
             let _ = crate::pose::evaluate_cameras(
                 &gt,
                 &est,

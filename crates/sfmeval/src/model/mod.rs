@@ -30,7 +30,7 @@ mod text;
 pub(crate) mod fuzz_tests;
 
 use crate::error::{Error, Result};
-use crate::geometry::{MAX_COORDINATE, Point3, PointCloud, show};
+use crate::geometry::{MAX_COORDINATE, Point3, PointCloud, Positions, show};
 
 /// Largest image width or height accepted, in pixels (a gigapixel panorama is 10⁵ wide); 0 means
 /// unknown (NVM and Bundler store no size) and is allowed.
@@ -523,7 +523,7 @@ impl Reconstruction {
     pub fn to_point_cloud(&self) -> PointCloud {
         let colors: Option<Vec<[u8; 3]>> = self.points.iter().map(|p| p.color).collect();
         PointCloud {
-            points: self.points.iter().map(|p| p.xyz).collect(),
+            points: Positions::F64(self.points.iter().map(|p| p.xyz).collect()),
             colors: if self.points.is_empty() { None } else { colors },
         }
     }

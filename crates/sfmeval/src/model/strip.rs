@@ -31,22 +31,14 @@ pub(crate) const MARKER_COLORS: [[u8; 3]; 3] = [[0, 255, 0], [0, 0, 255], [255, 
 /// be a written camera centre. Writers print 6–9 significant digits.
 pub(crate) const CENTER_TOLERANCE: f64 = 1e-5;
 
-fn keep(cloud: &PointCloud, remove: &[bool]) -> PointCloud {
-    let points = cloud
-        .points
-        .iter()
-        .zip(remove)
-        .filter(|(_, r)| !**r)
-        .map(|(p, _)| *p)
-        .collect();
-    let colors = cloud.colors.as_ref().map(|c| {
-        c.iter()
-            .zip(remove)
-            .filter(|(_, r)| !**r)
-            .map(|(c, _)| *c)
-            .collect()
-    });
-    PointCloud { points, colors }
+/// `cloud` without the points marked in `remove`, in place.
+fn keep(mut cloud: PointCloud, remove: &[bool]) -> PointCloud {
+    cloud.points.retain_indices(|i| !remove[i]);
+    if let Some(c) = cloud.colors.as_mut() {
+        let mut i = 0;
+        c.retain(|_| (!remove[i], i += 1).0);
+    }
+    cloud
 }
 
 /// Marks the points that lie within `tolerance` × (bounding-box diagonal of cloud and centres)
@@ -67,14 +59,23 @@ pub(crate) fn mark_camera_centers(
     if finite.is_empty() || cloud.points.is_empty() {
         return marks;
     }
-    let mut all: Vec<Point3> = finite.clone();
-    all.extend(
+    // The box of the centres and the finite points, without a copy of the cloud.
+    let mut b = Aabb {
+        min: finite[0],
+        max: finite[0],
+    };
+    for p in finite.iter().copied().chain(
         cloud
             .points
             .iter()
             .filter(|p| p.iter().all(|v| v.is_finite())),
-    );
-    let diag = Aabb::of(&all).map(|b| b.diagonal()).unwrap_or(0.0);
+    ) {
+        for (k, v) in p.into_iter().enumerate() {
+            b.min[k] = b.min[k].min(v);
+            b.max[k] = b.max[k].max(v);
+        }
+    }
+    let diag = b.diagonal();
     let tol = (tolerance * diag).max(f64::MIN_POSITIVE);
     let mut sorted = finite;
     sorted.sort_by(|a, b| a[0].total_cmp(&b[0]));
@@ -109,26 +110,18 @@ pub(crate) fn mark_camera_centers(
     marks
 }
 
-/// Removes the points that coincide with known camera centres (see [`mark_camera_centers`]).
-/// Returns the cloud and the number removed.
-pub(crate) fn remove_camera_centers(cloud: &PointCloud, centers: &[Point3]) -> (PointCloud, usize) {
-    let marks = mark_camera_centers(cloud, centers, CENTER_TOLERANCE);
-    let n = marks.iter().filter(|m| **m).count();
-    (keep(cloud, &marks), n)
-}
-
 /// Without known cameras: removes the leading and trailing runs of points whose colour is one
 /// of [`MARKER_COLORS`] (OpenMVG writes cameras first or last, Theia and openmvg-rs last), as
 /// long as at least one point remains. A cloud without colours is returned unchanged.
-pub(crate) fn remove_marker_runs(cloud: &PointCloud) -> (PointCloud, usize) {
+pub(crate) fn remove_marker_runs(cloud: PointCloud) -> (PointCloud, usize) {
     let Some(colors) = &cloud.colors else {
-        return (cloud.clone(), 0);
+        return (cloud, 0);
     };
     let is_marker = |c: &[u8; 3]| MARKER_COLORS.contains(c);
     let head = colors.iter().take_while(|c| is_marker(c)).count();
     let tail = colors.iter().rev().take_while(|c| is_marker(c)).count();
     if head + tail >= colors.len() {
-        return (cloud.clone(), 0);
+        return (cloud, 0);
     }
     let mut marks = vec![false; colors.len()];
     for m in marks.iter_mut().take(head) {
@@ -142,16 +135,19 @@ pub(crate) fn remove_marker_runs(cloud: &PointCloud) -> (PointCloud, usize) {
 
 /// Removes camera-centre points from a cloud: by position when `centers` are given and match at
 /// least one point, else by marker colour runs. `source` names the cloud in the warning.
+/// The cloud is filtered in place.
 pub(crate) fn strip_camera_points(
-    cloud: &PointCloud,
+    cloud: PointCloud,
     centers: Option<&[Point3]>,
     source: &str,
 ) -> Stripped {
     if let Some(centers) = centers.filter(|c| !c.is_empty()) {
-        let (c, n) = remove_camera_centers(cloud, centers);
+        // The points that coincide with known camera centres (see [`mark_camera_centers`]).
+        let marks = mark_camera_centers(&cloud, centers, CENTER_TOLERANCE);
+        let n = marks.iter().filter(|m| **m).count();
         if n > 0 {
             return Stripped {
-                cloud: c,
+                cloud: keep(cloud, &marks),
                 removed: n,
                 by_centers: true,
                 warning: Some(format!(
@@ -197,11 +193,11 @@ mod tests {
             Some(&fixture("openmvg_colmap/points3D.txt")),
         )
         .unwrap();
-        let s = strip_camera_points(&c, Some(&model.camera_centers()), "openmvg.ply");
+        let s = strip_camera_points(c.clone(), Some(&model.camera_centers()), "openmvg.ply");
         assert_eq!(s.removed, 6);
         assert_eq!(s.cloud.points.len(), model.points.len());
         assert!(s.warning.unwrap().contains("6 point"));
-        let s = strip_camera_points(&c, None, "openmvg.ply");
+        let s = strip_camera_points(c.clone(), None, "openmvg.ply");
         assert_eq!(s.removed, 6);
         assert!(!s.by_centers);
         assert!(
@@ -222,39 +218,43 @@ mod tests {
             Some(&fixture("theia_colmap/points3D.txt")),
         )
         .unwrap();
-        let s = strip_camera_points(&c, Some(&model.camera_centers()), "theia.ply");
+        let s = strip_camera_points(c.clone(), Some(&model.camera_centers()), "theia.ply");
         assert_eq!(s.removed, 6);
         assert!(s.by_centers);
-        let (_, n) = remove_marker_runs(&c);
+        let (_, n) = remove_marker_runs(c.clone());
         assert_eq!(n, 6);
     }
 
     #[test]
     fn nothing_to_remove_and_degenerate_inputs() {
         let c = PointCloud {
-            points: vec![[0.0, 0.0, 0.0], [1.0, 1.0, 1.0]],
+            points: vec![[0.0, 0.0, 0.0], [1.0, 1.0, 1.0]].into(),
             colors: Some(vec![[0, 255, 0], [0, 255, 0]]),
         };
         // All marker-coloured: keep everything rather than empty the cloud.
-        assert_eq!(remove_marker_runs(&c).1, 0);
+        assert_eq!(remove_marker_runs(c.clone()).1, 0);
         assert_eq!(
-            strip_camera_points(&c, Some(&[[5.0, 5.0, 5.0]]), "x").removed,
+            strip_camera_points(c.clone(), Some(&[[5.0, 5.0, 5.0]]), "x").removed,
             0
         );
         assert_eq!(
-            strip_camera_points(&c, Some(&[[f64::NAN, 0.0, 0.0]]), "x").removed,
+            strip_camera_points(c.clone(), Some(&[[f64::NAN, 0.0, 0.0]]), "x").removed,
             0
         );
         let empty = PointCloud::default();
         assert_eq!(
-            strip_camera_points(&empty, Some(&[[0.0; 3]]), "x").removed,
+            strip_camera_points(empty.clone(), Some(&[[0.0; 3]]), "x").removed,
             0
         );
         // Without colours, position still works.
         let nc = PointCloud {
-            points: vec![[0.0, 0.0, 0.0], [1.0, 1.0, 1.0]],
+            points: vec![[0.0, 0.0, 0.0], [1.0, 1.0, 1.0]].into(),
             colors: None,
         };
-        assert_eq!(remove_camera_centers(&nc, &[[1.0, 1.0, 1.0]]).1, 1);
+        let s = strip_camera_points(nc, Some(&[[1.0, 1.0, 1.0]]), "x");
+        assert_eq!(
+            (s.removed, s.cloud.points.iter().collect::<Vec<_>>()),
+            (1, vec![[0.0; 3]])
+        );
     }
 }

@@ -1,0 +1,340 @@
+//! A k-d tree that is the point storage itself: the caller reorders its points into the tree's
+//! order once ([`kd_order`]), and the tree keeps only one box a node ([`SlotTree`]), no copy of
+//! the points. Leaves are ranges of storage slots; the points are read through a closure, so
+//! they can stay in the file's `f32` and be mapped into another frame on the fly.
+//!
+//! Why not kiddo's k-d tree (used before for the reconstruction): it copies every point into
+//! its leaves (24 bytes a point in `f64` plus an index), the second copy of a dense cloud that
+//! the evaluation cannot afford at 10–100M points. The visiting order of the tree also serves
+//! as the cache-friendly order of the accuracy queries (it replaces a Morton sort).
+//!
+//! Exactness: the nearest squared distance is the minimum of `(a₀−q₀)² + (a₁−q₁)² + (a₂−q₂)²`
+//! in `f64` over the live points, the sum kiddo computes. The node boxes are rounded outwards to
+//! `f32`, so a box contains its points and its distance never exceeds theirs (rounding is
+//! monotone); pruning a node whose box distance is not below the best never drops a strictly
+//! nearer point.
+
+use crate::geometry::Point3;
+
+/// Most points in a leaf.
+pub(crate) const LEAF_SIZE: usize = 32;
+
+/// Levels below the root where the points are split in halves: the smallest `d` with
+/// `⌈n / 2^d⌉ ≤ LEAF_SIZE`.
+fn depth_for(n: usize) -> u32 {
+    let mut d = 0;
+    while n.div_ceil(1 << d) > LEAF_SIZE {
+        d += 1;
+    }
+    d
+}
+
+/// The storage order of a k-d tree over `n` points, `point(i)` giving point `i`: slot `k` of the
+/// reordered storage holds point `order[k]`. Each node's range is split at its middle along the
+/// longest axis of its points (median by that coordinate, ties by index), `depth_for(n)` times;
+/// deterministic and independent of the thread count. Non-finite points sort last on their axis.
+/// Holds 16 bytes a point while it runs.
+pub(crate) fn kd_order(n: usize, point: impl Fn(usize) -> Point3 + Sync) -> Vec<u32> {
+    // The keys only choose the splits (boxes are computed from the exact points afterwards),
+    // so `f32` keys are enough.
+    let mut keys: Vec<([f32; 3], u32)> =
+        crate::parallel::map_range(n, |i| (point(i).map(|v| v as f32), i as u32));
+    split(&mut keys, depth_for(n));
+    // Not `into_iter().collect()`: collecting in place would keep the keys' allocation,
+    // four times the size of the order.
+    keys.iter().map(|&(_, i)| i).collect()
+}
+
+fn split(keys: &mut [([f32; 3], u32)], levels: u32) {
+    if levels == 0 || keys.len() < 2 {
+        return;
+    }
+    let mut lo = [f32::INFINITY; 3];
+    let mut hi = [f32::NEG_INFINITY; 3];
+    for (p, _) in keys.iter() {
+        for k in 0..3 {
+            if p[k].is_finite() {
+                lo[k] = lo[k].min(p[k]);
+                hi[k] = hi[k].max(p[k]);
+            }
+        }
+    }
+    let axis = (0..3)
+        .max_by(|&a, &b| (hi[a] - lo[a]).total_cmp(&(hi[b] - lo[b])))
+        .unwrap_or(0);
+    let mid = keys.len() / 2;
+    keys.select_nth_unstable_by(mid, |a, b| {
+        a.0[axis].total_cmp(&b.0[axis]).then(a.1.cmp(&b.1))
+    });
+    let (left, right) = keys.split_at_mut(mid);
+    join(|| split(left, levels - 1), || split(right, levels - 1));
+}
+
+#[cfg(feature = "parallel")]
+fn join(a: impl FnOnce() + Send, b: impl FnOnce() + Send) {
+    rayon::join(a, b);
+}
+
+#[cfg(not(feature = "parallel"))]
+fn join(a: impl FnOnce(), b: impl FnOnce()) {
+    a();
+    b();
+}
+
+/// `f32` not above `v`.
+fn down(v: f64) -> f32 {
+    let f = v as f32;
+    if f64::from(f) > v { f.next_down() } else { f }
+}
+
+/// `f32` not below `v`.
+fn up(v: f64) -> f32 {
+    let f = v as f32;
+    if f64::from(f) < v { f.next_up() } else { f }
+}
+
+/// An axis-aligned box in `f32`, rounded outwards; empty (`min > max`) when no live point.
+#[derive(Debug, Clone, Copy)]
+struct NodeBox {
+    min: [f32; 3],
+    max: [f32; 3],
+}
+
+impl NodeBox {
+    const EMPTY: NodeBox = NodeBox {
+        min: [f32::INFINITY; 3],
+        max: [f32::NEG_INFINITY; 3],
+    };
+
+    fn is_empty(&self) -> bool {
+        self.min[0] > self.max[0]
+    }
+
+    fn union(a: NodeBox, b: NodeBox) -> NodeBox {
+        NodeBox {
+            min: [0, 1, 2].map(|k| a.min[k].min(b.min[k])),
+            max: [0, 1, 2].map(|k| a.max[k].max(b.max[k])),
+        }
+    }
+
+    /// Squared distance from `q` to the box (0 inside; +∞ for an empty box).
+    #[inline]
+    fn distance2(&self, q: &Point3) -> f64 {
+        if self.is_empty() {
+            return f64::INFINITY;
+        }
+        let mut d2 = 0.0;
+        for ((&min, &max), &qk) in self.min.iter().zip(&self.max).zip(q) {
+            let d = (f64::from(min) - qk).max(qk - f64::from(max)).max(0.0);
+            d2 += d * d;
+        }
+        d2
+    }
+}
+
+/// The boxes of a k-d tree over storage in [`kd_order`]: node `i` (heap layout, children
+/// `2i + 1` and `2i + 2`) covers a range of slots that halves at every level; the leaves are
+/// the nodes of the last level. Only live points (a predicate on the slot) count.
+pub(crate) struct SlotTree {
+    boxes: Vec<NodeBox>,
+    depth: u32,
+    n: usize,
+}
+
+impl SlotTree {
+    /// The boxes of the tree over `n` slots, `point(k)` giving the point in slot `k` and
+    /// `live(k)` whether it counts (non-finite points never do).
+    pub(crate) fn new(
+        n: usize,
+        point: impl Fn(usize) -> Point3 + Sync,
+        live: impl Fn(usize) -> bool + Sync,
+    ) -> SlotTree {
+        let depth = depth_for(n);
+        let leaves = 1usize << depth;
+        let first_leaf = leaves - 1;
+        let mut boxes = vec![NodeBox::EMPTY; 2 * leaves - 1];
+        let leaf_boxes = crate::parallel::map_range(leaves, |j| {
+            let (s, e) = leaf_range(n, depth, j);
+            let mut lo = [f64::INFINITY; 3];
+            let mut hi = [f64::NEG_INFINITY; 3];
+            for k in s..e {
+                let p = point(k);
+                if live(k) && p.iter().all(|v| v.is_finite()) {
+                    for a in 0..3 {
+                        lo[a] = lo[a].min(p[a]);
+                        hi[a] = hi[a].max(p[a]);
+                    }
+                }
+            }
+            if lo[0] > hi[0] {
+                NodeBox::EMPTY
+            } else {
+                NodeBox {
+                    min: lo.map(down),
+                    max: hi.map(up),
+                }
+            }
+        });
+        boxes[first_leaf..].copy_from_slice(&leaf_boxes);
+        for i in (0..first_leaf).rev() {
+            boxes[i] = NodeBox::union(boxes[2 * i + 1], boxes[2 * i + 2]);
+        }
+        SlotTree { boxes, depth, n }
+    }
+
+    /// The smallest squared distance from `q` to a live point, and its slot; `None` when no
+    /// point is live or `q` is not finite.
+    pub(crate) fn nearest(
+        &self,
+        q: Point3,
+        point: impl Fn(usize) -> Point3,
+        live: impl Fn(usize) -> bool,
+    ) -> Option<(f64, usize)> {
+        if !q.iter().all(|v| v.is_finite()) || self.boxes[0].is_empty() {
+            return None;
+        }
+        let mut best = (f64::INFINITY, usize::MAX);
+        // (node, first slot, end slot, level, box distance)
+        let mut stack: Vec<(usize, usize, usize, u32, f64)> = Vec::with_capacity(64);
+        stack.push((0, 0, self.n, 0, self.boxes[0].distance2(&q)));
+        while let Some((node, s, e, level, d)) = stack.pop() {
+            if d >= best.0 {
+                continue;
+            }
+            if level == self.depth {
+                for k in s..e {
+                    if !live(k) {
+                        continue;
+                    }
+                    let a = point(k);
+                    let d2 = (a[0] - q[0]) * (a[0] - q[0])
+                        + (a[1] - q[1]) * (a[1] - q[1])
+                        + (a[2] - q[2]) * (a[2] - q[2]);
+                    if d2 < best.0 {
+                        best = (d2, k);
+                    }
+                }
+                continue;
+            }
+            let m = s + (e - s) / 2;
+            let (l, r) = (2 * node + 1, 2 * node + 2);
+            let (dl, dr) = (self.boxes[l].distance2(&q), self.boxes[r].distance2(&q));
+            // Nearer child popped first.
+            if dl <= dr {
+                stack.push((r, m, e, level + 1, dr));
+                stack.push((l, s, m, level + 1, dl));
+            } else {
+                stack.push((l, s, m, level + 1, dl));
+                stack.push((r, m, e, level + 1, dr));
+            }
+        }
+        (best.1 != usize::MAX).then_some(best)
+    }
+}
+
+/// Slot range of leaf `j` of a tree of `depth` levels over `n` slots.
+fn leaf_range(n: usize, depth: u32, j: usize) -> (usize, usize) {
+    let (mut s, mut e) = (0, n);
+    for level in (0..depth).rev() {
+        let m = s + (e - s) / 2;
+        if (j >> level) & 1 == 0 {
+            e = m;
+        } else {
+            s = m;
+        }
+    }
+    (s, e)
+}
+
+// Test data only: platform maths is fine here (reports use libm, see clippy.toml).
+#[cfg(test)]
+#[allow(clippy::disallowed_methods, clippy::unwrap_used)]
+mod tests {
+    use super::*;
+    use crate::distance::CloudIndex;
+
+    fn cloud(n: usize, seed: u64) -> Vec<Point3> {
+        (0..n as u64)
+            .map(|i| {
+                let h = (i ^ seed).wrapping_mul(0x9e37_79b9_7f4a_7c15) ^ 0x5bd1_e995;
+                let h2 = h.wrapping_mul(0xbf58_476d_1ce4_e5b9);
+                let f = |x: u64, s: u32| ((x >> s) & 0xffff) as f64 / 65535.0 * 2.0 - 1.0;
+                // clumps: many duplicates in one corner
+                if i % 7 == 0 {
+                    [0.25, 0.25, f(h, 0).round()]
+                } else {
+                    [f(h, 0), f(h, 16) * 0.3, f(h2, 32) * 3.0]
+                }
+            })
+            .collect()
+    }
+
+    #[test]
+    fn order_is_a_permutation_and_leaves_cover_the_slots() {
+        for n in [0usize, 1, 2, 31, 32, 33, 64, 65, 1000, 4097] {
+            let pts = cloud(n, 1);
+            let order = kd_order(n, |i| pts[i]);
+            let mut sorted = order.clone();
+            sorted.sort_unstable();
+            assert_eq!(sorted, (0..n as u32).collect::<Vec<_>>());
+            let d = depth_for(n);
+            let mut next = 0;
+            for j in 0..1usize << d {
+                let (s, e) = leaf_range(n, d, j);
+                assert_eq!(s, next);
+                assert!(e - s <= LEAF_SIZE);
+                next = e;
+            }
+            assert_eq!(next, n);
+        }
+    }
+
+    /// Bit for bit the squared distance kiddo's tree finds (the index it replaces), with and
+    /// without dead points, for points stored in `f32` and mapped by a similarity on the fly.
+    #[test]
+    fn nearest_equals_kiddo_and_brute_force_bitwise() {
+        let n = 5000;
+        let raw: Vec<[f32; 3]> = cloud(n, 2).iter().map(|p| p.map(|v| v as f32)).collect();
+        let t = crate::transform::Similarity::from_matrix([
+            [0.0, -1.7, 0.0, 0.3],
+            [1.7, 0.0, 0.0, -2.0],
+            [0.0, 0.0, 1.7, 1.1],
+            [0.0, 0.0, 0.0, 1.0],
+        ])
+        .unwrap();
+        let in_gt = |p: [f32; 3]| t.apply(p.map(f64::from));
+        let order = kd_order(n, |i| in_gt(raw[i]));
+        let stored: Vec<[f32; 3]> = order.iter().map(|&i| raw[i as usize]).collect();
+        let point = |k: usize| in_gt(stored[k]);
+        let queries = cloud(700, 3);
+        for dead_every in [0usize, 3] {
+            let live =
+                |k: usize| dead_every == 0 || !(order[k] as usize).is_multiple_of(dead_every);
+            let tree = SlotTree::new(n, point, live);
+            let kept: Vec<Point3> = (0..n).filter(|&k| live(k)).map(point).collect();
+            let kiddo = CloudIndex::new(&kept).unwrap();
+            for q in queries.iter().map(|q| t.apply(*q)) {
+                let (d2, k) = tree.nearest(q, point, live).unwrap();
+                assert!(live(k));
+                let want = kiddo.nearest(q).0;
+                assert_eq!(d2.sqrt().to_bits(), want.to_bits(), "{q:?}");
+                let brute = kept
+                    .iter()
+                    .map(|a| {
+                        (a[0] - q[0]) * (a[0] - q[0])
+                            + (a[1] - q[1]) * (a[1] - q[1])
+                            + (a[2] - q[2]) * (a[2] - q[2])
+                    })
+                    .fold(f64::INFINITY, f64::min);
+                assert_eq!(d2.to_bits(), brute.to_bits());
+            }
+        }
+        let none = SlotTree::new(n, point, |_| false);
+        assert!(none.nearest([0.0; 3], point, |_| false).is_none());
+        let tree = SlotTree::new(n, point, |_| true);
+        assert!(
+            tree.nearest([f64::NAN, 0.0, 0.0], point, |_| true)
+                .is_none()
+        );
+    }
+}
