@@ -70,7 +70,13 @@ pub fn evaluate_run(
         },
         icp: IcpCriteria::TOOLBOX,
     };
-    let evaluation = tnt::evaluate(scene, &name, &recon.cloud.points, &request, &NoProgress)?;
+    let evaluation = tnt::evaluate(
+        scene,
+        &name,
+        &recon.cloud.points.as_f64(),
+        &request,
+        &NoProgress,
+    )?;
     let json = serde_json::to_string_pretty(&evaluation.report)? + "\n";
     write_atomic(&out.join(&rel), json.as_bytes())?;
     write_atomic(

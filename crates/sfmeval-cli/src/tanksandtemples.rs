@@ -104,7 +104,7 @@ pub fn tnt_cmd(args: &TntArgs) -> Result<()> {
     let evaluation = tnt::evaluate(
         &scene,
         &name_of(&args.recon),
-        &recon.cloud.points,
+        &recon.cloud.points.as_f64(),
         &request,
         &bars,
     )?;

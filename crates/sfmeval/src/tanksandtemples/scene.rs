@@ -73,7 +73,8 @@ impl Scene {
         let ground_truth = io::read_point_cloud(&ground_truth_path, &bytes)
             .map_err(|e| e.in_file("ground truth", &ground_truth_path))?
             .cloud
-            .points;
+            .points
+            .into_f64();
         drop(bytes);
 
         let crop_path = file(".json");
