@@ -104,7 +104,7 @@ impl Statistics {
 
     /// [`Statistics::of`] on the values `values[i]` with `keep(i)`, in that order, without a copy
     /// of them: the sums run in input order as in [`Statistics::of`], and the order statistics
-    /// are selected exactly by [`select_rank`] (a few counting passes), so the results are the
+    /// are selected exactly by `select_rank` (a few counting passes), so the results are the
     /// same bits as sorting a copy would give.
     pub fn of_kept(values: &[f64], keep: impl Fn(usize) -> bool, bins: usize) -> Statistics {
         let kept = || {
