@@ -120,21 +120,26 @@ pub fn report(args: &ReportArgs) -> Result<Vec<Row>> {
                 }
             }
             if args.verbose {
-                eprintln!(
-                    "{}/{}: {}{}",
-                    row.dataset,
-                    row.pipeline,
-                    row.status,
-                    row.mean
-                        .map(|m| format!(", mean {m:.6} m, {} points", row.points))
-                        .unwrap_or_default()
-                );
+                eprintln!("{}", progress_line(&row));
             }
             rows.push(row);
         }
     }
     write_tables(&args.out, &rows)?;
     Ok(rows)
+}
+
+/// `--verbose`'s line for a row: its status, then its mean distance and points, and its F-score
+/// at the first τ, when evaluated.
+fn progress_line(row: &Row) -> String {
+    let mut line = format!("{}/{}: {}", row.dataset, row.pipeline, row.status);
+    if let Some(m) = row.mean {
+        line += &format!(", mean {m:.6} m, {} points", row.points);
+    }
+    if let Some(t) = row.thresholds.first() {
+        line += &format!(", F {:.4} at τ {}", t.f_score, t.tau);
+    }
+    line
 }
 
 /// The rows of a Tanks and Temples scene's runs, evaluated with the benchmark's protocol (τ: the
@@ -181,16 +186,7 @@ fn report_tnt_dataset(
             }
         }
         if args.verbose {
-            eprintln!(
-                "{}/{}: {}{}",
-                row.dataset,
-                row.pipeline,
-                row.status,
-                row.thresholds
-                    .first()
-                    .map(|t| format!(", Tanks and Temples F {:.4} at τ {}", t.f_score, t.tau))
-                    .unwrap_or_default()
-            );
+            eprintln!("{}", progress_line(&row));
         }
         rows.push(row);
     }

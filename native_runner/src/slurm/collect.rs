@@ -16,7 +16,7 @@ use crate::args::{SweepArgs, Table1Args};
 use crate::dataset::Dataset;
 use crate::files::{copy_dir, partial_name, replace_dir};
 use crate::pipelines::{parse_customs, parse_list};
-use crate::report::{ReportArgs, report};
+use crate::report::report;
 use crate::run::{RUN_SCHEMA, RunRecord, Status, read_record};
 use crate::slurm::plan::{CellPlan, Job, Plan, Stage};
 use crate::slurm::state::{dataset_done, end_reason, task_done};
@@ -251,14 +251,11 @@ fn sweep_results(plan: &Plan, a: &SweepArgs, merged: &Merged, t0: Instant) -> Re
 fn table1_results(plan: &Plan, a: &Table1Args, merged: &Merged, t0: Instant) -> Result<()> {
     let table = plan.out.join("table");
     let t_rep = Instant::now();
-    let rows = report(&ReportArgs {
-        runs: vec![plan.out.join("runs")],
-        out: table.clone(),
-        datasets: Vec::new(),
-        eval: a.eval.eval_options()?,
-        align: a.eval.align_request()?,
-        verbose: false,
-    })?;
+    let rows = report(&crate::table1::report_args(
+        a,
+        &plan.out.join("runs"),
+        &table,
+    )?)?;
     let report_seconds = t_rep.elapsed().as_secs_f64();
     let (frame_seconds, per_view) = render_times(plan);
     let doc = json!({

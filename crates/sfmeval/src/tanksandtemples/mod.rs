@@ -25,11 +25,12 @@ mod voxel;
 pub use colors::hot_r;
 pub use icp::IcpCriteria;
 pub use protocol::{
-    MAPPING_ABOVE_FRAMES, PLOT_STRETCH, Registration, TntEvaluation, TntRequest,
-    UNIFORM_MAX_POINTS, evaluate,
+    PLOT_STRETCH, Registration, TntEvaluation, TntRequest, UNIFORM_MAX_POINTS, evaluate,
 };
 pub use report::*;
 pub use scene::{SCENE_TAU, Scene, scene_tau};
-pub use trajectory::{LogFrame, Mapping, log_from_model, read_log, read_mapping, write_log};
+pub use trajectory::{
+    LogFrame, MAPPING_ABOVE_FRAMES, Mapping, log_from_model, read_log, read_mapping, write_log,
+};
 pub use trajectory_alignment::{TrajectoryAlignment, TrajectoryAlignmentOptions};
 pub use voxel::voxel_down_sample;

@@ -17,7 +17,7 @@ use super::icp::{IcpCriteria, registration_icp};
 use super::matrix::{self, Matrix4};
 use super::report::*;
 use super::scene::{Scene, scene_tau};
-use super::trajectory::LogFrame;
+use super::trajectory::{LogFrame, MAPPING_ABOVE_FRAMES};
 use super::trajectory_alignment::{TrajectoryAlignmentOptions, align_trajectories};
 use super::voxel::voxel_down_sample;
 use crate::crop::{Axis, Volume};
@@ -27,9 +27,6 @@ use crate::geometry::Point3;
 use crate::parallel;
 use crate::progress::{Progress, Stage};
 use crate::report::Tool;
-
-/// Trajectories longer than this are a video's: the mapping file picks the reference frames.
-pub const MAPPING_ABOVE_FRAMES: usize = 1600;
 
 /// The toolbox's point budget of the last refinement (`MAX_POINT_NUMBER`).
 pub const UNIFORM_MAX_POINTS: u64 = 4_000_000;
@@ -216,14 +213,7 @@ pub fn evaluate(
                     distance,
                     request.icp,
                 ));
-                stage_results.push(StageResult {
-                    source_points: source.len(),
-                    target_points: target.len(),
-                    iterations: r.iterations,
-                    fitness: r.fitness,
-                    inlier_rmse: r.inlier_rmse,
-                    gt_from_recon: t,
-                });
+                stage_results.push(StageResult::of_icp(source.len(), target.len(), &r, t));
                 progress.advance(1);
             }
             let source = uniform_down_sample(nonempty(crop_moved(&t), "reconstructed")?);
@@ -238,14 +228,7 @@ pub fn evaluate(
                 2.0 * tau,
                 request.icp,
             ));
-            stage_results.push(StageResult {
-                source_points: source.len(),
-                target_points: target.len(),
-                iterations: r.iterations,
-                fitness: r.fitness,
-                inlier_rmse: r.inlier_rmse,
-                gt_from_recon: t,
-            });
+            stage_results.push(StageResult::of_icp(source.len(), target.len(), &r, t));
             progress.advance(1);
             if aligned.fitness < 0.5 {
                 warnings.push(format!(

@@ -4,7 +4,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use super::icp::IcpCriteria;
+use super::icp::{IcpCriteria, IcpResult};
 use super::matrix::Matrix4;
 use super::trajectory_alignment::{TrajectoryAlignment, TrajectoryAlignmentOptions};
 use crate::report::Tool;
@@ -99,7 +99,7 @@ impl From<&TrajectoryAlignmentOptions> for TrajectoryParams {
             ransac_n: o.ransac_n,
             max_iterations: o.max_iterations,
             seed: o.seed,
-            mapping_above_frames: super::protocol::MAPPING_ABOVE_FRAMES,
+            mapping_above_frames: super::trajectory::MAPPING_ABOVE_FRAMES,
         }
     }
 }
@@ -226,6 +226,26 @@ pub struct StageResult {
     pub inlier_rmse: f64,
     /// `gt_from_recon` after this stage.
     pub gt_from_recon: Matrix4,
+}
+
+impl StageResult {
+    /// The result of a refinement whose ICP ran on `source_points` against `target_points` and
+    /// left `gt_from_recon`.
+    pub(crate) fn of_icp(
+        source_points: usize,
+        target_points: usize,
+        icp: &IcpResult,
+        gt_from_recon: Matrix4,
+    ) -> StageResult {
+        StageResult {
+            source_points,
+            target_points,
+            iterations: icp.iterations,
+            fitness: icp.fitness,
+            inlier_rmse: icp.inlier_rmse,
+            gt_from_recon,
+        }
+    }
 }
 
 /// One direction's result.

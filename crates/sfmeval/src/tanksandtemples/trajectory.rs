@@ -13,6 +13,9 @@ use crate::model::Reconstruction;
 const LOG: &str = ".log trajectory";
 const MAPPING: &str = "mapping reference";
 
+/// Trajectories longer than this are a video's: the mapping file picks the reference frames.
+pub const MAPPING_ABOVE_FRAMES: usize = 1600;
+
 /// One frame of a `.log` trajectory.
 #[derive(Debug, Clone, PartialEq)]
 pub struct LogFrame {
