@@ -182,3 +182,42 @@ def test_errors_name_the_file(scene, sfmeval_bin, tmp_path):
     (bad / "Synth.json").write_text('{"class_name": "SelectionPolygonVolume", "orthogonal_axis": "Q"}')
     p = run("--scene", bad, "--recon", scene["recon"] / "dense.ply", "--trajectory", scene["log"], "--tau", 0.01)
     assert p.returncode == 1 and "Synth.json" in p.stderr, p.stderr
+
+
+MODELS = ROOT / "tests" / "fixtures" / "models"
+
+
+@pytest.mark.parametrize("model,reference", [
+    ("colmap_bin", "colmap_bin"), ("colmap_text", "colmap_bin"), ("colmap38.nvm", "colmap_bin"),
+    ("colmap38.bundle.out", "colmap_bin"), ("theia.nvm", "theia_colmap"),
+    ("openmvg_sfm_data.json", "openmvg_colmap")])
+def test_log_from_every_model_format(sfmeval_bin, tmp_path, model, reference):
+    """`sfmeval log` on models written by COLMAP 3.8, pycolmap, pytheia (and OpenMVG's layout):
+    each frame's centre is pycolmap's for the same model, a frame per listed image."""
+    import pycolmap
+
+    sys.path.insert(0, str(tnt_scene.TOOLBOX))
+    import trajectory_io
+
+    names = sorted(im["name"] for im in json.loads((MODELS / "gt_cameras.json").read_text())["images"])
+    listed = tmp_path / "images.txt"
+    listed.write_text("".join(n + "\n" for n in names))
+    log = tmp_path / "m.log"
+    p = subprocess.run([sfmeval_bin, "log", "--model", str(MODELS / model), "--images", str(listed),
+                        "--out", str(log)], capture_output=True, text=True)
+    assert p.returncode == 0, p.stderr
+    frames = trajectory_io.read_trajectory(str(log))
+    assert len(frames) == len(names)
+    ref = pycolmap.Reconstruction(str(MODELS / reference))
+    centres = {im.name: im.projection_center() for im in ref.images.values()}
+    registered = 0
+    for k, (f, n) in enumerate(zip(frames, names)):
+        meta = list(f.metadata)
+        if meta[1] == -1:
+            assert np.array_equal(f.pose, np.eye(4)), n
+            continue
+        registered += 1
+        assert meta == [k, k, 0]
+        c = centres[n]
+        assert np.linalg.norm(f.pose[:3, 3] - c) <= 1e-5 * max(1.0, np.linalg.norm(c)), (model, n)
+    assert registered >= len(centres) - 1 and registered >= 5, (model, registered)
