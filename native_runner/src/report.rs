@@ -95,35 +95,20 @@ pub fn report(args: &ReportArgs) -> Result<Vec<Row>> {
         } else {
             None
         };
-        for (rec, dir) in &records {
-            let mut row = base_row(&rec.facts());
-            if rec.status == Status::Ok {
-                match &mut gt {
-                    None => {
-                        row.status = "evaluation failed".into();
-                        row.reason = Some(format!(
-                            "no ground truth at {} (pass --datasets)",
-                            ds_dir.display()
-                        ));
-                    }
-                    Some(g) => match evaluate_run(g, dir, rec, args) {
-                        Ok((report, kept)) => {
-                            let rel = report_path(&rec.dataset, &rec.pipeline);
-                            write_atomic(&args.out.join(&rel), report.to_json().as_bytes())?;
-                            row = evaluated_row(&rec.facts(), &report, &kept);
-                        }
-                        Err(e) => {
-                            row.status = "evaluation failed".into();
-                            row.reason = Some(format!("{e:#}"));
-                        }
-                    },
+        rows.extend(dataset_rows(&records, args, |rec, dir| match &mut gt {
+            None => Ok(Err(anyhow::anyhow!(
+                "no ground truth at {} (pass --datasets)",
+                ds_dir.display()
+            ))),
+            Some(g) => match evaluate_run(g, dir, rec, args) {
+                Ok((report, kept)) => {
+                    let rel = report_path(&rec.dataset, &rec.pipeline);
+                    write_atomic(&args.out.join(&rel), report.to_json().as_bytes())?;
+                    Ok(Ok(evaluated_row(&rec.facts(), &report, &kept)))
                 }
-            }
-            if args.verbose {
-                eprintln!("{}", progress_line(&row));
-            }
-            rows.push(row);
-        }
+                Err(e) => Ok(Err(e)),
+            },
+        })?);
     }
     write_tables(&args.out, &rows)?;
     Ok(rows)
@@ -151,34 +136,45 @@ fn report_tnt_dataset(
     args: &ReportArgs,
 ) -> Result<Vec<Row>> {
     let any_ok = records.iter().any(|(r, _)| r.status == Status::Ok);
+    // Read only when some run needs it; unused otherwise.
     let scene = if any_ok {
-        match crate::tnt::read_scene(ds_dir, ds) {
-            Ok(s) => Ok(s),
-            Err(e) => Err(format!("{e:#}")),
-        }
+        crate::tnt::read_scene(ds_dir, ds).map_err(|e| format!("{e:#}"))
     } else {
         Err(String::new())
     };
+    dataset_rows(records, args, |rec, dir| {
+        Ok(match &scene {
+            Ok((scene, diagonal)) => crate::tnt::evaluate_run(
+                scene,
+                *diagonal,
+                dir,
+                rec,
+                &args.out,
+                sfmeval::tanksandtemples::scene_tau(ds).or(args.eval.tau.first().copied()),
+            ),
+            Err(e) => Err(anyhow::anyhow!(
+                "Tanks and Temples scene {}: {e}",
+                ds_dir.display()
+            )),
+        })
+    })
+}
+
+/// A dataset's rows: each run's row from its run.json, replaced by `evaluate`'s for runs that
+/// ended ok. `evaluate` returns `Err` for what stops the report (an output that cannot be
+/// written) and `Ok(Err)` for a run that cannot be evaluated, whose row then says
+/// "evaluation failed" and why.
+fn dataset_rows(
+    records: &[(RunRecord, &PathBuf)],
+    args: &ReportArgs,
+    mut evaluate: impl FnMut(&RunRecord, &Path) -> Result<Result<Row>>,
+) -> Result<Vec<Row>> {
     let mut rows = Vec::new();
     for (rec, dir) in records {
         let mut row = base_row(&rec.facts());
         if rec.status == Status::Ok {
-            let result = match &scene {
-                Ok((scene, diagonal)) => crate::tnt::evaluate_run(
-                    scene,
-                    *diagonal,
-                    dir,
-                    rec,
-                    &args.out,
-                    sfmeval::tanksandtemples::scene_tau(ds).or(args.eval.tau.first().copied()),
-                ),
-                Err(e) => Err(anyhow::anyhow!(
-                    "Tanks and Temples scene {}: {e}",
-                    ds_dir.display()
-                )),
-            };
-            match result {
-                Ok(r) => row = r,
+            match evaluate(rec, dir)? {
+                Ok(evaluated) => row = evaluated,
                 Err(e) => {
                     row.status = "evaluation failed".into();
                     row.reason = Some(format!("{e:#}"));
