@@ -12,6 +12,7 @@ use parry3d_f64::math::Vector;
 use parry3d_f64::query::PointQueryWithLocation as _;
 use parry3d_f64::shape::Triangle;
 
+use super::{down, up};
 use crate::geometry::{Point3, TriangleMesh};
 
 /// Most triangles in a leaf.
@@ -63,18 +64,6 @@ pub(crate) struct TriangleBvh {
     vertices: Vec<Point3>,
     tris: Vec<[u32; 3]>,
     ids: Vec<u32>,
-}
-
-/// `f32` not above `v` (rounds towards −∞).
-fn down(v: f64) -> f32 {
-    let f = v as f32;
-    if f64::from(f) > v { f.next_down() } else { f }
-}
-
-/// `f32` not below `v` (rounds towards +∞).
-fn up(v: f64) -> f32 {
-    let f = v as f32;
-    if f64::from(f) < v { f.next_up() } else { f }
 }
 
 impl TriangleBvh {

@@ -7,3 +7,16 @@ pub(crate) mod slot_tree;
 
 pub use cloud::CloudIndex;
 pub use mesh::{MeshHit, MeshIndex};
+
+/// `f32` not above `v` (rounds towards −∞): the lower corner of a box that must contain `v`
+/// (the BVH's and the slot tree's `f32` boxes).
+fn down(v: f64) -> f32 {
+    let f = v as f32;
+    if f64::from(f) > v { f.next_down() } else { f }
+}
+
+/// `f32` not below `v` (rounds towards +∞): the upper corner of such a box.
+fn up(v: f64) -> f32 {
+    let f = v as f32;
+    if f64::from(f) < v { f.next_up() } else { f }
+}

@@ -14,6 +14,7 @@
 //! monotone); pruning a node whose box distance is not below the best never drops a strictly
 //! nearer point.
 
+use super::{down, up};
 use crate::geometry::Point3;
 
 /// Most points in a leaf.
@@ -79,18 +80,6 @@ fn join(a: impl FnOnce() + Send, b: impl FnOnce() + Send) {
 fn join(a: impl FnOnce(), b: impl FnOnce()) {
     a();
     b();
-}
-
-/// `f32` not above `v`.
-fn down(v: f64) -> f32 {
-    let f = v as f32;
-    if f64::from(f) > v { f.next_down() } else { f }
-}
-
-/// `f32` not below `v`.
-fn up(v: f64) -> f32 {
-    let f = v as f32;
-    if f64::from(f) < v { f.next_up() } else { f }
 }
 
 /// An axis-aligned box in `f32`, rounded outwards; empty (`min > max`) when no live point.
