@@ -345,13 +345,15 @@ mod tests {
     fn each_dataset_is_chained_alone_and_resume_submits_what_is_missing() {
         let out = std::env::temp_dir().join(format!("sfmeval-slurm-plan-{}", std::process::id()));
         let p = plan(&out);
-        let subs = submissions(&p);
-        let shape: Vec<(String, Vec<usize>, Dependency)> = subs
-            .iter()
-            .map(|s| (s.label.clone(), s.tasks.clone(), s.dependency.clone()))
-            .collect();
+        // Each submission as (label, tasks, dependency).
+        let shape = |p: &Plan| -> Vec<(String, Vec<usize>, Dependency)> {
+            submissions(p)
+                .iter()
+                .map(|s| (s.label.clone(), s.tasks.clone(), s.dependency.clone()))
+                .collect()
+        };
         assert_eq!(
-            shape,
+            shape(&p),
             vec![
                 ("render_0".into(), vec![0, 1], Dependency::None),
                 ("finalize_0".into(), vec![0], Dependency::AfterOk(0)),
@@ -375,12 +377,8 @@ mod tests {
         let run = p.task_runs(1).join("a").join("q");
         std::fs::create_dir_all(&run).unwrap();
         std::fs::write(run.join("run.json"), "{}").unwrap();
-        let shape: Vec<(String, Vec<usize>, Dependency)> = submissions(&p)
-            .iter()
-            .map(|s| (s.label.clone(), s.tasks.clone(), s.dependency.clone()))
-            .collect();
         assert_eq!(
-            shape,
+            shape(&p),
             vec![
                 ("run_0".into(), vec![2, 3], Dependency::None),
                 ("render_1".into(), vec![2], Dependency::None),
