@@ -33,14 +33,13 @@ pub fn arange(stop: f64, step: f64) -> Vec<f64> {
     (0..len as usize).map(|i| i as f64 * step).collect()
 }
 
-/// The cumulative histogram: entry `k` is the share of `distances` below `edges[k + 1]`
-/// (at most it for the last one), as `cumsum(numpy.histogram(d, edges)[0]) / len(d)`.
-pub fn cumulative(distances: &[f64], edges: &[f64]) -> Vec<f64> {
-    if edges.len() < 2 || distances.is_empty() {
+/// The cumulative histogram of `sorted` (ascending): entry `k` is the share of the distances
+/// below `edges[k + 1]` (at most it for the last one), as
+/// `cumsum(numpy.histogram(d, edges)[0]) / len(d)`.
+pub fn cumulative(sorted: &[f64], edges: &[f64]) -> Vec<f64> {
+    if edges.len() < 2 || sorted.is_empty() {
         return Vec::new();
     }
-    let mut sorted: Vec<f64> = distances.to_vec();
-    sorted.sort_by(f64::total_cmp);
     let n = sorted.len() as f64;
     let first = sorted.partition_point(|d| *d < edges[0]);
     let last = edges.len() - 1;
@@ -59,8 +58,8 @@ pub fn cumulative(distances: &[f64], edges: &[f64]) -> Vec<f64> {
 }
 
 /// Scores at `tau` with the toolbox's plot stretch (5): distances of the reconstruction to the
-/// ground truth (`precision_distances`) and back (`recall_distances`). Empty inputs give zeros
-/// and one-entry curves, as the toolbox returns.
+/// ground truth (`precision_distances`) and back (`recall_distances`), each sorted ascending.
+/// Empty inputs give zeros and one-entry curves, as the toolbox returns.
 pub fn scores(
     precision_distances: &[f64],
     recall_distances: &[f64],
@@ -77,7 +76,7 @@ pub fn scores(
             recall_curve: vec![0.0],
         };
     }
-    let share = |d: &[f64]| d.iter().filter(|d| **d < tau).count() as f64 / d.len() as f64;
+    let share = |d: &[f64]| d.partition_point(|d| *d < tau) as f64 / d.len() as f64;
     let precision = share(precision_distances);
     let recall = share(recall_distances);
     let f_score = if precision + recall > 0.0 {

@@ -277,7 +277,15 @@ pub fn evaluate(
         progress.finish();
         d
     };
-    let scores = curves::scores(&precision_distances, &recall_distances, tau, PLOT_STRETCH);
+    // Each side's distances sorted once, for the scores, the curves and the median.
+    let sorted = |d: &[f64]| {
+        let mut s = d.to_vec();
+        s.sort_by(f64::total_cmp);
+        s
+    };
+    let (precision_sorted, recall_sorted) =
+        (sorted(&precision_distances), sorted(&recall_distances));
+    let scores = curves::scores(&precision_sorted, &recall_sorted, tau, PLOT_STRETCH);
 
     let (axis, axis_min, axis_max, polygon_vertices) = match volume {
         Volume::PolygonPrism {
@@ -355,8 +363,13 @@ pub fn evaluate(
             refinement: stage_results,
             gt_from_recon,
         },
-        precision: side(precision, recon_cropped_count, &precision_distances),
-        recall: side(recall, gt_cropped.len(), &recall_distances),
+        precision: side(
+            precision,
+            recon_cropped_count,
+            &precision_distances,
+            &precision_sorted,
+        ),
+        recall: side(recall, gt_cropped.len(), &recall_distances, &recall_sorted),
         f_score,
         curves: CurvesSection {
             edges,
@@ -420,24 +433,24 @@ fn uniform_down_sample(points: Vec<Point3>) -> Vec<Point3> {
     points.into_iter().step_by(k).collect()
 }
 
-fn side(value: f64, cropped_points: usize, distances: &[f64]) -> SideSection {
-    let (mean, median) = if distances.is_empty() {
+/// One side's section: the mean sums `distances` in their order; the median is taken of the
+/// same values `sorted`.
+fn side(value: f64, cropped_points: usize, distances: &[f64], sorted: &[f64]) -> SideSection {
+    let n = sorted.len();
+    let (mean, median) = if n == 0 {
         (0.0, 0.0)
+    } else if n % 2 == 1 {
+        (distances.iter().sum::<f64>() / n as f64, sorted[n / 2])
     } else {
-        let mut sorted = distances.to_vec();
-        sorted.sort_by(f64::total_cmp);
-        let n = sorted.len();
-        let median = if n % 2 == 1 {
-            sorted[n / 2]
-        } else {
-            0.5 * (sorted[n / 2 - 1] + sorted[n / 2])
-        };
-        (distances.iter().sum::<f64>() / n as f64, median)
+        (
+            distances.iter().sum::<f64>() / n as f64,
+            0.5 * (sorted[n / 2 - 1] + sorted[n / 2]),
+        )
     };
     SideSection {
         value,
         cropped_points,
-        points: distances.len(),
+        points: n,
         mean_distance: mean,
         median_distance: median,
     }
