@@ -5,9 +5,11 @@
 //! the real filesystem, and [`write_atomic`] is the one way outputs reach the disk.
 
 mod disk;
+mod stream;
 mod write;
 
 pub use disk::{
     Disk, IMAGE_EXTENSIONS, image_names, name_of, path_str, read, read_dataset, read_input_files,
 };
+pub use stream::read_ply_cloud;
 pub use write::write_atomic;

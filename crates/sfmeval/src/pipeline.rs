@@ -100,18 +100,27 @@ pub fn read_reconstruction(name: &str, files: &BTreeMap<String, Vec<u8>>) -> Res
         });
     }
     let (file_name, bytes) = point_cloud_file(name, files)?;
-    let loaded = io::read_point_cloud(file_name, bytes)?;
+    Ok(reconstruction_from_cloud(
+        name,
+        io::read_point_cloud(file_name, bytes)?,
+    ))
+}
+
+/// The reconstruction `name` from a point cloud already read (a dense PLY read in pieces by
+/// the front end, [`io::point_cloud_from_ply`]), as [`read_reconstruction`] makes it from the
+/// cloud's file.
+pub fn reconstruction_from_cloud(name: &str, loaded: io::LoadedCloud) -> ReconInput {
     let mut warnings = loaded.warnings;
     let stripped = model::strip::strip_camera_points(loaded.cloud, None, name);
     warnings.extend(stripped.warning);
-    Ok(ReconInput {
+    ReconInput {
         cloud: stripped.cloud,
         model: None,
         name: name.to_string(),
         format: loaded.format.name().to_string(),
         warnings,
         cloud_is_model_points: false,
-    })
+    }
 }
 
 /// The first of `files` that is (part of) an SfM model.

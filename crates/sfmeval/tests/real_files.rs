@@ -63,3 +63,31 @@ fn colmap_ply_colours_and_clouds_are_clouds() {
             .all(|c| *c == [200, 100, 50])
     );
 }
+
+/// Every PLY another program wrote: streamed in pieces, the same as read whole (clouds), or
+/// left to the whole-file reader (meshes, ascii). Open3D's and COLMAP's binary clouds stream.
+#[test]
+fn streamed_ply_equals_the_whole_file_read() {
+    use sfmeval::io::ply_stream::{HEAD_BYTES, PlyCloudStream};
+    let mut streamed = Vec::new();
+    for entry in std::fs::read_dir(fixtures()).unwrap() {
+        let path = entry.unwrap().path();
+        if path.extension().and_then(|e| e.to_str()) != Some("ply") {
+            continue;
+        }
+        let name = path.file_name().unwrap().to_string_lossy().to_string();
+        let bytes = std::fs::read(&path).unwrap();
+        let head = &bytes[..bytes.len().min(HEAD_BYTES)];
+        let Some(mut s) = PlyCloudStream::new(head, bytes.len() as u64).unwrap() else {
+            continue;
+        };
+        for piece in bytes[s.body_start()..].chunks(1000) {
+            s.push(piece);
+        }
+        let got = s.finish().unwrap_or_else(|e| panic!("{name}: {e}"));
+        assert_eq!(got, io::ply::read_ply(&bytes).unwrap(), "{name}");
+        streamed.push(name);
+    }
+    streamed.sort();
+    assert_eq!(streamed, ["colmap_points.ply", "open3d_cloud_binary.ply"]);
+}

@@ -4,6 +4,7 @@ pub mod gltf;
 pub mod npy;
 pub mod obj;
 pub mod ply;
+pub mod ply_stream;
 
 use std::collections::BTreeMap;
 
@@ -238,19 +239,7 @@ pub fn read_point_cloud_with_limits(
     let format = detect(name, bytes)?;
     let mut warnings = Vec::new();
     let cloud = match format {
-        Format::Ply => {
-            let p = ply::read_ply(bytes)?;
-            if !p.triangles.is_empty() {
-                warnings.push(format!(
-                    "the reconstruction PLY has {} triangles; only its vertices are evaluated",
-                    p.triangles.len()
-                ));
-            }
-            PointCloud {
-                points: p.vertices,
-                colors: p.colors,
-            }
-        }
+        Format::Ply => return point_cloud_from_ply(name, ply::read_ply(bytes)?),
         Format::Obj => {
             warnings.push("the reconstruction is a mesh; only its vertices are evaluated".into());
             PointCloud {
@@ -269,6 +258,32 @@ pub fn read_point_cloud_with_limits(
             }
         }
     };
+    loaded(name, cloud, format, warnings)
+}
+
+/// The reconstructed point cloud of a PLY file `name` already read ([`ply::read_ply`], or
+/// in pieces by [`ply_stream::PlyCloudStream`]), as [`read_point_cloud`] gives it.
+pub fn point_cloud_from_ply(name: &str, p: ply::PlyData) -> Result<LoadedCloud> {
+    let mut warnings = Vec::new();
+    if !p.triangles.is_empty() {
+        warnings.push(format!(
+            "the reconstruction PLY has {} triangles; only its vertices are evaluated",
+            p.triangles.len()
+        ));
+    }
+    let cloud = PointCloud {
+        points: p.vertices,
+        colors: p.colors,
+    };
+    loaded(name, cloud, Format::Ply, warnings)
+}
+
+fn loaded(
+    name: &str,
+    cloud: PointCloud,
+    format: Format,
+    warnings: Vec<String>,
+) -> Result<LoadedCloud> {
     if cloud.points.is_empty() {
         return Err(Error::Empty {
             what: format!("reconstruction '{name}' (no points)"),

@@ -21,7 +21,7 @@
 use crate::error::{Error, Result};
 use crate::geometry::Positions;
 
-const FMT: &str = "PLY";
+pub(super) const FMT: &str = "PLY";
 
 /// Body encoding of a PLY file.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
@@ -58,7 +58,7 @@ pub struct PlyData {
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-enum Scalar {
+pub(super) enum Scalar {
     I8,
     U8,
     I16,
@@ -138,7 +138,7 @@ impl Scalar {
 }
 
 #[derive(Debug, Clone)]
-enum Property {
+pub(super) enum Property {
     Scalar {
         name: String,
         ty: Scalar,
@@ -159,15 +159,15 @@ impl Property {
 }
 
 #[derive(Debug, Clone)]
-struct Element {
-    name: String,
-    count: u64,
-    properties: Vec<Property>,
+pub(super) struct Element {
+    pub(super) name: String,
+    pub(super) count: u64,
+    pub(super) properties: Vec<Property>,
 }
 
 impl Element {
     /// Byte size of one entry when it has no list property.
-    fn fixed_stride(&self) -> Option<usize> {
+    pub(super) fn fixed_stride(&self) -> Option<usize> {
         self.properties.iter().try_fold(0usize, |acc, p| match p {
             Property::Scalar { ty, .. } => Some(acc + ty.size()),
             Property::List { .. } => None,
@@ -197,14 +197,14 @@ impl Element {
     }
 }
 
-struct Header {
-    encoding: PlyEncoding,
-    elements: Vec<Element>,
-    comments: Vec<String>,
-    body_start: usize,
+pub(super) struct Header {
+    pub(super) encoding: PlyEncoding,
+    pub(super) elements: Vec<Element>,
+    pub(super) comments: Vec<String>,
+    pub(super) body_start: usize,
 }
 
-fn parse_header(bytes: &[u8]) -> Result<Header> {
+pub(super) fn parse_header(bytes: &[u8]) -> Result<Header> {
     if !bytes.starts_with(b"ply") {
         return Err(Error::malformed(
             FMT,
@@ -306,12 +306,12 @@ fn find(hay: &[u8], needle: &[u8]) -> Option<usize> {
 }
 
 /// Where the vertex element's interesting properties are.
-struct VertexLayout {
+pub(super) struct VertexLayout {
     xyz: [(usize, Scalar); 3],
     rgb: Option<[(usize, Scalar); 3]>,
 }
 
-fn vertex_layout(e: &Element) -> Result<VertexLayout> {
+pub(super) fn vertex_layout(e: &Element) -> Result<VertexLayout> {
     let get = |n: &str| {
         e.scalar(&[n]).ok_or_else(|| {
             Error::malformed(FMT, format!("vertex element has no scalar property '{n}'"))
@@ -343,13 +343,26 @@ fn face_list_index(e: &Element) -> Option<usize> {
 pub fn read_ply(bytes: &[u8]) -> Result<PlyData> {
     let header = parse_header(bytes)?;
     let body = &bytes[header.body_start.min(bytes.len())..];
+    let (mut out, layout) = empty_data(&header)?;
+    match header.encoding {
+        PlyEncoding::Ascii => read_ascii_body(&header, body, &layout, &mut out)?,
+        PlyEncoding::BinaryLittleEndian => {
+            read_binary_body(&header, body, &layout, false, &mut out)?
+        }
+        PlyEncoding::BinaryBigEndian => read_binary_body(&header, body, &layout, true, &mut out)?,
+    }
+    check_data(out)
+}
+
+/// What `header` declares, with no vertex or face read yet, and where its vertex properties are.
+pub(super) fn empty_data(header: &Header) -> Result<(PlyData, VertexLayout)> {
     let vertex_idx = header
         .elements
         .iter()
         .position(|e| e.name == "vertex")
         .ok_or_else(|| Error::malformed(FMT, "no 'vertex' element"))?;
     let layout = vertex_layout(&header.elements[vertex_idx])?;
-    let mut out = PlyData {
+    let out = PlyData {
         encoding: header.encoding,
         vertices: Positions::default(),
         colors: None,
@@ -363,13 +376,11 @@ pub fn read_ply(bytes: &[u8]) -> Result<PlyData> {
             .map(|p| p.name().to_string())
             .collect(),
     };
-    match header.encoding {
-        PlyEncoding::Ascii => read_ascii_body(&header, body, &layout, &mut out)?,
-        PlyEncoding::BinaryLittleEndian => {
-            read_binary_body(&header, body, &layout, false, &mut out)?
-        }
-        PlyEncoding::BinaryBigEndian => read_binary_body(&header, body, &layout, true, &mut out)?,
-    }
+    Ok((out, layout))
+}
+
+/// The checks of a file read whole: finite vertices, face indices in range.
+pub(super) fn check_data(out: PlyData) -> Result<PlyData> {
     match &out.vertices {
         Positions::F64(v) => crate::geometry::check_finite(FMT, "vertex", v)?,
         Positions::F32(v) => crate::geometry::check_finite_f32(FMT, "vertex", v)?,
@@ -426,33 +437,14 @@ fn read_binary_body(
                     "list properties in the vertex element are not supported",
                 )
             })?;
-            let offsets = prefix_offsets(element);
-            let mut colors = layout.rgb.map(|_| Vec::with_capacity(count));
-            let xyz = layout.xyz.map(|(i, ty)| (offsets[i], ty));
-            let rgb = layout.rgb.map(|c| c.map(|(i, ty)| (offsets[i], ty)));
             let data = body
                 .get(pos..pos + stride * count)
                 .ok_or_else(|| Error::truncated(FMT, "vertex data ends early"))?;
-            if xyz.iter().all(|&(_, ty)| ty == Scalar::F32) {
-                let mut vertices = Vec::with_capacity(count);
-                for rec in data.chunks_exact(stride) {
-                    vertices.push(xyz.map(|(o, _)| read_f32(&rec[o..], big)));
-                }
-                out.vertices = Positions::F32(vertices);
-            } else {
-                let mut vertices = Vec::with_capacity(count);
-                for rec in data.chunks_exact(stride) {
-                    vertices.push(xyz.map(|(o, ty)| ty.read(&rec[o..], big)));
-                }
-                out.vertices = Positions::F64(vertices);
-            }
-            if let (Some(colors), Some(rgb)) = (colors.as_mut(), rgb) {
-                for rec in data.chunks_exact(stride) {
-                    colors.push(rgb.map(|(o, ty)| to_u8(ty.read(&rec[o..], big), ty)));
-                }
-            }
+            let records = VertexRecords::new(element, layout, stride, big);
+            out.vertices = records.empty_positions(count);
+            out.colors = layout.rgb.map(|_| Vec::with_capacity(count));
+            records.decode(data, &mut out.vertices, out.colors.as_mut());
             pos += stride * count;
-            out.colors = colors;
         } else if let Some(stride) = element.fixed_stride() {
             let len = stride
                 .checked_mul(count)
@@ -521,6 +513,75 @@ fn read_binary_body(
     Ok(())
 }
 
+/// Where a binary vertex record keeps its position and colour.
+pub(super) struct VertexRecords {
+    stride: usize,
+    big: bool,
+    xyz: [(usize, Scalar); 3],
+    rgb: Option<[(usize, Scalar); 3]>,
+}
+
+impl VertexRecords {
+    /// The records of the fixed-stride vertex element `element` (`stride` bytes each).
+    pub(super) fn new(element: &Element, layout: &VertexLayout, stride: usize, big: bool) -> Self {
+        let offsets = prefix_offsets(element);
+        VertexRecords {
+            stride,
+            big,
+            xyz: layout.xyz.map(|(i, ty)| (offsets[i], ty)),
+            rgb: layout.rgb.map(|c| c.map(|(i, ty)| (offsets[i], ty))),
+        }
+    }
+
+    /// Bytes a record.
+    pub(super) fn stride(&self) -> usize {
+        self.stride
+    }
+
+    /// Whether the records have red, green and blue.
+    pub(super) fn has_colors(&self) -> bool {
+        self.rgb.is_some()
+    }
+
+    /// Storage for `count` positions as the file keeps them: `f32` when x, y and z are
+    /// `float`, `f64` otherwise.
+    pub(super) fn empty_positions(&self, count: usize) -> Positions {
+        if self.xyz.iter().all(|&(_, ty)| ty == Scalar::F32) {
+            Positions::F32(Vec::with_capacity(count))
+        } else {
+            Positions::F64(Vec::with_capacity(count))
+        }
+    }
+
+    /// Appends the whole records of `data` (a multiple of the stride) to `positions` (made by
+    /// [`Self::empty_positions`]) and `colors`.
+    pub(super) fn decode(
+        &self,
+        data: &[u8],
+        positions: &mut Positions,
+        colors: Option<&mut Vec<[u8; 3]>>,
+    ) {
+        let (xyz, big) = (self.xyz, self.big);
+        match positions {
+            Positions::F32(v) => {
+                for rec in data.chunks_exact(self.stride) {
+                    v.push(xyz.map(|(o, _)| read_f32(&rec[o..], big)));
+                }
+            }
+            Positions::F64(v) => {
+                for rec in data.chunks_exact(self.stride) {
+                    v.push(xyz.map(|(o, ty)| ty.read(&rec[o..], big)));
+                }
+            }
+        }
+        if let (Some(colors), Some(rgb)) = (colors, self.rgb) {
+            for rec in data.chunks_exact(self.stride) {
+                colors.push(rgb.map(|(o, ty)| to_u8(ty.read(&rec[o..], big), ty)));
+            }
+        }
+    }
+}
+
 /// An `f32` from the first 4 bytes of `b` (callers check the length).
 #[inline]
 fn read_f32(b: &[u8], big: bool) -> f32 {
@@ -542,7 +603,7 @@ fn truncated_entry(element: &Element, entry: usize) -> Error {
     )
 }
 
-fn element_what(name: &str) -> &'static str {
+pub(super) fn element_what(name: &str) -> &'static str {
     match name {
         "vertex" => "vertices",
         "face" => "faces",

@@ -1,0 +1,42 @@
+//! Dense clouds read from disk in pieces ([`sfmeval::io::ply_stream`]): the file's bytes never
+//! sit in memory beside the decoded points.
+
+use std::fs::File;
+use std::io::Read as _;
+use std::path::Path;
+
+use anyhow::{Context as _, Result};
+use sfmeval::io::ply::PlyData;
+use sfmeval::io::ply_stream::{HEAD_BYTES, PlyCloudStream};
+
+/// Bytes read from the file at a time.
+const PIECE_BYTES: usize = 8 << 20;
+
+/// The binary PLY point cloud at `path`, read a piece at a time; `Ok(None)` when the file is
+/// not one that streams (ascii, a mesh, ...: read it whole). Errors reading the file name it;
+/// format errors are the core's, as from a whole-file read.
+pub fn read_ply_cloud(path: &Path) -> Result<Option<PlyData>> {
+    let what = || format!("cannot read '{}'", path.display());
+    let mut file = File::open(path).with_context(what)?;
+    let len = file.metadata().with_context(what)?.len();
+    let mut head = Vec::with_capacity(HEAD_BYTES);
+    (&mut file)
+        .take(HEAD_BYTES as u64)
+        .read_to_end(&mut head)
+        .with_context(what)?;
+    let Some(mut stream) = PlyCloudStream::new(&head, len)? else {
+        return Ok(None);
+    };
+    if let Some(body) = head.get(stream.body_start()..) {
+        stream.push(body);
+    }
+    let mut piece = vec![0u8; PIECE_BYTES];
+    while !stream.is_complete() {
+        let n = file.read(&mut piece).with_context(what)?;
+        if n == 0 {
+            break;
+        }
+        stream.push(&piece[..n]);
+    }
+    Ok(Some(stream.finish()?))
+}
