@@ -3,7 +3,8 @@
 # then runs the wasm-bindgen tests (Node and headless Chromium), the packed npm tarball in Node
 # and in a bundler-free page in Chromium (report byte for byte the CLI's), every alignment path
 # through the npm package in Node against the CLI (byte for byte), and the page end to end in
-# Chromium via playwright-core (tests/browser/e2e.mjs: results equal the CLI's; tests/browser/ux.mjs:
+# Chromium via playwright-core (tests/browser/e2e.mjs: results equal the CLI's; tests/browser/dense.mjs:
+# a dense PLY streamed into the page, a too-large one refused; tests/browser/ux.mjs:
 # layout at 1366×768 and 1920×1080, errors in view, keyboard, axe-core, cancel; tests/browser/compare.mjs:
 # a runner runs folder compared in the page equals `sfmeval-runner report`'s table and reports).
 # SFMEVAL_BENCH=1 also runs the speed benchmarks (bench/data; not tests): whole eval in the page,
@@ -94,6 +95,14 @@ t=$SECONDS
 node tests/browser/ux.mjs --url "http://127.0.0.1:$port/" --out "$out" >"$log/ux.log" 2>&1
 count ux "$log/ux.log" $?
 echo "ux: $((SECONDS - t)) s (screenshots ux-*.png in $out)"
+# a dense binary PLY streamed into the page (2M points here; SFMEVAL_DENSE_POINTS for more), and
+# a 40M-point file refused from its header (tests/browser/dense.mjs)
+t=$SECONDS
+node tests/browser/dense.mjs --url "http://127.0.0.1:$port/" --cli target/release/sfmeval --out "$out/dense" \
+  --points "${SFMEVAL_DENSE_POINTS:-2000000}" >"$log/dense.log" 2>&1
+count dense "$log/dense.log" $?
+rm -f "$out"/dense/*.ply
+echo "dense: $((SECONDS - t)) s"
 
 # Compare: a runner runs folder of four pipelines (custom commands that copy the demo's COLMAP
 # model and two real sparse clouds of the same statue from tests/fixtures/global, and one that

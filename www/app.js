@@ -34,7 +34,11 @@ function startWorker() {
   worker = new Worker(new URL('./worker.js', import.meta.url), { type: 'module' });
   worker.onmessage = (ev) => {
     const m = ev.data;
-    if (m.type === 'progress') { if (state.running) showProgress(m.stage, m.done, m.total); return; }
+    if (m.type === 'progress') {
+      if (state.running) showProgress(m.stage, m.done, m.total);
+      else if (m.stage === 'reading') showProgress('reading (MB)', Math.round(m.done / 1e6), Math.max(2, Math.round(m.total / 1e6)));
+      return;
+    }
     const p = pending.get(m.id);
     if (!p) return;
     pending.delete(m.id);
@@ -261,11 +265,22 @@ async function loadRecon(fileList, name) {
   setBusy(true);
   setInputInfo('recon', 'reading…');
   try {
-    const { files, transfer, folder } = await readFiles(fileList);
-    const names = Object.keys(files);
-    // The report names a reconstruction as the CLI does: the file, or the model's folder.
-    if (!name) name = folder ?? (names.length === 1 ? names[0] : 'model');
-    const r = await call('loadRecon', { files, name }, transfer);
+    let r;
+    const single = fileList.length === 1 && !fileList[0].webkitRelativePath ? fileList[0] : null;
+    if (single && /\.ply$/i.test(single.name)) {
+      // Read by the worker a piece at a time (a dense cloud streams; no size limit here: the
+      // worker refuses a cloud that would not fit, from its header).
+      if (!name) name = single.name;
+      try {
+        r = await call('loadRecon', { file: single, name });
+      } finally { hideProgress(); }
+    } else {
+      const { files, transfer, folder } = await readFiles(fileList);
+      const names = Object.keys(files);
+      // The report names a reconstruction as the CLI does: the file, or the model's folder.
+      if (!name) name = folder ?? (names.length === 1 ? names[0] : 'model');
+      r = await call('loadRecon', { files, name }, transfer);
+    }
     state.recon = r;
     sources.recon = { files: Array.from(fileList), name };
     state.beside = null;

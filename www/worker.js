@@ -1,7 +1,7 @@
 // The sfmeval core runs here, off the main thread. Messages in: {id, type, ...}; out: replies
 // {id, ok, ...} or {id, ok: false, error}, and {type: 'progress', id, stage, done, total}.
 import {
-  init, version, loadGroundTruth, loadReconstruction, loadCameras, raw, cropFile, parseCrop,
+  init, version, loadGroundTruth, loadReconstruction, loadReconstructionFile, loadCameras, raw, cropFile, parseCrop,
   parseTransform, parsePointPairs, errorColors, POSE_STRIDE, comparisonTables, runRow,
 } from './sfmeval/index.js';
 
@@ -73,13 +73,29 @@ const handlers = {
       transfer: [vertices.buffer, triangles.buffer],
     };
   },
-  loadRecon({ files, name }) {
-    const bytes = {};
-    for (const [n, b] of Object.entries(files)) bytes[n] = new Uint8Array(b);
-    const r = loadReconstruction(bytes, name);
+  async loadRecon({ files, file, name, id }) {
+    let r;
+    if (file) {
+      // One file: a binary PLY cloud streams in pieces (a dense cloud never sits in memory
+      // twice), with progress; anything else is read whole.
+      let lastPost = 0;
+      const onProgress = (done, total) => {
+        const now = performance.now();
+        if (now - lastPost > 100 || done === total) {
+          lastPost = now;
+          postMessage({ type: 'progress', id, stage: 'reading', done, total });
+        }
+      };
+      r = await loadReconstructionFile(file, { name, onProgress });
+    } else {
+      const bytes = {};
+      for (const [n, b] of Object.entries(files)) bytes[n] = new Uint8Array(b);
+      r = loadReconstruction(bytes, name);
+    }
     if (recon) recon.free();
     recon = r;
-    const positions = r.positions();
+    // float32 files hand over their own values (exact, half the bytes of a dense cloud)
+    const positions = r.positionsAreF32 ? r.positionsF32() : r.positions();
     const colors = r.colors() ?? null;
     return {
       reply: {

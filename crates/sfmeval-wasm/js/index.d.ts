@@ -139,6 +139,22 @@ export function loadGroundTruth(
 ): RawGroundTruth;
 /** Reads a reconstruction (PLY, or an SfM model's files). */
 export function loadReconstruction(files: Files | RawReconstruction, name?: string): RawReconstruction;
+/** Bytes of WebAssembly memory a streamed reconstruction point needs through an evaluation. */
+export const BYTES_PER_POINT: number;
+/** WebAssembly memory a reconstruction may take (bytes). */
+export const RECONSTRUCTION_BUDGET: number;
+/** Reads a reconstruction from a `File`/`Blob` a piece at a time (a binary PLY cloud streams;
+ * anything else is read whole); refuses a cloud of more than `maxPoints` points before
+ * reading them. */
+export function loadReconstructionFile(
+  file: Blob & { name?: string },
+  options?: {
+    name?: string;
+    onProgress?: (bytesRead: number, bytesTotal: number) => void;
+    pieceBytes?: number;
+    maxPoints?: number;
+  },
+): Promise<RawReconstruction>;
 /** Reads ground-truth cameras. */
 export function loadCameras(files: Files | RawCameras): RawCameras;
 /** Aligns and measures, as `sfmeval eval`. Throws an `Error` with the core's message. */
@@ -224,6 +240,7 @@ export const GroundTruth: typeof rawBindings.GroundTruth;
 export type GroundTruth = RawGroundTruth;
 export const Reconstruction: typeof rawBindings.Reconstruction;
 export type Reconstruction = RawReconstruction;
+export const ReconstructionStream: typeof rawBindings.ReconstructionStream;
 export const Cameras: typeof rawBindings.Cameras;
 export type Cameras = RawCameras;
 /** The raw wasm-bindgen bindings. */

@@ -84,6 +84,53 @@ export function loadReconstruction(files, name) {
   return new wasm.Reconstruction(name, map);
 }
 
+/**
+ * Bytes of WebAssembly memory one point of a streamed reconstruction needs through an
+ * evaluation, about: its position as the file's float32 (12), the evaluation's own copy (12),
+ * distances, input order, status and k-d tree boxes (15), 16 while the tree order is computed,
+ * and the GT-frame points the viewer reads (24 + 12), with room to spare.
+ */
+export const BYTES_PER_POINT = 100;
+/** WebAssembly memory a reconstruction may take: wasm32 memory is 4 GiB at most, shared with
+ * the ground truth and the evaluation's other buffers. */
+export const RECONSTRUCTION_BUDGET = 3e9;
+
+/**
+ * Reads a reconstruction from a `File` or `Blob` (browser) a piece at a time, so the file's
+ * bytes never enter WebAssembly memory: a binary PLY point cloud (a dense cloud) streams;
+ * anything else (ascii PLY, a mesh) is read whole. Refuses, before reading the points, a
+ * cloud with more than `maxPoints` points (default `RECONSTRUCTION_BUDGET / BYTES_PER_POINT`,
+ * 30 M), which would not fit the page's memory. `onProgress(bytesRead, bytesTotal)` is called
+ * after every piece (`pieceBytes`, default 8 MiB).
+ */
+export async function loadReconstructionFile(file, { name, onProgress, pieceBytes = 8 << 20, maxPoints } = {}) {
+  const fileName = file.name ?? 'reconstruction.ply';
+  name = name ?? fileName;
+  const head = new Uint8Array(await file.slice(0, 1 << 16).arrayBuffer());
+  const stream = /\.ply$/i.test(fileName) ? wasm.ReconstructionStream.start(name, fileName, head, file.size) : undefined;
+  if (!stream) return loadReconstruction({ [fileName]: await file.arrayBuffer() }, name);
+  const limit = maxPoints ?? Math.floor(RECONSTRUCTION_BUDGET / BYTES_PER_POINT);
+  if (stream.declaredPoints > limit) {
+    const n = stream.declaredPoints;
+    stream.free();
+    const m = (v) => `${(v / 1e6).toFixed(1)} M`;
+    throw new Error(`reconstruction '${name}': ${m(n)} points do not fit this page (up to ${m(limit)}: about ${BYTES_PER_POINT} bytes a point of WebAssembly memory, which is at most 4 GB); evaluate it with the sfmeval CLI, which reads clouds of any size: sfmeval eval --gt GT --recon ${fileName}`);
+  }
+  try {
+    let at = stream.bodyStart;
+    while (!stream.isComplete && at < file.size) {
+      const end = Math.min(at + pieceBytes, file.size);
+      stream.push(new Uint8Array(await file.slice(at, end).arrayBuffer()));
+      at = end;
+      if (onProgress) onProgress(at, file.size);
+    }
+  } catch (e) {
+    stream.free();
+    throw e;
+  }
+  return stream.finish();
+}
+
 /** Reads ground-truth cameras (a dataset's cameras.json or any model in the ground-truth frame). */
 export function loadCameras(files) {
   if (files instanceof wasm.Cameras) return files;
@@ -194,6 +241,7 @@ export const POSE_STRIDE = 14;
 
 export const GroundTruth = wasm.GroundTruth;
 export const Reconstruction = wasm.Reconstruction;
+export const ReconstructionStream = wasm.ReconstructionStream;
 export const Cameras = wasm.Cameras;
 /** The raw wasm-bindgen bindings. */
 export const raw = wasm;

@@ -27,9 +27,11 @@ use sfmeval::transform::Similarity;
 use wasm_bindgen::prelude::*;
 
 mod poses;
+mod stream;
 mod table;
 
 pub use poses::error_colors;
+pub use stream::ReconstructionStream;
 pub use table::{comparison_tables, run_row};
 
 /// Installs the panic hook so that a Rust panic shows its message in the console.
@@ -267,6 +269,25 @@ impl Reconstruction {
     /// Points in the reconstruction's own frame, `x0, y0, z0, x1, ...`.
     pub fn positions(&self) -> Float64Array {
         points_f64(&self.input.cloud.points.as_f64())
+    }
+
+    /// Whether the points are stored as 32-bit floats (a binary PLY with `float` x y z), so
+    /// [`Self::positions_f32`] gives them exactly.
+    #[wasm_bindgen(getter, js_name = positionsAreF32)]
+    pub fn positions_are_f32(&self) -> bool {
+        matches!(
+            self.input.cloud.points,
+            sfmeval::geometry::Positions::F32(_)
+        )
+    }
+
+    /// The same as 32-bit floats (WebGL buffers), without a 64-bit copy of a dense cloud.
+    #[wasm_bindgen(js_name = positionsF32)]
+    pub fn positions_f32(&self) -> Float32Array {
+        match &self.input.cloud.points {
+            sfmeval::geometry::Positions::F32(v) => Float32Array::from(v.as_flattened()),
+            sfmeval::geometry::Positions::F64(v) => points_f32(v),
+        }
     }
 
     /// Per-point RGB colours (`r0, g0, b0, ...`), when the file has them.
