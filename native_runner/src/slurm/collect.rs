@@ -17,7 +17,7 @@ use crate::dataset::Dataset;
 use crate::files::{copy_dir, partial_name, replace_dir};
 use crate::pipelines::{parse_customs, parse_list};
 use crate::report::report;
-use crate::run::{RUN_SCHEMA, RunRecord, Status, read_record};
+use crate::run::{RunRecord, Status, read_record};
 use crate::slurm::plan::{CellPlan, Job, Plan, Stage};
 use crate::slurm::state::{dataset_done, end_reason, task_done};
 use crate::sweep::variants::Variant;
@@ -72,39 +72,27 @@ fn write_missing_run(
         .map(|d| d.as_secs_f64())
         .unwrap_or(0.0);
     let rec = RunRecord {
-        schema: RUN_SCHEMA.into(),
-        dataset: cell.dataset.clone(),
-        dataset_dir: dataset_dir.to_string_lossy().to_string(),
-        pipeline: cell.pipeline.clone(),
-        kind: kind_tool.0,
-        tool: kind_tool.1,
-        version: None,
         status,
         reason: Some(reason.clone()),
-        command: Vec::new(),
-        options,
-        wall_seconds: 0.0,
-        cpu_seconds: 0.0,
-        peak_memory_bytes: 0,
-        exit_status: None,
-        images_total: Dataset::open(&dataset_dir).map_or(0, |d| d.image_count),
-        images_registered: 0,
-        points: 0,
-        models: 0,
-        started_unix: 0.0,
         finished_unix: now,
-        log: "log.txt".into(),
-        steps: Vec::new(),
         warnings: vec![
             "no result from its Slurm task: `sfmeval-runner table1 --executor slurm --resume` redoes it"
                 .into(),
         ],
-        tool_report: serde_json::Value::Null,
+        ..RunRecord::not_run(
+            &cell.dataset,
+            &dataset_dir,
+            Dataset::open(&dataset_dir).map_or(0, |d| d.image_count),
+            &cell.pipeline,
+            &kind_tool.0,
+            &kind_tool.1,
+            options,
+        )
     };
     let tmp = partial_name(dest);
     std::fs::create_dir_all(&tmp).with_context(|| format!("creating {}", tmp.display()))?;
     write_atomic(
-        &tmp.join("log.txt"),
+        &tmp.join(&rec.log),
         format!("# {}: {reason}\n", status.label()).as_bytes(),
     )?;
     let mut text = serde_json::to_string_pretty(&rec)?;
