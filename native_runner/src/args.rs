@@ -32,7 +32,8 @@ pub struct Cli {
 pub enum Command {
     /// Create the Python venv with the pinned SfM tools (requirements/runner.txt).
     Setup(SetupArgs),
-    /// Run pipelines on datasets: writes `OUT/<dataset>/<pipeline>/` (sparse.ply, cameras.json, run.json, log.txt, model/).
+    /// Run pipelines on datasets: writes `OUT/<dataset>/<pipeline>/` (sparse.ply, cameras.json, run.json, log.txt, model/);
+    /// with `--executor slurm`, `OUT/runs/<dataset>/<pipeline>/` and the tables in `OUT/table/`.
     Run(RunArgs),
     /// Join the run folders of several shards into one.
     Merge(MergeArgs),
