@@ -11,6 +11,7 @@ use sfmeval::align::{AlignMode, AlignRequest};
 use sfmeval::evaluate::EvalOptions;
 
 use crate::adapters::Intrinsics;
+use crate::report::ReportArgs;
 use crate::run::{BatchOptions, parse_shard};
 
 /// The whole command line.
@@ -31,7 +32,8 @@ pub struct Cli {
 pub enum Command {
     /// Create the Python venv with the pinned SfM tools (requirements/runner.txt).
     Setup(SetupArgs),
-    /// Run pipelines on datasets: writes `OUT/<dataset>/<pipeline>/` (sparse.ply, cameras.json, run.json, log.txt, model/).
+    /// Run pipelines on datasets: writes `OUT/<dataset>/<pipeline>/` (sparse.ply, cameras.json, run.json, log.txt, model/);
+    /// with `--executor slurm`, `OUT/runs/<dataset>/<pipeline>/` and the tables in `OUT/table/`.
     Run(RunArgs),
     /// Join the run folders of several shards into one.
     Merge(MergeArgs),
@@ -44,7 +46,7 @@ pub enum Command {
     Sweep(SweepArgs),
     /// List the pipelines and whether each is installed here.
     Pipelines(PipelinesArgs),
-    /// One task of a Slurm batch (what the sbatch scripts of `table1 --executor slurm` run).
+    /// One task of a Slurm batch (what the sbatch scripts of `--executor slurm` run).
     #[command(hide = true)]
     SlurmTask(SlurmTaskArgs),
 }
@@ -144,7 +146,8 @@ pub struct BatchArgs {
     /// How the runs execute.
     #[command(flatten)]
     pub exec: ExecArgs,
-    /// Skip runs already finished in the output folder.
+    /// Skip runs already finished in the output folder (with --executor slurm: complete the
+    /// batch planned in OUT, submitting only the tasks without result, then collect again).
     #[arg(long)]
     pub resume: bool,
     /// With --resume, redo runs that failed or timed out.
@@ -197,6 +200,13 @@ pub struct RunArgs {
     /// The pipelines and how they run.
     #[command(flatten)]
     pub batch: BatchArgs,
+    /// With --executor slurm: how the collect stage measures every run into OUT/table/ (a
+    /// local run does not evaluate: `report` does).
+    #[command(flatten)]
+    pub eval: EvalArgs,
+    /// Where the runs go (this machine, or a Slurm cluster: OUT/slurm/, OUT/runs/, OUT/table/).
+    #[command(flatten)]
+    pub slurm: SlurmArgs,
 }
 
 /// Arguments of `merge`.
@@ -261,6 +271,30 @@ impl EvalArgs {
 }
 
 impl EvalArgs {
+    /// Whether every option has its default (a local `run`, which does not evaluate, takes
+    /// none).
+    pub fn is_default(&self) -> bool {
+        self.crop.is_none()
+            && self.samples == sfmeval::evaluate::DEFAULT_SAMPLES
+            && self.tau.is_empty()
+            && self.tau_percent.is_empty()
+            && self.align == "auto"
+            && self.eval_seed == 0
+    }
+
+    /// The report of a batch: its runs folder into its table folder, measured as these
+    /// options say (a local `table1` and a Slurm batch's collect make the same tables).
+    pub fn report_args(&self, runs: &Path, table: &Path) -> Result<ReportArgs> {
+        Ok(ReportArgs {
+            runs: vec![runs.to_path_buf()],
+            out: table.to_path_buf(),
+            datasets: Vec::new(),
+            eval: self.eval_options()?,
+            align: self.align_request()?,
+            verbose: false,
+        })
+    }
+
     /// The alignment request of `--align` (validated: modes that need a transform or point
     /// pairs are refused, a batch has neither).
     pub fn align_request(&self) -> Result<AlignRequest> {
@@ -339,17 +373,22 @@ pub struct Table1Args {
     /// How every run is measured.
     #[command(flatten)]
     pub eval: EvalArgs,
+    /// Slurm: complete the batch already planned in OUT (after a node failure, a cancelled or
+    /// timed-out task): submit only the tasks whose results are missing, then collect again.
+    #[arg(long)]
+    pub resume: bool,
     /// Where the stages run (this machine, or a Slurm cluster).
     #[command(flatten)]
     pub slurm: SlurmArgs,
 }
 
-/// Where `table1` and `sweep` run: here, or as Slurm job arrays (`--executor slurm`).
+/// Where `table1`, `sweep` and `run` run: here, or as Slurm job arrays (`--executor slurm`).
+/// Their `--resume` (a Slurm batch: submit only what is missing) is each command's own.
 #[derive(Args, Clone)]
 pub struct SlurmArgs {
     /// `local` (everything in this process) or `slurm`: write sbatch scripts for the stages
-    /// (render shards, finalize, one task per dataset × pipeline, collect) into OUT/slurm/ and
-    /// submit them as job arrays chained by dependencies.
+    /// (render shards, finalize, one task per dataset × pipeline, collect; `run` only the last
+    /// two) into OUT/slurm/ and submit them as job arrays chained by dependencies.
     #[arg(long, default_value = "local", value_parser = ["local", "slurm"])]
     pub executor: String,
     /// Slurm: render tasks per dataset (task i renders the views k with k % n == i).
@@ -369,20 +408,22 @@ pub struct SlurmArgs {
     /// Slurm: only write the scripts (OUT/slurm/*.sbatch and submit.sh), submit nothing.
     #[arg(long)]
     pub dry_run: bool,
-    /// Slurm: complete the batch already planned in OUT (after a node failure, a cancelled or
-    /// timed-out task): submit only the tasks whose results are missing, then collect again.
-    #[arg(long)]
-    pub resume: bool,
     /// Slurm: the sbatch executable.
     #[arg(long, default_value = "sbatch")]
     pub sbatch: String,
 }
 
 impl SlurmArgs {
-    /// Fails when a Slurm-only option is given without `--executor slurm`.
-    pub fn check_local(&self) -> Result<()> {
+    /// Whether the batch goes to Slurm.
+    pub fn is_slurm(&self) -> bool {
+        self.executor == "slurm"
+    }
+
+    /// Fails when a Slurm-only option is given without `--executor slurm` (`slurm_resume`:
+    /// `--resume` of `table1` and `sweep`, which only Slurm batches have).
+    pub fn check_local(&self, slurm_resume: bool) -> Result<()> {
         if self.dry_run
-            || self.resume
+            || slurm_resume
             || !self.stages.is_empty()
             || self.partition.is_some()
             || self.account.is_some()
@@ -451,6 +492,10 @@ pub struct SweepArgs {
     /// How every run is measured.
     #[command(flatten)]
     pub eval: EvalArgs,
+    /// Slurm: complete the batch already planned in OUT (after a node failure, a cancelled or
+    /// timed-out task): submit only the tasks whose results are missing, then collect again.
+    #[arg(long)]
+    pub resume: bool,
     /// Where the stages run (this machine, or a Slurm cluster).
     #[command(flatten)]
     pub slurm: SlurmArgs,

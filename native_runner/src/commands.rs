@@ -12,6 +12,13 @@ use crate::report::ReportArgs;
 
 /// `run`: every (dataset, pipeline) of the grid into `OUT/<dataset>/<pipeline>/`.
 pub fn run(a: &RunArgs) -> Result<()> {
+    a.slurm.check_local(false)?;
+    if !a.eval.is_default() {
+        anyhow::bail!(
+            "--crop, --samples, --tau, --tau-percent, --align and --eval-seed go with --executor \
+             slurm (a local run does not evaluate: give them to `report`)"
+        );
+    }
     let customs = parse_customs(&a.batch.tools.customs)?;
     let specs = parse_list(&a.batch.pipelines, &customs)?;
     let datasets: Vec<Dataset> = a

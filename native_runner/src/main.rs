@@ -3,7 +3,7 @@
 //!
 //! ```text
 //! sfmeval-runner setup [--venv .venv]
-//! sfmeval-runner run --datasets DIR... --pipelines LIST --out runs/ [--jobs N] [--resume] [--shard i/n]
+//! sfmeval-runner run --datasets DIR... --pipelines LIST --out runs/ [--jobs N] [--resume] [--shard i/n] [--executor slurm ...]
 //! sfmeval-runner merge runs-0/ runs-1/ ... --out runs/
 //! sfmeval-runner report runs/ --out table/
 //! sfmeval-runner table1 [--quick] [--out table1/] [--executor slurm [--dry-run] [--resume]]
@@ -40,13 +40,14 @@ fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Setup(a) => setup::setup(&a.venv, &a.python),
+        Command::Run(a) if a.slurm.is_slurm() => slurm::submit_run(&a),
         Command::Run(a) => commands::run(&a),
         Command::Merge(a) => commands::merge(&a),
         Command::Report(a) => commands::report(&a),
-        Command::Table1(a) if a.slurm.executor == "slurm" => slurm::submit_table1(&a),
+        Command::Table1(a) if a.slurm.is_slurm() => slurm::submit_table1(&a),
         Command::Table1(a) => table1::table1(&a),
         Command::SlurmTask(a) => slurm::task::slurm_task(&a),
-        Command::Sweep(a) if a.slurm.executor == "slurm" => slurm::submit_sweep(&a),
+        Command::Sweep(a) if a.slurm.is_slurm() => slurm::submit_sweep(&a),
         Command::Sweep(a) => sweep::sweep(&a),
         Command::Pipelines(a) => commands::pipelines(&a),
     };

@@ -78,6 +78,47 @@ pub struct RunRecord {
 }
 
 impl RunRecord {
+    /// A run of `pipeline` (`kind`, `tool`, `options`) on a dataset that has done nothing yet:
+    /// status `failed` without reason, no command, no time, nothing registered. `run_one` fills
+    /// it in as the tool runs; the Slurm collect writes it for a task that left no result.
+    pub fn not_run(
+        dataset: &str,
+        dataset_dir: &Path,
+        images_total: usize,
+        pipeline: &str,
+        kind: &str,
+        tool: &str,
+        options: BTreeMap<String, String>,
+    ) -> RunRecord {
+        RunRecord {
+            schema: RUN_SCHEMA.into(),
+            dataset: dataset.into(),
+            dataset_dir: dataset_dir.to_string_lossy().to_string(),
+            pipeline: pipeline.into(),
+            kind: kind.into(),
+            tool: tool.into(),
+            version: None,
+            status: Status::Failed,
+            reason: None,
+            command: Vec::new(),
+            options,
+            wall_seconds: 0.0,
+            cpu_seconds: 0.0,
+            peak_memory_bytes: 0,
+            exit_status: None,
+            images_total,
+            images_registered: 0,
+            points: 0,
+            models: 0,
+            started_unix: 0.0,
+            finished_unix: 0.0,
+            log: "log.txt".into(),
+            steps: Vec::new(),
+            warnings: Vec::new(),
+            tool_report: serde_json::Value::Null,
+        }
+    }
+
     /// The fields the tables use.
     pub fn facts(&self) -> sfmeval_table::RunFacts {
         sfmeval_table::RunFacts {
@@ -365,35 +406,19 @@ pub fn run_one(
     options.insert("intrinsics".into(), intrinsics.name().into());
     options.insert("timeout".into(), format!("{}", timeout.as_secs_f64()));
     options.insert("seed".into(), opts.seed.to_string());
-    let log_name = "log.txt";
-    let log = work.join(log_name);
     let mut rec = RunRecord {
-        schema: RUN_SCHEMA.into(),
-        dataset: ds.name.clone(),
-        dataset_dir: ds.dir.to_string_lossy().to_string(),
-        pipeline: spec.name.clone(),
-        kind: spec.kind.clone(),
-        tool: adapter.tool().to_string(),
-        version: None,
-        status: Status::Failed,
-        reason: None,
-        command: Vec::new(),
-        options,
-        wall_seconds: 0.0,
-        cpu_seconds: 0.0,
-        peak_memory_bytes: 0,
-        exit_status: None,
-        images_total: ds.image_count,
-        images_registered: 0,
-        points: 0,
-        models: 0,
         started_unix: unix_now(),
-        finished_unix: 0.0,
-        log: log_name.into(),
-        steps: Vec::new(),
-        warnings: Vec::new(),
-        tool_report: serde_json::Value::Null,
+        ..RunRecord::not_run(
+            &ds.name,
+            &ds.dir,
+            ds.image_count,
+            &spec.name,
+            &spec.kind,
+            adapter.tool(),
+            options,
+        )
     };
+    let log = work.join(&rec.log);
     let header = format!(
         "# sfmeval-runner {}: dataset {} ({}), pipeline {} ({})\n",
         env!("CARGO_PKG_VERSION"),

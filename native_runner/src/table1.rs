@@ -83,24 +83,11 @@ fn generate(
     render_dataset("table1", python, scripts, &args, dest)
 }
 
-/// The report of a Table I batch: its runs folder into its table folder, measured as `a` says
-/// (the local `table1` and the Slurm batch's collect task make the same tables).
-pub fn report_args(a: &Table1Args, runs: &Path, table: &Path) -> Result<crate::report::ReportArgs> {
-    Ok(crate::report::ReportArgs {
-        runs: vec![runs.to_path_buf()],
-        out: table.to_path_buf(),
-        datasets: Vec::new(),
-        eval: a.eval.eval_options()?,
-        align: a.eval.align_request()?,
-        verbose: false,
-    })
-}
-
 /// The whole experiment.
 pub fn table1(a: &Table1Args) -> Result<()> {
     let t0 = Instant::now();
     a.exec.check()?;
-    a.slurm.check_local()?;
+    a.slurm.check_local(a.resume)?;
     let python = crate::env::find_python(a.tools.python.as_deref())?;
     let scripts = std::path::absolute(find_blender_scripts(
         a.generator.blender_scripts.as_deref(),
@@ -150,7 +137,7 @@ pub fn table1(a: &Table1Args) -> Result<()> {
     let summary = crate::run::run_batch(&datasets, &specs, &customs, &env, &opts)?;
     let runs_seconds = t_runs.elapsed().as_secs_f64();
     let t_rep = Instant::now();
-    let rows = crate::report::report(&report_args(a, &runs, &table)?)?;
+    let rows = crate::report::report(&a.eval.report_args(&runs, &table)?)?;
     let report_seconds = t_rep.elapsed().as_secs_f64();
     timing.insert("datasets_seconds".into(), gen_seconds.into());
     timing.insert("runs_seconds".into(), runs_seconds.into());

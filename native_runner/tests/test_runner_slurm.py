@@ -6,9 +6,13 @@ The job: `table1 --quick` on one preset (statue) with two pipelines (openmvg, py
 task per pipeline, collect. It is run once locally and once through Slurm; the pycolmap run task
 is cancelled (scancel) while it runs, the table is written with that cell marked, and
 `--resume` submits only that task (and the collect), after which the table equals the local one
-byte for byte. Then a `noise=0,8` sweep (small preset at the same size, openmvg) locally and
-through Slurm: the same sweep.csv and charts but for the run times. Measured on 2 vCPUs
-(loaded): table1 ~12 s locally, ~25 s through Slurm with its resume; the sweep test 40-60 s."""
+byte for byte. Then `run --executor slurm` of the same grid on that dataset with a 1-minute
+time limit: the pycolmap task is stopped until Slurm kills it (TIMEOUT), the table marks the
+cell, `--resume` with a longer limit completes it to a local `run` + `report`'s table. Then a
+`noise=0,8` sweep (small preset at the same size, openmvg) locally and through Slurm: the same
+sweep.csv and charts but for the run times. Measured on 2 vCPUs (loaded): table1 ~12 s
+locally, ~25 s through Slurm with its resume; the run test ~80 s (60-90 s of it waiting for
+Slurm's time limit, which it checks every 30 s); the sweep test 40-60 s."""
 
 import csv
 import json
@@ -22,7 +26,9 @@ from runner_testlib import load, run_cli
 
 PRESET = "statue"
 NAME = "statue-quick"
-PIPES = "openmvg;pycolmap"
+# One thread each: with all cores, pycolmap's model can depend on the load (seen under load 9:
+# 31 points in one run, 34 in the next), and the tests compare runs made at different times.
+PIPES = "openmvg:threads=1;pycolmap:threads=1"
 SETS = ["camera.resolution=[320, 180]", "render.samples=4",
         "views.orbits=[{elevation_deg=20.0, count=12}, "
         "{elevation_deg=45.0, count=12, azimuth_offset_deg=15.0}]"]
@@ -137,15 +143,15 @@ def test_dry_run_writes_the_scripts_and_submits_nothing(runner_bin, cluster, tmp
     assert cluster.jobs() == {}
 
 
-def wait_running_then_cancel(cluster, job, task_dir, pipeline, timeout=240):
-    """scancel JOB while it runs its tool (its partial run folder exists)."""
+def wait_running_then_cancel(cluster, job, task_dir, pipeline, *scancel, timeout=240):
+    """`scancel [SCANCEL...] JOB` while it runs its tool (its partial run folder exists)."""
     deadline = time.time() + timeout
     while time.time() < deadline:
         state = cluster.jobs().get(job)
         busy = task_dir.is_dir() and any(n.startswith(".%s.partial" % pipeline)
                                          for n in os.listdir(task_dir))
         if state == "RUNNING" and busy:
-            cluster.cmd("scancel", job)
+            cluster.cmd("scancel", *scancel, job)
             return
         assert not (task_dir / pipeline / "run.json").exists(), \
             "the task finished before it could be cancelled"
@@ -223,6 +229,82 @@ def test_slurm_gives_the_local_table_and_resume_completes_it(runner_bin, tools, 
     assert (out / "table" / "table1.md").read_text() == (local / "table" / "table1.md").read_text()
     print("slurm: first submission %.1f s, resume %.1f s" % (first, resumed))
     print(json.dumps(load(out / "table1.json")["timing"]))
+
+
+RUN_SLURM = ["--executor", "slurm", "--stage", "collect:cpus=1,mem=2G"]
+
+
+def test_run_through_slurm_equals_local_run_and_a_timed_out_task_resumes(runner_bin, tools,
+                                                                        cluster, local,
+                                                                        tmp_path):
+    """`run --executor slurm` on the dataset the local table1 rendered: one array of run tasks
+    (no render) and the collect. Slurm's time limit (1 minute, the least it takes) kills the
+    pycolmap task, which the test stops (SIGSTOP, a tool that hangs): the table is written with
+    that cell marked `timeout` and Slurm's message; `--resume` with a longer limit redoes that
+    task only, and the table then equals a local `run` + `report` of the same grid."""
+    dataset = local / "datasets" / NAME
+    grid = ["--datasets", str(dataset), "--pipelines", PIPES]
+    env = {"SLURM_CONF": cluster.conf}
+    dry = tmp_path / "dry"
+    run_cli(runner_bin, "run", *grid, "--out", dry, *RUN_SLURM, "--dry-run", env=env)
+    sb = [l for l in (dry / "slurm" / "submit.sh").read_text().splitlines()
+          if "sbatch --parsable" in l]
+    assert [l.split("=")[0] for l in sb] == ["run_0", "collect"], sb
+    assert "--parsable --array=0-1 %s/run.sbatch" % (dry / "slurm") in sb[0]
+    assert "--dependency=afterany:$run_0 " in sb[1]
+    plan = load(dry / "slurm" / "plan.json")
+    assert plan["render_shards"] == 0 and plan["datasets"][0]["dir"] == str(dataset)
+    assert sorted(f for f in os.listdir(dry / "slurm") if f.endswith(".sbatch")) == \
+        ["collect.sbatch", "run.sbatch"] and not (dry / "datasets").exists()
+    bad = run_cli(runner_bin, "run", *grid, "--out", tmp_path / "b", "--samples", "9",
+                  check=False)
+    assert bad.returncode == 1 and "go with --executor slurm" in bad.stderr, bad.stderr
+
+    out = tmp_path / "slurm"
+    t0 = time.time()
+    run_cli(runner_bin, "run", *grid, "--out", out, "--samples", "100000", *RUN_SLURM,
+            "--stage", "run:cpus=1,mem=2G,time=1", env=env)
+    stages = load(out / "slurm" / "jobs.json")[0]["stages"]
+    assert [(s["label"], s["tasks"]) for s in stages] == [("run_0", [0, 1]), ("collect", [0])]
+    k = [c["pipeline"] for c in load(out / "slurm" / "plan.json")["cells"]].index("pycolmap")
+    task_dir = out / "slurm" / "runs" / ("task-%d" % k) / NAME
+    wait_running_then_cancel(cluster, "%s_%d" % (stages[0]["job"], k), task_dir, "pycolmap",
+                             "--signal=STOP", "--full")
+    # the local run of the same grid meanwhile (the stopped task takes no CPU)
+    mine = tmp_path / "local"
+    run_cli(runner_bin, "run", *grid, "--out", mine)
+    run_cli(runner_bin, "report", mine, "--out", mine / "table", "--samples", "100000")
+    cluster.wait_idle(240)
+    first = time.time() - t0
+
+    cells = md_cells(out / "table" / "table1.md")
+    local_cells = md_cells(mine / "table" / "table1.md")
+    assert cells[(NAME, "pycolmap")].startswith(
+        "timeout: Slurm run task %d: Slurm time limit" % k), cells
+    assert cells[(NAME, "openmvg")] == local_cells[(NAME, "openmvg")]
+    rec = load(out / "runs" / NAME / "pycolmap" / "run.json")
+    assert rec["status"] == "timeout" and "DUE TO TIME LIMIT" in rec["reason"], rec["reason"]
+    with open(os.path.join(cluster.root, "slurmctld.log"), errors="replace") as f:
+        assert "Time limit exhausted for JobId=" in f.read()
+    doc = load(out / "batch.json")
+    assert doc["runs_executed"] == {"ok": 1} and doc["datasets"] == [str(dataset)]
+    assert [(t["task"], t["status"]) for t in doc["tasks_without_result"]] == [(k, "timeout")]
+
+    t1 = time.time()
+    p = run_cli(runner_bin, "run", *grid, "--out", out, "--samples", "100000", *RUN_SLURM,
+                "--stage", "run:cpus=1,mem=2G,time=10", "--resume", env=env)
+    assert "submitted run 1/2, collect 1/1" in p.stderr, p.stderr
+    assert "#SBATCH --time=10" in (out / "slurm" / "run.sbatch").read_text().splitlines()
+    cluster.wait_idle(240)
+    resumed = time.time() - t1
+    for f in ["table1.md", "table1.csv"]:
+        assert (out / "table" / f).read_text() == (mine / "table" / f).read_text(), f
+    for pipe in ["openmvg", "pycolmap"]:
+        rel = os.path.join("reports", NAME, pipe + ".json")
+        assert measures(load(out / "table" / rel)) == measures(load(mine / "table" / rel)), pipe
+    assert load(out / "batch.json")["tasks_without_result"] == []
+    print("slurm run: first submission (with the timeout) %.1f s, resume %.1f s"
+          % (first, resumed))
 
 
 SWEEP = ["sweep", "--factor", "noise=0,8", "--dataset-preset", "small",

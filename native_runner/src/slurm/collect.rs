@@ -2,7 +2,7 @@
 //! left none (cancelled, timed out, its node failed, its dataset never rendered) becomes a run
 //! with status `failed` or `timeout` and the reason from its Slurm output file, so the table
 //! is written with that cell marked; then every run is evaluated and the tables written, as a
-//! local `table1` does.
+//! local `table1`, `sweep` or `run` + `report` does.
 
 use std::collections::BTreeMap;
 use std::path::Path;
@@ -12,12 +12,12 @@ use anyhow::{Context, Result};
 use serde_json::json;
 use sfmeval_fs::write_atomic;
 
-use crate::args::{SweepArgs, Table1Args};
+use crate::args::{RunArgs, SweepArgs, Table1Args};
 use crate::dataset::Dataset;
 use crate::files::{copy_dir, partial_name, replace_dir};
 use crate::pipelines::{parse_customs, parse_list};
-use crate::report::report;
-use crate::run::{RUN_SCHEMA, RunRecord, Status, read_record};
+use crate::report::{ReportArgs, report};
+use crate::run::{RunRecord, Status, read_record};
 use crate::slurm::plan::{CellPlan, Job, Plan, Stage};
 use crate::slurm::state::{dataset_done, end_reason, task_done};
 use crate::sweep::variants::Variant;
@@ -30,6 +30,16 @@ fn why_missing(plan: &Plan, k: usize, cell: &CellPlan) -> (Status, String) {
         return (st, format!("Slurm run task {k}: {why}"));
     }
     let n = plan.render_shards;
+    if n == 0 {
+        return (
+            Status::Failed,
+            format!(
+                "dataset {} is gone: no images/ in {}",
+                cell.dataset,
+                plan.dataset_dir(&cell.dataset).display()
+            ),
+        );
+    }
     let d = plan
         .datasets
         .iter()
@@ -72,39 +82,26 @@ fn write_missing_run(
         .map(|d| d.as_secs_f64())
         .unwrap_or(0.0);
     let rec = RunRecord {
-        schema: RUN_SCHEMA.into(),
-        dataset: cell.dataset.clone(),
-        dataset_dir: dataset_dir.to_string_lossy().to_string(),
-        pipeline: cell.pipeline.clone(),
-        kind: kind_tool.0,
-        tool: kind_tool.1,
-        version: None,
         status,
         reason: Some(reason.clone()),
-        command: Vec::new(),
-        options,
-        wall_seconds: 0.0,
-        cpu_seconds: 0.0,
-        peak_memory_bytes: 0,
-        exit_status: None,
-        images_total: Dataset::open(&dataset_dir).map_or(0, |d| d.image_count),
-        images_registered: 0,
-        points: 0,
-        models: 0,
-        started_unix: 0.0,
         finished_unix: now,
-        log: "log.txt".into(),
-        steps: Vec::new(),
         warnings: vec![
-            "no result from its Slurm task: `sfmeval-runner table1 --executor slurm --resume` redoes it"
-                .into(),
+            "no result from its Slurm task: the batch's command with --resume redoes it".into(),
         ],
-        tool_report: serde_json::Value::Null,
+        ..RunRecord::not_run(
+            &cell.dataset,
+            &dataset_dir,
+            Dataset::open(&dataset_dir).map_or(0, |d| d.image_count),
+            &cell.pipeline,
+            &kind_tool.0,
+            &kind_tool.1,
+            options,
+        )
     };
     let tmp = partial_name(dest);
     std::fs::create_dir_all(&tmp).with_context(|| format!("creating {}", tmp.display()))?;
     write_atomic(
-        &tmp.join("log.txt"),
+        &tmp.join(&rec.log),
         format!("# {}: {reason}\n", status.label()).as_bytes(),
     )?;
     let mut text = serde_json::to_string_pretty(&rec)?;
@@ -203,7 +200,7 @@ fn render_times(
 
 /// Merges the runs, marks the missing ones, evaluates and writes what the local command
 /// writes: `table/` and `table1.json` for `table1`; `table/`, `sweep.csv`, `charts/`,
-/// `sweep.html` and `sweep.json` for `sweep`.
+/// `sweep.html` and `sweep.json` for `sweep`; `report`'s `table/` and `batch.json` for `run`.
 pub fn collect(plan: &Plan) -> Result<()> {
     let t0 = Instant::now();
     let job = plan.job()?;
@@ -211,12 +208,13 @@ pub fn collect(plan: &Plan) -> Result<()> {
     match &job {
         Job::Table1(a) => table1_results(plan, a, &merged, t0),
         Job::Sweep(a) => sweep_results(plan, a, &merged, t0),
+        Job::Run(a) => run_results(plan, a, &merged, t0),
     }
 }
 
 /// The sweep's outputs: a variant whose dataset was not finalized is a failed variant.
 fn sweep_results(plan: &Plan, a: &SweepArgs, merged: &Merged, t0: Instant) -> Result<()> {
-    let sweep_plan = SweepPlan::new(a, &plan.python, &plan.blender_scripts)?;
+    let sweep_plan = SweepPlan::new(a, &plan.python, plan.blender_scripts()?)?;
     let (frame_seconds, _) = render_times(plan);
     let variants: Vec<Variant> = sweep_plan
         .planned
@@ -247,16 +245,36 @@ fn sweep_results(plan: &Plan, a: &SweepArgs, merged: &Merged, t0: Instant) -> Re
     )
 }
 
+/// Evaluates `OUT/runs/` into `OUT/table/` as `report` does, prints `table1.md` and a summary
+/// line; returns the seconds it took.
+fn write_tables(plan: &Plan, args: &ReportArgs, merged: &Merged) -> Result<f64> {
+    let t = Instant::now();
+    let rows = report(args)?;
+    let seconds = t.elapsed().as_secs_f64();
+    let t1 = std::fs::read_to_string(args.out.join("table1.md")).unwrap_or_default();
+    println!("{t1}");
+    eprintln!(
+        "collect: {} run(s), {} without result; tables in {}",
+        rows.len(),
+        merged.without_result.len(),
+        plan.out.join("table").display()
+    );
+    Ok(seconds)
+}
+
+/// Writes `doc` as `OUT/<name>`.
+fn write_json(plan: &Plan, name: &str, doc: &serde_json::Value) -> Result<()> {
+    let mut text = serde_json::to_string_pretty(doc)?;
+    text.push('\n');
+    write_atomic(&plan.out.join(name), text.as_bytes())
+}
+
 /// `table/` and `table1.json`.
 fn table1_results(plan: &Plan, a: &Table1Args, merged: &Merged, t0: Instant) -> Result<()> {
-    let table = plan.out.join("table");
-    let t_rep = Instant::now();
-    let rows = report(&crate::table1::report_args(
-        a,
-        &plan.out.join("runs"),
-        &table,
-    )?)?;
-    let report_seconds = t_rep.elapsed().as_secs_f64();
+    let args = a
+        .eval
+        .report_args(&plan.out.join("runs"), &plan.out.join("table"))?;
+    let report_seconds = write_tables(plan, &args, merged)?;
     let (frame_seconds, per_view) = render_times(plan);
     let doc = json!({
         "quick": a.quick,
@@ -274,16 +292,27 @@ fn table1_results(plan: &Plan, a: &Table1Args, merged: &Merged, t0: Instant) -> 
             "collect_seconds": t0.elapsed().as_secs_f64(),
         },
     });
-    let mut text = serde_json::to_string_pretty(&doc)?;
-    text.push('\n');
-    write_atomic(&plan.out.join("table1.json"), text.as_bytes())?;
-    let t1 = std::fs::read_to_string(table.join("table1.md")).unwrap_or_default();
-    println!("{t1}");
-    eprintln!(
-        "collect: {} run(s), {} without result; tables in {}",
-        rows.len(),
-        merged.without_result.len(),
-        table.display()
-    );
-    Ok(())
+    write_json(plan, "table1.json", &doc)
+}
+
+/// `run`'s batch: `report`'s `table/` and `batch.json` (the datasets, pipelines, tasks without
+/// result and times).
+fn run_results(plan: &Plan, a: &RunArgs, merged: &Merged, t0: Instant) -> Result<()> {
+    let args = a
+        .eval
+        .report_args(&plan.out.join("runs"), &plan.out.join("table"))?;
+    let report_seconds = write_tables(plan, &args, merged)?;
+    let doc = json!({
+        "executor": "slurm",
+        "datasets": plan.datasets.iter().map(|d| plan.dataset_dir(&d.name)).collect::<Vec<_>>(),
+        "pipelines": plan.pipelines,
+        "runs_executed": merged.executed,
+        "tasks_without_result": merged.without_result,
+        "timing": {
+            "runs_seconds": merged.runs_seconds,
+            "report_seconds": report_seconds,
+            "collect_seconds": t0.elapsed().as_secs_f64(),
+        },
+    });
+    write_json(plan, "batch.json", &doc)
 }

@@ -1,13 +1,14 @@
-//! `sfmeval-runner table1|sweep --executor slurm`: the seed experiment or a sweep as Slurm job arrays on a
-//! cluster whose nodes share the output folder, the runner binary, `blender_scripts` and the
-//! venv. Four stages, one sbatch script each under `OUT/slurm/`:
+//! `sfmeval-runner table1|sweep|run --executor slurm`: the seed experiment, a sweep or a batch of
+//! runs as Slurm job arrays on a cluster whose nodes share the output folder, the runner binary,
+//! `blender_scripts` and the venv. Four stages, one sbatch script each under `OUT/slurm/` (a
+//! `run` batch, on datasets that exist, has only the last two):
 //!
 //! 1. `render`: one task per dataset and render shard (`generate.py --views i/n`);
 //! 2. `finalize` (`afterok` on render): one task per dataset (`generate.py --finalize`);
 //! 3. `run` (`afterok` on finalize): one task per dataset × pipeline, each into its own folder;
 //! 4. `collect` (`afterany` on all): merge the runs into `OUT/runs/` (a task that left no
 //!    result becomes a failed or timed-out cell with Slurm's reason), evaluate and write the
-//!    tables, as a local `table1` does.
+//!    tables, as a local `table1` (or `run` + `report`) does.
 //!
 //! The modules: [`plan`] (what task k of a stage does, where it writes), [`resources`](mod@resources) (the
 //! per-stage `--cpus-per-task`, `--mem`, `--time`, partition, account), [`script`] (the sbatch
@@ -27,9 +28,10 @@ use std::collections::BTreeSet;
 use anyhow::{Context, Result, bail};
 use sfmeval_fs::write_atomic;
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
-use crate::args::{SlurmArgs, SweepArgs, Table1Args, ToolArgs};
+use crate::args::{RunArgs, SlurmArgs, SweepArgs, Table1Args, ToolArgs};
+use crate::dataset::Dataset;
 use crate::env::find_python;
 use crate::generator::find_blender_scripts;
 use crate::pipelines::{parse_customs, parse_list};
@@ -40,25 +42,26 @@ use crate::slurm::state::missing_tasks;
 use crate::sweep::SweepPlan;
 use crate::table1::{dataset_name, generator_args, presets};
 
-/// The plan of a batch: its command line `argv`, output folder, tools, generator, pipelines
-/// and datasets; the cells are the datasets by name × the pipelines (as `run`'s grid).
+/// The plan of a batch: its command line `argv`, output folder, tools, generator (absolute;
+/// none for `run`), pipelines and datasets (rendered in `render_shards` parts each, or, with
+/// `render_shards` 0, existing folders); the cells are the datasets by name × the pipelines
+/// (as `run`'s grid).
 fn make_plan(
     argv: Vec<String>,
     out: &Path,
     tools: &ToolArgs,
-    blender_scripts: Option<&Path>,
+    blender_scripts: Option<PathBuf>,
     pipelines: &[String],
     datasets: Vec<DatasetPlan>,
     render_shards: usize,
 ) -> Result<Plan> {
-    if render_shards == 0 {
+    if render_shards == 0 && datasets.iter().any(|d| d.dir.is_none()) {
         bail!("--render-shards must be at least 1");
     }
     let out =
         std::path::absolute(out).with_context(|| format!("resolving --out {}", out.display()))?;
     // absolute when given as a path; a bare name is looked up on each node's PATH
     let python = find_python(tools.python.as_deref())?;
-    let blender_scripts = std::path::absolute(find_blender_scripts(blender_scripts)?)?;
     let runner = std::env::current_exe().context("locating the sfmeval-runner binary")?;
     let customs = parse_customs(&tools.customs)?;
     let specs = parse_list(pipelines, &customs)?;
@@ -93,8 +96,9 @@ fn make_plan(
 }
 
 /// What to submit: per dataset, its render tasks without result, then its finalize task, then
-/// its run tasks, each `afterok` on the one before it that is submitted; last the collect,
-/// `afterany` on everything submitted (always: the tables are rewritten on every submission).
+/// its run tasks, each `afterok` on the one before it that is submitted (a `run` batch has
+/// only run tasks, which wait for nothing); last the collect, `afterany` on everything
+/// submitted (always: the tables are rewritten on every submission).
 fn submissions(plan: &Plan) -> Vec<Submission> {
     let missing: Vec<Vec<usize>> = [Stage::Render, Stage::Finalize, Stage::Run]
         .into_iter()
@@ -157,18 +161,63 @@ pub fn submit_table1(a: &Table1Args) -> Result<()> {
             generator_args: generator_args(&p, a.quick, &a.generator.sets),
             name: dataset_name(&p, a.quick),
             preset: p,
+            dir: None,
         });
     }
+    let scripts = std::path::absolute(find_blender_scripts(
+        a.generator.blender_scripts.as_deref(),
+    )?)?;
     let plan = make_plan(
         std::env::args().collect(),
         &a.out,
         &a.tools,
-        a.generator.blender_scripts.as_deref(),
+        Some(scripts),
         &a.pipelines,
         datasets,
         a.slurm.render_shards,
     )?;
-    submit_plan(&plan, &a.slurm, a.generator.fresh)
+    submit_plan(&plan, &a.slurm, a.resume, a.generator.fresh)
+}
+
+/// `run --executor slurm`: one task per dataset × pipeline on the existing datasets, then the
+/// collect, which merges the runs into `OUT/runs/` and writes `report`'s tables into
+/// `OUT/table/`.
+pub fn submit_run(a: &RunArgs) -> Result<()> {
+    a.batch.exec.check()?;
+    a.eval.eval_options()?;
+    a.eval.align_request()?;
+    if a.batch.shard.is_some() {
+        bail!("--shard goes with the local executor: a Slurm batch runs one task per cell");
+    }
+    if a.batch.retry_failed {
+        bail!(
+            "--retry-failed goes with the local executor: a Slurm batch's --resume redoes the \
+             tasks without result"
+        );
+    }
+    let datasets = a
+        .datasets
+        .iter()
+        .map(|d| {
+            let ds = Dataset::open(d)?;
+            Ok(DatasetPlan {
+                preset: ds.name.clone(),
+                name: ds.name,
+                generator_args: Vec::new(),
+                dir: Some(ds.dir),
+            })
+        })
+        .collect::<Result<Vec<_>>>()?;
+    let plan = make_plan(
+        std::env::args().collect(),
+        &a.out,
+        &a.batch.tools,
+        None,
+        &a.batch.pipelines,
+        datasets,
+        0,
+    )?;
+    submit_plan(&plan, &a.slurm, a.batch.resume, false)
 }
 
 /// `sweep --executor slurm`: one dataset per factor value, made by the same generator
@@ -198,6 +247,7 @@ pub fn submit_sweep(a: &SweepArgs) -> Result<()> {
                 preset: pl.text.clone(),
                 name: pl.dataset.clone(),
                 generator_args: args,
+                dir: None,
             }
         })
         .collect();
@@ -205,17 +255,17 @@ pub fn submit_sweep(a: &SweepArgs) -> Result<()> {
         std::env::args().collect(),
         &a.out,
         &a.tools,
-        Some(&scripts),
+        Some(scripts),
         &a.pipelines,
         datasets,
         a.slurm.render_shards,
     )?;
-    submit_plan(&plan, &a.slurm, a.generator.fresh)
+    submit_plan(&plan, &a.slurm, a.resume, a.generator.fresh)
 }
 
-/// Checks a resumed batch against its plan (or refuses to overwrite one), writes the plan
-/// and the scripts and, unless `--dry-run`, submits them.
-fn submit_plan(plan: &Plan, slurm: &SlurmArgs, fresh: bool) -> Result<()> {
+/// Checks a resumed batch (`resume`) against its plan (or refuses to overwrite one), writes
+/// the plan and the scripts and, unless `--dry-run`, submits them.
+fn submit_plan(plan: &Plan, slurm: &SlurmArgs, resume: bool, fresh: bool) -> Result<()> {
     if fresh {
         bail!("--fresh does not go with --executor slurm: choose a new --out");
     }
@@ -223,7 +273,7 @@ fn submit_plan(plan: &Plan, slurm: &SlurmArgs, fresh: bool) -> Result<()> {
     let plan_path = Plan::path(&plan.out);
     if plan_path.is_file() {
         let old = Plan::read(&plan_path)?;
-        if !slurm.resume {
+        if !resume {
             bail!(
                 "{} holds a Slurm batch already: add --resume to submit what is missing, or \
                  choose another --out",
@@ -232,19 +282,19 @@ fn submit_plan(plan: &Plan, slurm: &SlurmArgs, fresh: bool) -> Result<()> {
         }
         if !old.same_work(plan) {
             bail!(
-                "--resume: {} was planned with other presets, pipelines or --render-shards; \
-                 give the same ones, or choose another --out",
+                "--resume: {} was planned with other presets, datasets, pipelines or \
+                 --render-shards; give the same ones, or choose another --out",
                 plan.out.display()
             );
         }
-    } else if slurm.resume {
+    } else if resume {
         bail!(
             "--resume: {} holds no Slurm batch (no {})",
             plan.out.display(),
             plan_path.display()
         );
     }
-    if slurm.resume && !slurm.dry_run {
+    if resume && !slurm.dry_run {
         let queued = submit::still_queued(plan, &slurm.sbatch)?;
         if !queued.is_empty() {
             bail!(
@@ -254,11 +304,16 @@ fn submit_plan(plan: &Plan, slurm: &SlurmArgs, fresh: bool) -> Result<()> {
             );
         }
     }
-    for dir in [plan.slurm_dir().join("logs"), plan.out.join("datasets")] {
+    let mut dirs = vec![plan.slurm_dir().join("logs")];
+    if plan.render_shards > 0 {
+        dirs.push(plan.out.join("datasets"));
+    }
+    for dir in dirs {
         std::fs::create_dir_all(&dir).with_context(|| format!("creating {}", dir.display()))?;
     }
     let subs = submissions(plan);
-    for stage in Stage::ALL {
+    // the stages the batch has (a `run` batch renders nothing)
+    for stage in Stage::ALL.into_iter().filter(|&st| plan.task_count(st) > 0) {
         let r = res
             .get(&stage)
             .with_context(|| format!("no resources for stage {}", stage.name()))?;
@@ -316,6 +371,7 @@ mod tests {
             preset: n.into(),
             name: n.into(),
             generator_args: Vec::new(),
+            dir: None,
         };
         let cell = |d: &str, p: &str| CellPlan {
             dataset: d.into(),
@@ -327,7 +383,7 @@ mod tests {
             cwd: out.into(),
             runner: out.join("sfmeval-runner"),
             python: out.join("python"),
-            blender_scripts: out.into(),
+            blender_scripts: Some(out.into()),
             out: out.into(),
             render_shards: 2,
             datasets: vec![ds("b"), ds("a")],
@@ -341,17 +397,18 @@ mod tests {
         }
     }
 
+    /// Each submission as (label, tasks, dependency).
+    fn shape(p: &Plan) -> Vec<(String, Vec<usize>, Dependency)> {
+        submissions(p)
+            .iter()
+            .map(|s| (s.label.clone(), s.tasks.clone(), s.dependency.clone()))
+            .collect()
+    }
+
     #[test]
     fn each_dataset_is_chained_alone_and_resume_submits_what_is_missing() {
         let out = std::env::temp_dir().join(format!("sfmeval-slurm-plan-{}", std::process::id()));
         let p = plan(&out);
-        // Each submission as (label, tasks, dependency).
-        let shape = |p: &Plan| -> Vec<(String, Vec<usize>, Dependency)> {
-            submissions(p)
-                .iter()
-                .map(|s| (s.label.clone(), s.tasks.clone(), s.dependency.clone()))
-                .collect()
-        };
         assert_eq!(
             shape(&p),
             vec![
@@ -391,6 +448,47 @@ mod tests {
                 ),
             ]
         );
+        let _ = std::fs::remove_dir_all(&out);
+    }
+
+    #[test]
+    fn a_run_batch_has_only_run_tasks_on_the_datasets_where_they_are() {
+        let out = std::env::temp_dir().join(format!("sfmeval-slurm-run-{}", std::process::id()));
+        let mut p = plan(&out);
+        p.render_shards = 0;
+        p.blender_scripts = None;
+        for d in &mut p.datasets {
+            d.dir = Some(out.join("given").join(&d.name));
+        }
+        assert_eq!(p.task_count(Stage::Render), 0);
+        assert_eq!(p.task_count(Stage::Finalize), 0);
+        assert_eq!(p.task_count(Stage::Run), 4);
+        assert_eq!(p.dataset_dir("a"), out.join("given").join("a"));
+        assert!(p.blender_scripts().is_err());
+        assert_eq!(
+            shape(&p),
+            vec![
+                ("run_0".into(), vec![2, 3], Dependency::None),
+                ("run_1".into(), vec![0, 1], Dependency::None),
+                ("collect".into(), vec![0], Dependency::AfterAny(vec![0, 1])),
+            ]
+        );
+        // Task 2 (b/p) finished: a resume submits the other three, then collects.
+        let run = p.task_runs(2).join("b").join("p");
+        std::fs::create_dir_all(&run).unwrap();
+        std::fs::write(run.join("run.json"), "{}").unwrap();
+        assert_eq!(
+            shape(&p),
+            vec![
+                ("run_0".into(), vec![3], Dependency::None),
+                ("run_1".into(), vec![0, 1], Dependency::None),
+                ("collect".into(), vec![0], Dependency::AfterAny(vec![0, 1])),
+            ]
+        );
+        // A dataset folder is ready when it has its images (no dataset.json needed).
+        assert!(!state::dataset_done(&p, "a"));
+        std::fs::create_dir_all(out.join("given").join("a").join("images")).unwrap();
+        assert!(state::dataset_done(&p, "a"));
         let _ = std::fs::remove_dir_all(&out);
     }
 }

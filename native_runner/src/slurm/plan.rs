@@ -1,6 +1,6 @@
-//! The plan of a Slurm batch, `OUT/slurm/plan.json`: the `table1` command it was made from,
-//! its datasets (each rendered in `render_shards` parts) and its cells (dataset × pipeline),
-//! and where every task reads and writes. Task `k` of a stage means the same work in every
+//! The plan of a Slurm batch, `OUT/slurm/plan.json`: the `table1`, `sweep` or `run` command it
+//! was made from, its datasets (each rendered in `render_shards` parts, or existing folders for
+//! `run`) and its cells (dataset × pipeline), and where every task reads and writes. Task `k` of a stage means the same work in every
 //! submission of the batch, so a resubmitted array index redoes exactly one task.
 
 use std::path::{Path, PathBuf};
@@ -9,7 +9,7 @@ use anyhow::{Context, Result, bail};
 use clap::Parser;
 use serde::{Deserialize, Serialize};
 
-use crate::args::{Cli, Command, ExecArgs, SweepArgs, Table1Args, ToolArgs};
+use crate::args::{Cli, Command, ExecArgs, RunArgs, SweepArgs, Table1Args, ToolArgs};
 
 /// `schema` of `plan.json`.
 pub const PLAN_SCHEMA: &str = "sfmeval.slurm-plan/1";
@@ -17,9 +17,9 @@ pub const PLAN_SCHEMA: &str = "sfmeval.slurm-plan/1";
 /// A stage of the batch: one sbatch script, a job array (except `collect`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
 pub enum Stage {
-    /// One task per dataset and render shard: `generate.py --views i/n`.
+    /// One task per dataset and render shard: `generate.py --views i/n` (none in a `run` batch).
     Render,
-    /// One task per dataset: `generate.py --finalize`.
+    /// One task per dataset: `generate.py --finalize` (none in a `run` batch).
     Finalize,
     /// One task per dataset × pipeline: the run into its own folder.
     Run,
@@ -57,6 +57,8 @@ pub enum Job {
     Table1(Box<Table1Args>),
     /// `sweep`: one condition varied.
     Sweep(Box<SweepArgs>),
+    /// `run`: pipelines on existing datasets.
+    Run(Box<RunArgs>),
 }
 
 impl Job {
@@ -65,6 +67,7 @@ impl Job {
         match self {
             Job::Table1(a) => &a.tools,
             Job::Sweep(a) => &a.tools,
+            Job::Run(a) => &a.batch.tools,
         }
     }
 
@@ -73,6 +76,7 @@ impl Job {
         match self {
             Job::Table1(a) => &a.exec,
             Job::Sweep(a) => &a.exec,
+            Job::Run(a) => &a.batch.exec,
         }
     }
 
@@ -81,19 +85,29 @@ impl Job {
         match self {
             Job::Table1(a) => &a.pipelines,
             Job::Sweep(a) => &a.pipelines,
+            Job::Run(a) => &a.batch.pipelines,
         }
+    }
+
+    /// Whether the tools' scratch files stay in the run folders (`run --keep-scratch`).
+    pub fn keep_scratch(&self) -> bool {
+        matches!(self, Job::Run(a) if a.batch.keep_scratch)
     }
 }
 
 /// One dataset of the batch.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct DatasetPlan {
-    /// What it stands for: the generator preset (`table1`) or the factor value (`sweep`).
+    /// What it stands for: the generator preset (`table1`), the factor value (`sweep`) or
+    /// the folder name (`run`).
     pub preset: String,
-    /// Folder name under `OUT/datasets/`.
+    /// Folder name under `OUT/datasets/` (`run`: the existing folder's name).
     pub name: String,
     /// The generator's arguments (without `--views`, `--finalize`, `--out`).
     pub generator_args: Vec<String>,
+    /// An existing dataset folder (`run`): not rendered, read where it is.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub dir: Option<PathBuf>,
 }
 
 /// One cell of the table: a pipeline on a dataset (run task `k` is `cells[k]`).
@@ -110,7 +124,8 @@ pub struct CellPlan {
 pub struct Plan {
     /// Always [`PLAN_SCHEMA`].
     pub schema: String,
-    /// The `sfmeval-runner table1|sweep ...` command line; every task reads its options from it.
+    /// The `sfmeval-runner table1|sweep|run ...` command line; every task reads its options
+    /// from it.
     pub argv: Vec<String>,
     /// The folder it was given in: the tasks start there.
     pub cwd: PathBuf,
@@ -118,11 +133,12 @@ pub struct Plan {
     pub runner: PathBuf,
     /// The venv's Python (bpy and the SfM tools).
     pub python: PathBuf,
-    /// The generator's folder (`blender_scripts`).
-    pub blender_scripts: PathBuf,
+    /// The generator's folder (`blender_scripts`; none in a `run` batch).
+    pub blender_scripts: Option<PathBuf>,
     /// The batch's output folder (absolute).
     pub out: PathBuf,
-    /// Render tasks per dataset.
+    /// Render tasks per dataset; 0 in a `run` batch, whose datasets exist (no render or
+    /// finalize task).
     pub render_shards: usize,
     /// The datasets, in preset order.
     pub datasets: Vec<DatasetPlan>,
@@ -149,14 +165,23 @@ impl Plan {
         Ok(plan)
     }
 
-    /// The command of the batch (`table1` or `sweep`), parsed again from [`Plan::argv`].
+    /// The command of the batch (`table1`, `sweep` or `run`), parsed again from
+    /// [`Plan::argv`].
     pub fn job(&self) -> Result<Job> {
         let cli = Cli::try_parse_from(&self.argv).context("the plan's command line")?;
         match cli.command {
             Command::Table1(a) => Ok(Job::Table1(Box::new(a))),
             Command::Sweep(a) => Ok(Job::Sweep(Box::new(a))),
-            _ => bail!("the plan's command line is neither table1 nor sweep"),
+            Command::Run(a) => Ok(Job::Run(Box::new(a))),
+            _ => bail!("the plan's command line is not table1, sweep or run"),
         }
+    }
+
+    /// The generator's folder (a batch that renders has one).
+    pub fn blender_scripts(&self) -> Result<&Path> {
+        self.blender_scripts
+            .as_deref()
+            .context("the plan names no blender_scripts folder (a run batch renders nothing)")
     }
 
     /// Whether `other` does the same work (datasets, shards, cells): a batch may only be
@@ -171,6 +196,7 @@ impl Plan {
     pub fn task_count(&self, stage: Stage) -> usize {
         match stage {
             Stage::Render => self.datasets.len() * self.render_shards,
+            Stage::Finalize if self.render_shards == 0 => 0,
             Stage::Finalize => self.datasets.len(),
             Stage::Run => self.cells.len(),
             Stage::Collect => 1,
@@ -206,9 +232,13 @@ impl Plan {
             .with_context(|| format!("run task {k}: the plan has {} cells", self.cells.len()))
     }
 
-    /// `OUT/datasets/<name>`.
+    /// The folder of dataset `name`: its existing folder (`run`), else `OUT/datasets/<name>`.
     pub fn dataset_dir(&self, name: &str) -> PathBuf {
-        self.out.join("datasets").join(name)
+        self.datasets
+            .iter()
+            .find(|d| d.name == name)
+            .and_then(|d| d.dir.clone())
+            .unwrap_or_else(|| self.out.join("datasets").join(name))
     }
 
     /// `OUT/slurm/`: plan, scripts, logs, the run tasks' folders.

@@ -154,7 +154,7 @@ pub fn sbatch_args(sub: &Submission, job_of: impl Fn(usize) -> Option<String>) -
 pub fn submit_sh(plan: &Plan, subs: &[Submission], sbatch: &str) -> String {
     let mut s = String::from("#!/bin/bash\n");
     s.push_str(&format!(
-        "# Submits the stages of {} in order (what `sfmeval-runner table1 --executor slurm` does\n# without --dry-run).\nset -euo pipefail\n",
+        "# Submits the stages of {} in order (what `sfmeval-runner ... --executor slurm` does\n# without --dry-run).\nset -euo pipefail\n",
         Plan::path(&plan.out).display()
     ));
     for sub in subs {

@@ -14,9 +14,14 @@ fn part_record(plan: &Plan, dataset: &str, shard: usize) -> std::path::PathBuf {
         .join(format!("views-{shard}-of-{}.json", plan.render_shards))
 }
 
-/// Whether a dataset is finalized (its `dataset.json` is written last).
+/// Whether a dataset is ready: finalized (its `dataset.json` is written last), or, in a `run`
+/// batch, an existing folder with its `images/`.
 pub fn dataset_done(plan: &Plan, dataset: &str) -> bool {
-    plan.dataset_dir(dataset).join("dataset.json").is_file()
+    let dir = plan.dataset_dir(dataset);
+    if plan.render_shards == 0 {
+        return dir.join("images").is_dir();
+    }
+    dir.join("dataset.json").is_file()
 }
 
 /// Whether task `k` of `stage` left its result (a task whose result is there has nothing to do).

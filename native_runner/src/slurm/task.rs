@@ -11,7 +11,7 @@ use crate::args::{SlurmTaskArgs, ToolArgs};
 use crate::dataset::Dataset;
 use crate::env::make_env;
 use crate::pipelines::{parse_customs, parse_list};
-use crate::run::run_batch;
+use crate::run::{BatchOptions, run_batch};
 use crate::slurm::collect::collect;
 use crate::slurm::plan::{DatasetPlan, Plan, Stage};
 use crate::slurm::state::{dataset_done, task_done};
@@ -50,7 +50,7 @@ pub fn slurm_task(a: &SlurmTaskArgs) -> Result<()> {
 /// `generate.py ARGS EXTRA --out OUT/datasets/<name>`, its output into the task's log.
 fn generator(plan: &Plan, ds: &DatasetPlan, extra: &[&str]) -> Result<()> {
     let dir = plan.dataset_dir(&ds.name);
-    let script = plan.blender_scripts.join("generate.py");
+    let script = plan.blender_scripts()?.join("generate.py");
     eprintln!(
         "{}: {} {} {} {} --out {}",
         ds.name,
@@ -96,7 +96,10 @@ fn run_cell(plan: &Plan, k: usize) -> Result<()> {
         ..job.tools().clone()
     };
     let env = make_env(&tools, &out)?;
-    let opts = job.exec().batch_options(&out, true, false)?;
+    let opts = BatchOptions {
+        keep_scratch: job.keep_scratch(),
+        ..job.exec().batch_options(&out, true, false)?
+    };
     let summary = run_batch(&[dataset], &[spec], &customs, &env, &opts)?;
     eprintln!(
         "run task {k}: {}/{}: {:?}",

@@ -81,7 +81,7 @@ pub fn sweep(a: &SweepArgs) -> Result<()> {
     let t0 = Instant::now();
     parse_factor(&a.factor)?;
     a.exec.check()?;
-    a.slurm.check_local()?;
+    a.slurm.check_local(a.resume)?;
     // absolute paths: the generator runs in the datasets folder
     let python = find_python(a.tools.python.as_deref())?;
     let scripts = std::path::absolute(find_blender_scripts(
