@@ -8,8 +8,9 @@
 # reports equal the CLI's, and without the headers the single-thread fallback; tests/browser/ux.mjs:
 # layout at 1366×768 and 1920×1080, errors in view, keyboard, axe-core, cancel; tests/browser/compare.mjs:
 # a runner runs folder compared in the page equals `sfmeval-runner report`'s table and reports).
-# SFMEVAL_BENCH=1 also runs the speed benchmarks (bench/data; not tests): whole eval in the page,
-# and per operation in Node (tests/browser/bench-ops.mjs).
+# SFMEVAL_BENCH=1 also runs the speed benchmarks (bench/data; not tests): whole eval in the page
+# with threads off and on against native with 1 and 2 threads (tests/browser/bench.mjs), and per
+# operation in Node (tests/browser/bench-ops.mjs).
 # Ends with "N passed, N failed".
 set -uo pipefail
 cd "$(dirname "$0")/.."
