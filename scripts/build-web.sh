@@ -55,6 +55,10 @@ bindgen "$raw_wasm" "$OUT/pkg"
 # two builds' flags do not invalidate each other. SFMEVAL_THREADS=0 skips it (the page then runs
 # its single-thread build everywhere).
 if [ "${SFMEVAL_THREADS:-1}" != 0 ]; then
+  if ! rustup component list --installed 2>/dev/null | grep -q '^rust-src'; then
+    echo "build-web: rustup component add rust-src (for -Z build-std; scripts/setup.sh does this)"
+    rustup component add rust-src
+  fi
   echo "build-web: cargo build (wasm32, threads + SIMD128, release)"
   mt_target=$TARGET_DIR/wasm-threads
   # the link of the final module only: shared memory (imported, so every worker gets the same
