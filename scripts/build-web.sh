@@ -2,7 +2,9 @@
 # Builds the WebAssembly core once and assembles from it:
 #   target/web/npm/            the npm package `sfmeval` (ESM + TypeScript declarations)
 #   target/web/sfmeval-*.tgz   that package packed by `npm pack`
-#   target/web/site/           the static page (www/ + the package + vendored three.js/uPlot + demo)
+#   target/web/site/           the static page (www/ + the package + vendored three.js/uPlot + demo),
+#                              with the threaded build in site/sfmeval-mt/
+#   target/web/pkg-mt/         the threaded + SIMD128 build (for the page only)
 # Downloads nothing at build time once scripts/setup-extra.sh (or a first run) has installed
 # wasm-bindgen-cli (pinned to Cargo.lock's wasm-bindgen) into .tools/ and the npm dev packages.
 set -euo pipefail
@@ -27,19 +29,52 @@ cargo build --release --locked --target wasm32-unknown-unknown -p sfmeval-wasm
 raw_wasm=$TARGET_DIR/wasm32-unknown-unknown/release/sfmeval_wasm.wasm
 
 mkdir -p "$OUT"
-rm -rf "$OUT/pkg.tmp"
-wasm-bindgen --target web --out-dir "$OUT/pkg.tmp" "$raw_wasm"
-# wasm-opt takes ~20 s: skip it when wasm-bindgen's output did not change.
-hash=$(sha256sum "$OUT/pkg.tmp/sfmeval_wasm_bg.wasm" | cut -d' ' -f1)
-if [ -f "$OUT/pkg/.source-hash" ] && [ "$(cat "$OUT/pkg/.source-hash")" = "$hash" ]; then
-  cp "$OUT/pkg/sfmeval_wasm_bg.wasm" "$OUT/pkg.tmp/sfmeval_wasm_bg.wasm"
+# wasm-bindgen, then wasm-opt -O3 (~20 s; skipped when wasm-bindgen's output did not change).
+# Usage: bindgen RAW_WASM OUT_DIR [wasm-opt feature flags...]
+bindgen() {
+  local raw=$1 dir=$2 hash; shift 2
+  rm -rf "$dir.tmp"
+  wasm-bindgen --target web --out-dir "$dir.tmp" "$raw"
+  hash=$(sha256sum "$dir.tmp/sfmeval_wasm_bg.wasm" | cut -d' ' -f1)
+  if [ -f "$dir/.source-hash" ] && [ "$(cat "$dir/.source-hash")" = "$hash" ]; then
+    cp "$dir/sfmeval_wasm_bg.wasm" "$dir.tmp/sfmeval_wasm_bg.wasm"
+  else
+    echo "build-web: wasm-opt -O3 $*"
+    crates/sfmeval-wasm/js/node_modules/.bin/wasm-opt -O3 "$@" "$dir.tmp/sfmeval_wasm_bg.wasm" -o "$dir.tmp/opt.wasm"
+    mv "$dir.tmp/opt.wasm" "$dir.tmp/sfmeval_wasm_bg.wasm"
+  fi
+  echo "$hash" > "$dir.tmp/.source-hash"
+  rm -rf "$dir" && mv "$dir.tmp" "$dir"
+}
+bindgen "$raw_wasm" "$OUT/pkg"
+
+# The threaded build, which the page loads where it is cross-origin isolated and has SIMD: the
+# core's rayon maps on a pool of Web Workers (wasm-bindgen-rayon) over shared memory, compiled
+# with SIMD128. Threads need std rebuilt with atomics: -Z build-std on the stable toolchain
+# (RUSTC_BOOTSTRAP=1; rust-src comes from scripts/setup.sh), in its own target dir so that the
+# two builds' flags do not invalidate each other. SFMEVAL_THREADS=0 skips it (the page then runs
+# its single-thread build everywhere).
+if [ "${SFMEVAL_THREADS:-1}" != 0 ]; then
+  if ! rustup component list --installed 2>/dev/null | grep -q '^rust-src'; then
+    echo "build-web: rustup component add rust-src (for -Z build-std; scripts/setup.sh does this)"
+    rustup component add rust-src
+  fi
+  echo "build-web: cargo build (wasm32, threads + SIMD128, release)"
+  mt_target=$TARGET_DIR/wasm-threads
+  # the link of the final module only: shared memory (imported, so every worker gets the same
+  # one; up to 4 GB) and the TLS exports wasm-bindgen's thread start-up calls
+  RUSTC_BOOTSTRAP=1 CARGO_TARGET_DIR=$mt_target \
+    RUSTFLAGS="-C target-feature=+atomics,+bulk-memory,+mutable-globals,+simd128 -C link-arg=--max-memory=4294967296" \
+    cargo rustc --release --locked --target wasm32-unknown-unknown -Z build-std=panic_abort,std \
+    -p sfmeval-wasm --features threads --lib --crate-type cdylib -- \
+    -C link-arg=--shared-memory -C link-arg=--import-memory -C link-arg=--export=__wasm_init_tls \
+    -C link-arg=--export=__tls_size -C link-arg=--export=__tls_align -C link-arg=--export=__tls_base
+  bindgen "$mt_target/wasm32-unknown-unknown/release/sfmeval_wasm.wasm" "$OUT/pkg-mt" \
+    --enable-threads --enable-bulk-memory --enable-mutable-globals --enable-simd --enable-sign-ext \
+    --enable-nontrapping-float-to-int --enable-reference-types --enable-multivalue
 else
-  echo "build-web: wasm-opt -O3"
-  crates/sfmeval-wasm/js/node_modules/.bin/wasm-opt -O3 "$OUT/pkg.tmp/sfmeval_wasm_bg.wasm" -o "$OUT/pkg.tmp/opt.wasm"
-  mv "$OUT/pkg.tmp/opt.wasm" "$OUT/pkg.tmp/sfmeval_wasm_bg.wasm"
+  rm -rf "$OUT/pkg-mt"
 fi
-echo "$hash" > "$OUT/pkg.tmp/.source-hash"
-rm -rf "$OUT/pkg" && mv "$OUT/pkg.tmp" "$OUT/pkg"
 
 # npm package
 rm -rf "$OUT/npm" && mkdir -p "$OUT/npm"
@@ -53,6 +88,11 @@ SITE=$OUT/site
 rm -rf "$SITE" && mkdir -p "$SITE/sfmeval" "$SITE/vendor/three/addons/controls" "$SITE/vendor/uplot" "$SITE/demo"
 cp www/*.html www/*.js www/*.css "$SITE/"
 cp "$OUT"/npm/*.js "$OUT"/npm/*.wasm "$SITE/sfmeval/"
+if [ -d "$OUT/pkg-mt" ]; then # the threaded build behind the same API (www/worker.js picks one)
+  mkdir -p "$SITE/sfmeval-mt"
+  cp crates/sfmeval-wasm/js/index.js "$SITE/sfmeval-mt/"
+  cp -r "$OUT"/pkg-mt/sfmeval_wasm.js "$OUT"/pkg-mt/sfmeval_wasm_bg.wasm "$OUT"/pkg-mt/snippets "$SITE/sfmeval-mt/"
+fi
 three=www/node_modules/three
 cp "$three/build/three.module.js" "$three/build/three.core.js" "$three/LICENSE" "$SITE/vendor/three/"
 cp "$three/examples/jsm/controls/OrbitControls.js" "$three/examples/jsm/controls/TransformControls.js" \
@@ -84,4 +124,6 @@ PY
 fi
 
 wasm=$OUT/pkg/sfmeval_wasm_bg.wasm
-echo "build-web: wasm $(stat -c %s "$wasm") bytes, $(gzip -9c "$wasm" | wc -c) gzipped; package $(ls "$OUT"/sfmeval-*.tgz); site $SITE ($((SECONDS - t0)) s)"
+mt=$OUT/pkg-mt/sfmeval_wasm_bg.wasm
+[ -f "$mt" ] && mt_size="; threaded $(stat -c %s "$mt") bytes, $(gzip -9c "$mt" | wc -c) gzipped" || mt_size="; no threaded build"
+echo "build-web: wasm $(stat -c %s "$wasm") bytes, $(gzip -9c "$wasm" | wc -c) gzipped$mt_size; package $(ls "$OUT"/sfmeval-*.tgz); site $SITE ($((SECONDS - t0)) s)"

@@ -24,6 +24,8 @@ fi
 
 # --- Rust ------------------------------------------------------------------
 rustup target list --installed | grep -q wasm32-unknown-unknown || rustup target add wasm32-unknown-unknown
+# the standard library's source: the page's threaded wasm rebuilds std with atomics (-Z build-std)
+rustup component list --installed | grep -q '^rust-src' || rustup component add rust-src
 
 # --- Python venv -----------------------------------------------------------
 if [ ! -x .venv/bin/python ]; then

@@ -3,12 +3,15 @@
 # then runs the wasm-bindgen tests (Node and headless Chromium), the packed npm tarball in Node
 # and in a bundler-free page in Chromium (report byte for byte the CLI's), every alignment path
 # through the npm package in Node against the CLI (byte for byte), and the page end to end in
-# Chromium via playwright-core (tests/browser/e2e.mjs: results equal the CLI's; tests/browser/dense.mjs:
+# Chromium via playwright-core, served with the COOP/COEP headers so that it runs its threaded build
+# (tests/browser/e2e.mjs: results equal the CLI's; tests/browser/threads.mjs: the threaded build's
+# reports equal the CLI's, and without the headers the single-thread fallback; tests/browser/dense.mjs:
 # a dense PLY streamed into the page, a too-large one refused; tests/browser/ux.mjs:
 # layout at 1366×768 and 1920×1080, errors in view, keyboard, axe-core, cancel; tests/browser/compare.mjs:
 # a runner runs folder compared in the page equals `sfmeval-runner report`'s table and reports).
-# SFMEVAL_BENCH=1 also runs the speed benchmarks (bench/data; not tests): whole eval in the page,
-# and per operation in Node (tests/browser/bench-ops.mjs).
+# SFMEVAL_BENCH=1 also runs the speed benchmarks (bench/data; not tests): whole eval in the page
+# with threads off and on against native with 1 and 2 threads (tests/browser/bench.mjs), and per
+# operation in Node (tests/browser/bench-ops.mjs).
 # Ends with "N passed, N failed".
 set -uo pipefail
 cd "$(dirname "$0")/.."
@@ -83,13 +86,27 @@ echo "npm: $((SECONDS - t)) s"
 # the page in Chromium
 t=$SECONDS
 port=$(python3 -c 'import socket; s=socket.socket(); s.bind(("127.0.0.1", 0)); print(s.getsockname()[1])')
-python3 -m http.server "$port" --bind 127.0.0.1 --directory target/web/site >"$log/http.log" 2>&1 &
+# served as a static host must serve it: with COOP/COEP (cross-origin isolated, so threaded);
+# a second server without them for the single-thread fallback (tests/browser/threads.mjs)
+python3 scripts/serve_site.py "$port" --directory target/web/site >"$log/http.log" 2>&1 &
 server=$!
-trap 'kill $server 2>/dev/null' EXIT
-for _ in $(seq 50); do curl -sf "http://127.0.0.1:$port/" >/dev/null && break; sleep 0.1; done
+plain_port=$(python3 -c 'import socket; s=socket.socket(); s.bind(("127.0.0.1", 0)); print(s.getsockname()[1])')
+python3 scripts/serve_site.py "$plain_port" --no-isolation --directory target/web/site >"$log/http-plain.log" 2>&1 &
+plain_server=$!
+trap 'kill $server $plain_server 2>/dev/null' EXIT
+for p in "$port" "$plain_port"; do
+  for _ in $(seq 50); do curl -sf "http://127.0.0.1:$p/" >/dev/null && break; sleep 0.1; done
+done
 node tests/browser/e2e.mjs --url "http://127.0.0.1:$port/" --cli target/release/sfmeval --out "$out" >"$log/e2e.log" 2>&1
 count e2e "$log/e2e.log" $?
 echo "e2e: $((SECONDS - t)) s (screenshots in $out)"
+# the threaded build where the page is isolated (reports byte for byte the CLI's), the
+# single-thread fallback with its note where it is not
+t=$SECONDS
+node tests/browser/threads.mjs --url "http://127.0.0.1:$port/" --plain-url "http://127.0.0.1:$plain_port/" \
+  --cli target/release/sfmeval --out "$out" --depth "$out/demo-depth" >"$log/threads.log" 2>&1
+count threads "$log/threads.log" $?
+echo "threads: $((SECONDS - t)) s"
 # the page as a person uses it: layout at two window sizes, errors, keyboard, axe-core, cancel
 t=$SECONDS
 node tests/browser/ux.mjs --url "http://127.0.0.1:$port/" --out "$out" >"$log/ux.log" 2>&1
@@ -140,6 +157,6 @@ if [ "${SFMEVAL_BENCH:-0}" = 1 ]; then
   cargo build --release --locked -q -p sfmeval --features parallel --example bench_op &&
     node tests/browser/bench-ops.mjs 2>&1 | tee "$log/bench-ops.log"
 fi
-kill $server 2>/dev/null
+kill $server $plain_server 2>/dev/null
 echo "$passed passed, $failed failed"
 [ "$failed" -eq 0 ]

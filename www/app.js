@@ -29,6 +29,11 @@ class Cancelled extends Error {
 }
 let worker = null;
 let nextId = 1;
+/** `?threads=N`: the worker pool's size (0 or 1: the single-thread build); default all cores. */
+const threadsParam = (() => {
+  const v = new URLSearchParams(location.search).get('threads');
+  return v !== null && /^\d+$/.test(v) ? Number(v) : undefined;
+})();
 const pending = new Map();
 function startWorker() {
   worker = new Worker(new URL('./worker.js', import.meta.url), { type: 'module' });
@@ -58,7 +63,7 @@ async function restartWorker() {
   pending.clear();
   for (const p of stopped) p.reject(new Cancelled());
   startWorker();
-  await call('init');
+  await call('init', { threads: threadsParam });
   const reload = async (type, src, extra = {}) => {
     if (!src) return;
     const { files, transfer } = await readFiles(src.files);
@@ -968,8 +973,16 @@ $('dl-csv').onclick = async () => {
 };
 
 // ---- start ------------------------------------------------------------------------------
-call('init').then((m) => {
-  $('version').textContent = `core ${m.version}`;
+call('init', { threads: threadsParam }).then((m) => {
+  $('version').textContent = `core ${m.version} · ${m.threads === 1 ? '1 thread' : `${m.threads} threads`}`;
+  // threads wanted but off: say why (a static host must send the COOP/COEP headers)
+  const note = $('threads-note');
+  note.hidden = !m.threadsOff;
+  if (m.threadsOff) {
+    note.textContent = `single thread: ${m.threadsOff}`;
+    note.title = 'Multi-threading needs a cross-origin isolated page (the server sends Cross-Origin-Opener-Policy: same-origin and Cross-Origin-Embedder-Policy: require-corp) and WebAssembly SIMD; scripts/serve.sh sends both headers.';
+  }
+  document.body.dataset.threads = String(m.threads);
   document.body.dataset.ready = '1';
 }).catch((e) => showError(`could not load the WebAssembly core: ${e.message}`));
 hideProgress();

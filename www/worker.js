@@ -1,10 +1,50 @@
 // The sfmeval core runs here, off the main thread. Messages in: {id, type, ...}; out: replies
 // {id, ok, ...} or {id, ok: false, error}, and {type: 'progress', id, stage, done, total}.
-import {
-  init, version, loadGroundTruth, loadReconstruction, loadReconstructionFile, loadCameras, raw, cropFile, parseCrop,
-  parseTransform, parsePointPairs, errorColors, POSE_STRIDE, comparisonTables, runRow,
-} from './sfmeval/index.js';
+// Two builds of the core: `sfmeval-mt/` (rayon threads over shared memory, SIMD128) where the
+// page is cross-origin isolated and the browser has WebAssembly SIMD, else `sfmeval/` (one
+// thread, scalar). Both are the npm package's API; `init` picks one.
+let api = null;
+let version, loadGroundTruth, loadReconstruction, loadReconstructionFile, loadCameras, raw, cropFile, parseCrop,
+  parseTransform, parsePointPairs, errorColors, POSE_STRIDE, comparisonTables, runRow;
 
+// (module (func (result v128) i32.const 0 i8x16.splat i8x16.popcnt)): valid only with SIMD128
+const SIMD_PROBE = new Uint8Array([0, 97, 115, 109, 1, 0, 0, 0, 1, 5, 1, 96, 0, 1, 123, 3, 2, 1, 0,
+  10, 10, 1, 8, 0, 65, 0, 253, 15, 253, 98, 11]);
+
+/** Why the threaded build cannot run here (a short phrase), or null. */
+function threadsMissing() {
+  if (!self.crossOriginIsolated) return 'the page is not cross-origin isolated';
+  if (typeof SharedArrayBuffer !== 'function') return 'no SharedArrayBuffer';
+  if (!WebAssembly.validate(SIMD_PROBE)) return 'no WebAssembly SIMD';
+  return null;
+}
+
+/**
+ * Loads the threaded build with a pool of `threads` workers when it can run here and more than
+ * one thread is asked for (default: the machine's cores), else the single-thread build.
+ * Returns the build and, when threads were wanted but are off, why.
+ */
+async function loadCore(threads) {
+  const want = threads ?? navigator.hardwareConcurrency ?? 1;
+  let note = null;
+  if (want >= 2) {
+    const missing = threadsMissing();
+    if (missing) note = missing;
+    else {
+      try {
+        const mt = await import('./sfmeval-mt/index.js');
+        await mt.init();
+        await mt.raw.initThreadPool(want);
+        return { core: mt, note };
+      } catch (e) {
+        note = `the threaded build did not load: ${e && e.message ? e.message : e}`;
+      }
+    }
+  }
+  const st = await import('./sfmeval/index.js');
+  await st.init();
+  return { core: st, note };
+}
 let gt = null;
 let recon = null;
 let cameraFiles = null; // attached to each new ground truth
@@ -52,9 +92,17 @@ function cameraData(r, report) {
 }
 
 const handlers = {
-  async init() {
-    await init();
-    return { version: version() };
+  async init({ threads }) {
+    if (!api) {
+      const { core, note } = await loadCore(threads);
+      api = { core, note };
+      ({
+        version, loadGroundTruth, loadReconstruction, loadReconstructionFile, loadCameras, raw, cropFile, parseCrop,
+        parseTransform, parsePointPairs, errorColors, POSE_STRIDE, comparisonTables, runRow,
+      } = core);
+    }
+    // threads: the pool's size (1: the single-thread build); threadsOff: why threads are off
+    return { version: version(), threads: raw.threadCount(), threadsOff: api.note };
   },
   loadGt({ files, maxTriangles }) {
     const bytes = {};

@@ -1,8 +1,11 @@
-// Speed of the page's wasm core in headless Chromium against the native CLI with one thread,
-// in the same run. Workloads: 100k points near the demo ground truth (written here, seeded) and
+// Speed of the page's wasm core in headless Chromium against the native CLI, in the same run:
+// the page with threads off (`?threads=0`, the single-thread scalar build) and on (`?threads=N`,
+// the threaded + SIMD128 build, N = --threads, default 2) against `sfmeval eval --threads 1` and
+// `--threads N`. Workloads: 100k points near the demo ground truth (written here, seeded) and
 // bench/data's cloud_1m.ply against mesh_1m.glb (bench/generate.py). Alignment none, default
-// options (1M completeness samples). Not a test: prints a table.
-// Usage: node bench.mjs --url http://127.0.0.1:PORT/ --cli target/release/sfmeval
+// options (1M completeness samples); median of --rounds (default 1). Not a test: prints a table.
+// The page must be served cross-origin isolated (scripts/serve_site.py).
+// Usage: node bench.mjs --url http://127.0.0.1:PORT/ --cli target/release/sfmeval [--threads N] [--rounds R]
 import { chromium } from 'playwright-core';
 import { execFileSync } from 'node:child_process';
 import { existsSync, mkdirSync, readFileSync, writeFileSync, statSync } from 'node:fs';
@@ -47,21 +50,29 @@ const browser = await chromium.launch({
   executablePath: process.env.CHROMIUM || '/usr/bin/chromium',
   args: ['--use-angle=swiftshader', '--enable-unsafe-swiftshader', '--no-sandbox', '--disable-dev-shm-usage'],
 });
-const page = await browser.newPage();
-await page.goto(args.url);
-await page.waitForFunction(() => document.body.dataset.ready === '1', null, { timeout: 60000 });
-const rows = [];
-for (const c of cases) {
-  // native, one thread, wall time of the whole command (read + index + measure + report)
+const threads = Number(args.threads ?? 2);
+const rounds = Number(args.rounds ?? 1);
+const median = (xs) => [...xs].sort((a, b) => a - b)[Math.floor(xs.length / 2)];
+const pages = {};
+for (const [key, n] of [['off', 0], ['on', threads]]) {
+  const page = await browser.newPage();
+  await page.goto(new URL(`?threads=${n}`, args.url).href);
+  await page.waitForFunction(() => document.body.dataset.ready === '1', null, { timeout: 60000 });
+  const got = await page.evaluate(() => document.body.dataset.threads);
+  if (Number(got) !== Math.max(n, 1)) throw new Error(`page with ?threads=${n} runs ${got} threads (is the server cross-origin isolated?)`);
+  pages[key] = page;
+}
+// native, wall time of the whole command (read + index + measure + report)
+function native(c, n) {
   const t0 = process.hrtime.bigint();
-  execFileSync(cli, ['eval', '--gt', c.gt, '--recon', c.recon, '--align', 'none', '--threads', '1', '--quiet', '--report', join(work, 'native.json')]);
-  const native = Number(process.hrtime.bigint() - t0) / 1e6;
-  // browser: the worker reads the bytes, then evaluates (what the page does)
-  const files = { gt: readFileSync(c.gt), recon: readFileSync(c.recon) };
-  const ms = await page.evaluate(async ({ gtName, reconName, gtB64, reconB64 }) => {
+  execFileSync(cli, ['eval', '--gt', c.gt, '--recon', c.recon, '--align', 'none', '--threads', String(n), '--quiet', '--report', join(work, 'native.json')]);
+  return Number(process.hrtime.bigint() - t0) / 1e6;
+}
+// browser: the worker reads the bytes, then evaluates (what the page does)
+async function inPage(page, c, files) {
+  return page.evaluate(async ({ gtName, reconName, gtB64, reconB64 }) => {
     const dec = (b) => Uint8Array.from(atob(b), (ch) => ch.charCodeAt(0)).buffer;
     const call = window.sfmeval.call;
-    const t0 = performance.now();
     const g = dec(gtB64), r = dec(reconB64);
     const t1 = performance.now();
     await call('loadGt', { files: { [gtName]: g } }, [g]);
@@ -69,15 +80,40 @@ for (const c of cases) {
     const t2 = performance.now();
     const res = await call('evaluate', { options: { align: 'none' } });
     const t3 = performance.now();
-    return { read: t2 - t1, evaluate: t3 - t2, evalInWorker: res.ms, report: res.reportJson };
+    return { read: t2 - t1, evaluate: t3 - t2, report: res.reportJson };
   }, { gtName: c.gt.split('/').pop(), reconName: c.recon.split('/').pop(), gtB64: files.gt.toString('base64'), reconB64: files.recon.toString('base64') });
-  const same = ms.report === readFileSync(join(work, 'native.json'), 'utf8');
-  const wasmTotal = ms.read + ms.evaluate;
-  rows.push({ case: c.name, native_ms: Math.round(native), wasm_read_ms: Math.round(ms.read), wasm_eval_ms: Math.round(ms.evaluate), wasm_total_ms: Math.round(wasmTotal), ratio: (wasmTotal / native).toFixed(2), same_report: same });
+}
+const rows = [];
+for (const c of cases) {
+  const files = { gt: readFileSync(c.gt), recon: readFileSync(c.recon) };
+  const t = { native1: [], nativeN: [], off: [], on: [] };
+  let same = true;
+  for (let k = 0; k < rounds; k++) {
+    t.native1.push(native(c, 1));
+    const want = readFileSync(join(work, 'native.json'), 'utf8');
+    t.nativeN.push(native(c, threads));
+    same &&= readFileSync(join(work, 'native.json'), 'utf8') === want;
+    for (const key of ['off', 'on']) {
+      const ms = await inPage(pages[key], c, files);
+      t[key].push(ms.read + ms.evaluate);
+      same &&= ms.report === want;
+    }
+  }
+  const m = Object.fromEntries(Object.entries(t).map(([k, v]) => [k, median(v)]));
+  rows.push({
+    case: c.name, threads, rounds, native_1t_ms: Math.round(m.native1), [`native_${threads}t_ms`]: Math.round(m.nativeN),
+    chromium_off_ms: Math.round(m.off), [`chromium_on_${threads}t_ms`]: Math.round(m.on),
+    off_vs_native_1t: (m.off / m.native1).toFixed(2), off_vs_native_nt: (m.off / m.nativeN).toFixed(2),
+    on_vs_native_nt: (m.on / m.nativeN).toFixed(2), same_report: same,
+  });
 }
 await browser.close();
-const wasm = join(root, 'target/web/pkg/sfmeval_wasm_bg.wasm');
-const raw = statSync(wasm).size, gz = gzipSync(readFileSync(wasm), { level: 9 }).length;
-console.log(`bench: wasm ${raw} bytes raw, ${gz} bytes gzipped`);
+const sizes = {};
+for (const [key, dir] of [['single', 'pkg'], ['threaded', 'pkg-mt']]) {
+  const wasm = join(root, `target/web/${dir}/sfmeval_wasm_bg.wasm`);
+  if (!existsSync(wasm)) continue;
+  sizes[key] = { bytes: statSync(wasm).size, gzip_bytes: gzipSync(readFileSync(wasm), { level: 9 }).length };
+  console.log(`bench: ${key} wasm ${sizes[key].bytes} bytes raw, ${sizes[key].gzip_bytes} bytes gzipped`);
+}
 for (const r of rows) console.log(`bench: ${JSON.stringify(r)}`);
-writeFileSync(join(work, 'bench.json'), JSON.stringify({ wasm_bytes: raw, wasm_gzip_bytes: gz, rows }, null, 2));
+writeFileSync(join(work, 'bench.json'), JSON.stringify({ wasm: sizes, rows }, null, 2));

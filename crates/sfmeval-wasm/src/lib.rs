@@ -33,6 +33,25 @@ mod table;
 pub use poses::error_colors;
 pub use stream::ReconstructionStream;
 pub use table::{comparison_tables, run_row};
+/// `initThreadPool(n)`: starts the pool of `n` Web Workers the threaded build's maps run on.
+#[cfg(feature = "threads")]
+pub use wasm_bindgen_rayon::init_thread_pool;
+
+/// Threads the core's parallel maps use: the pool's size in the threaded build, 1 otherwise.
+#[wasm_bindgen(js_name = threadCount)]
+pub fn thread_count() -> usize {
+    threads_in_pool()
+}
+
+#[cfg(feature = "threads")]
+fn threads_in_pool() -> usize {
+    rayon::current_num_threads()
+}
+
+#[cfg(not(feature = "threads"))]
+fn threads_in_pool() -> usize {
+    1
+}
 
 /// Installs the panic hook so that a Rust panic shows its message in the console.
 #[wasm_bindgen(start)]
