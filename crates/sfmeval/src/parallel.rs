@@ -103,8 +103,18 @@ where
     F: Fn(&Point3) -> R + Sync + Send,
 {
     let order = morton_order(points);
-    let visited = map(&order, progress, |&i| f(&points[i as usize]));
-    let mut position = vec![0u32; points.len()];
+    map_in_order(&order, progress, |i| f(&points[i]))
+}
+
+/// Maps `f` over `0..order.len()` visiting the indices in `order` (a permutation) and returns
+/// the results by index, like [`map`]: [`map_points`] with an order computed once and reused.
+pub(crate) fn map_in_order<R, F>(order: &[u32], progress: &dyn Progress, f: F) -> Vec<R>
+where
+    R: Send + Copy,
+    F: Fn(usize) -> R + Sync + Send,
+{
+    let visited = map(order, progress, |&i| f(i as usize));
+    let mut position = vec![0u32; order.len()];
     for (k, &i) in order.iter().enumerate() {
         position[i as usize] = k as u32;
     }

@@ -2,6 +2,7 @@
 
 mod bvh;
 mod cloud;
+pub(crate) mod kd_cloud;
 mod mesh;
 pub(crate) mod slot_tree;
 

@@ -179,14 +179,36 @@ impl SlotTree {
         point: impl Fn(usize) -> Point3,
         live: impl Fn(usize) -> bool,
     ) -> Option<(f64, usize)> {
-        if !q.iter().all(|v| v.is_finite()) || self.boxes[0].is_empty() {
+        if !q.iter().all(|v| v.is_finite()) {
             return None;
         }
-        let mut best = (f64::INFINITY, usize::MAX);
+        let best = self.nearest_below(q, (f64::INFINITY, usize::MAX), point, live);
+        (best.1 != usize::MAX).then_some(best)
+    }
+
+    /// The nearest live point strictly closer to `q` than `bound.0` (squared), with its slot;
+    /// `bound` itself when there is none. `bound` is a known candidate (its squared distance
+    /// and slot, e.g. the previous answer of a query that moved a little) or a search radius
+    /// (`usize::MAX` as the slot): only nodes nearer than the bound are opened, so a tight bound
+    /// visits a leaf or two and a radius skips the empty space. The minimum found is the one
+    /// [`SlotTree::nearest`] finds whenever it is below the bound. `q` must be finite.
+    pub(crate) fn nearest_below(
+        &self,
+        q: Point3,
+        bound: (f64, usize),
+        point: impl Fn(usize) -> Point3,
+        live: impl Fn(usize) -> bool,
+    ) -> (f64, usize) {
+        let mut best = bound;
+        // A depth-first stack: each level pushes two entries and pops one, so it never holds
+        // more than `depth + 2` (`depth` < 64 for any `usize` count).
         // (node, first slot, end slot, level, box distance)
-        let mut stack: Vec<(usize, usize, usize, u32, f64)> = Vec::with_capacity(64);
-        stack.push((0, 0, self.n, 0, self.boxes[0].distance2(&q)));
-        while let Some((node, s, e, level, d)) = stack.pop() {
+        let mut stack = [(0usize, 0usize, 0usize, 0u32, 0f64); 66];
+        let mut top = 1;
+        stack[0] = (0, 0, self.n, 0, self.boxes[0].distance2(&q));
+        while top > 0 {
+            top -= 1;
+            let (node, s, e, level, d) = stack[top];
             if d >= best.0 {
                 continue;
             }
@@ -208,16 +230,22 @@ impl SlotTree {
             let m = s + (e - s) / 2;
             let (l, r) = (2 * node + 1, 2 * node + 2);
             let (dl, dr) = (self.boxes[l].distance2(&q), self.boxes[r].distance2(&q));
-            // Nearer child popped first.
-            if dl <= dr {
-                stack.push((r, m, e, level + 1, dr));
-                stack.push((l, s, m, level + 1, dl));
+            // Nearer child popped first; a child no nearer than the best is not pushed.
+            let (near, far) = if dl <= dr {
+                ((l, s, m, dl), (r, m, e, dr))
             } else {
-                stack.push((l, s, m, level + 1, dl));
-                stack.push((r, m, e, level + 1, dr));
+                ((r, m, e, dr), (l, s, m, dl))
+            };
+            if far.3 < best.0 {
+                stack[top] = (far.0, far.1, far.2, level + 1, far.3);
+                top += 1;
+            }
+            if near.3 < best.0 {
+                stack[top] = (near.0, near.1, near.2, level + 1, near.3);
+                top += 1;
             }
         }
-        (best.1 != usize::MAX).then_some(best)
+        best
     }
 }
 

@@ -11,10 +11,11 @@
 
 use super::matrix::{self, IDENTITY, Matrix4};
 use crate::align::umeyama;
-use crate::distance::CloudIndex;
+use crate::distance::kd_cloud::{KdCloud, NO_POINT, distance2};
 use crate::geometry::Point3;
 use crate::parallel;
 use crate::progress::NoProgress;
+use crate::spatial_order::morton_order;
 
 /// When ICP stops.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -51,20 +52,52 @@ pub struct IcpResult {
 
 /// Matches and their score for the source as it stands.
 struct Matches {
+    /// (source index, target slot) in source order.
     pairs: Vec<(u32, u32)>,
     fitness: f64,
     inlier_rmse: f64,
 }
 
-fn matches(source: &[Point3], target: &CloudIndex, max_distance: f64) -> Matches {
-    let limit = max_distance * max_distance;
-    let nearest = parallel::map_points(source, &NoProgress, |p| target.nearest_squared(*p));
+/// No match (in `Matches::slots`).
+const UNMATCHED: u32 = u32::MAX;
+
+/// Each source point's nearest target point strictly closer than the correspondence distance
+/// (`limit` = its square), the query visiting the points in `order`. A point matched before
+/// starts from its previous match (it moved a little: the nearest now is at most that far), the
+/// others from the radius; the nearest found is the exact one either way, so the matches are
+/// those of an unbounded nearest-neighbour query filtered by the distance. `slots` gets each
+/// point's matched slot (or [`UNMATCHED`]) for the next call.
+fn matches(
+    source: &[Point3],
+    order: &[u32],
+    target: &KdCloud,
+    limit: f64,
+    slots: &mut [u32],
+) -> Matches {
+    let found = parallel::map_in_order(order, &NoProgress, |i| {
+        let q = source[i];
+        let bound = match slots[i] {
+            UNMATCHED => (limit, NO_POINT),
+            k => {
+                let d2 = distance2(target.point(k as usize), q);
+                if d2 < limit {
+                    (d2, k as usize)
+                } else {
+                    (limit, NO_POINT)
+                }
+            }
+        };
+        target.nearest_below(q, bound)
+    });
     let mut pairs = Vec::new();
     let mut error2 = 0.0;
-    for (i, (d2, j)) in nearest.into_iter().enumerate() {
-        if d2 < limit {
+    for (i, (d2, k)) in found.into_iter().enumerate() {
+        if k != NO_POINT {
             error2 += d2;
-            pairs.push((i as u32, j as u32));
+            pairs.push((i as u32, k as u32));
+            slots[i] = k as u32;
+        } else {
+            slots[i] = UNMATCHED;
         }
     }
     let (fitness, inlier_rmse) = if pairs.is_empty() {
@@ -82,27 +115,32 @@ fn matches(source: &[Point3], target: &CloudIndex, max_distance: f64) -> Matches
     }
 }
 
-/// Runs ICP of `source` (already in its initial pose) against `target` (indexed by
-/// `target_index`).
+/// Runs ICP of `source` (already in its initial pose) against `target`.
 pub fn registration_icp(
     source: &[Point3],
-    target: &[Point3],
-    target_index: &CloudIndex,
+    target: &KdCloud,
     max_distance: f64,
     criteria: IcpCriteria,
 ) -> IcpResult {
+    let limit = max_distance * max_distance;
     let mut moved = source.to_vec();
+    // The moves are small: one spatial visiting order serves every iteration.
+    let order = morton_order(&moved);
+    let mut slots = vec![UNMATCHED; source.len()];
     let mut transformation = IDENTITY;
-    let mut current = matches(&moved, target_index, max_distance);
+    let mut current = matches(&moved, &order, target, limit, &mut slots);
     let mut iterations = 0;
     while iterations < criteria.max_iterations {
-        let update = fit(&moved, target, &current.pairs);
+        let update = fit(&moved, |k| target.point(k), &current.pairs);
         transformation = matrix::mul(&update, &transformation);
         for p in moved.iter_mut() {
             *p = matrix::apply(&update, *p);
         }
         iterations += 1;
-        let previous = std::mem::replace(&mut current, matches(&moved, target_index, max_distance));
+        let previous = std::mem::replace(
+            &mut current,
+            matches(&moved, &order, target, limit, &mut slots),
+        );
         if (previous.fitness - current.fitness).abs() < criteria.relative_fitness
             && (previous.inlier_rmse - current.inlier_rmse).abs() < criteria.relative_rmse
         {
@@ -119,12 +157,16 @@ pub fn registration_icp(
 
 /// The scaled Umeyama fit of the matches; the identity without matches or when they are
 /// degenerate (Open3D returns the identity for no matches).
-pub(crate) fn fit(source: &[Point3], target: &[Point3], pairs: &[(u32, u32)]) -> Matrix4 {
+pub(crate) fn fit(
+    source: &[Point3],
+    target: impl Fn(usize) -> Point3,
+    pairs: &[(u32, u32)],
+) -> Matrix4 {
     if pairs.is_empty() {
         return IDENTITY;
     }
     let src: Vec<Point3> = pairs.iter().map(|&(i, _)| source[i as usize]).collect();
-    let dst: Vec<Point3> = pairs.iter().map(|&(_, j)| target[j as usize]).collect();
+    let dst: Vec<Point3> = pairs.iter().map(|&(_, j)| target(j as usize)).collect();
     umeyama(&src, &dst, true).map_or(IDENTITY, |s| s.matrix)
 }
 
@@ -156,13 +198,13 @@ mod tests {
             [0.0, 0.0, 0.0, 1.0],
         ];
         let source: Vec<Point3> = target.iter().map(|p| matrix::apply(&t, *p)).collect();
-        let index = CloudIndex::new(&target).unwrap();
+        let index = KdCloud::new(&target).unwrap();
         let strict = IcpCriteria {
             relative_fitness: 1e-12,
             relative_rmse: 1e-12,
             max_iterations: 50,
         };
-        let r = registration_icp(&source, &target, &index, 0.2, strict);
+        let r = registration_icp(&source, &index, 0.2, strict);
         assert_eq!(r.fitness, 1.0);
         assert!(r.inlier_rmse < 1e-9, "{}", r.inlier_rmse);
         for p in &target {
@@ -170,11 +212,11 @@ mod tests {
             assert!((0..3).all(|k| (back[k] - p[k]).abs() < 1e-9));
         }
         // The toolbox's criteria stop once the match count settles: here after 1 update.
-        let r = registration_icp(&source, &target, &index, 0.2, IcpCriteria::TOOLBOX);
+        let r = registration_icp(&source, &index, 0.2, IcpCriteria::TOOLBOX);
         assert_eq!(r.iterations, 1);
         // No match within the distance: nothing moves.
         let far: Vec<Point3> = target.iter().map(|p| [p[0] + 10.0, p[1], p[2]]).collect();
-        let r = registration_icp(&far, &target, &index, 0.2, IcpCriteria::TOOLBOX);
+        let r = registration_icp(&far, &index, 0.2, IcpCriteria::TOOLBOX);
         assert_eq!((r.fitness, r.transformation), (0.0, IDENTITY));
     }
 }

@@ -21,7 +21,7 @@ use super::trajectory::{LogFrame, MAPPING_ABOVE_FRAMES};
 use super::trajectory_alignment::{TrajectoryAlignmentOptions, align_trajectories};
 use super::voxel::voxel_down_sample;
 use crate::crop::{Axis, Volume};
-use crate::distance::CloudIndex;
+use crate::distance::kd_cloud::KdCloud;
 use crate::error::{Error, Result};
 use crate::geometry::Point3;
 use crate::parallel;
@@ -171,7 +171,7 @@ pub fn evaluate(
     progress.start(Stage::Alignment, 5);
     let gt_cropped = nonempty(crop(&scene.ground_truth), "ground-truth")?;
     let gt_half = voxel_down_sample(&gt_cropped, tau / 2.0)?;
-    let gt_half_index = CloudIndex::new(&gt_half)?;
+    let gt_half_index = KdCloud::new(&gt_half)?;
     progress.advance(1);
 
     let mut stage_params = Vec::new();
@@ -197,14 +197,13 @@ pub fn evaluate(
             progress.advance(1);
             let mut t = aligned.gt_from_recon;
             // Two voxel refinements, then the uniform one.
-            let gt_full = voxel_down_sample(&gt_cropped, tau)?;
-            let gt_full_index = CloudIndex::new(&gt_full)?;
-            for (voxel, distance, target, index) in [
-                (tau, 80.0 * tau, &gt_full, &gt_full_index),
-                (tau / 2.0, 20.0 * tau, &gt_half, &gt_half_index),
+            let gt_full_index = KdCloud::new(&voxel_down_sample(&gt_cropped, tau)?)?;
+            for (voxel, distance, index) in [
+                (tau, 80.0 * tau, &gt_full_index),
+                (tau / 2.0, 20.0 * tau, &gt_half_index),
             ] {
                 let source = voxel_down_sample(&nonempty(crop_moved(&t), "reconstructed")?, voxel)?;
-                let r = registration_icp(&source, target, index, distance, request.icp);
+                let r = registration_icp(&source, index, distance, request.icp);
                 t = matrix::mul(&r.transformation, &t);
                 stage_params.push(StageParams::new(
                     "voxel",
@@ -213,13 +212,12 @@ pub fn evaluate(
                     distance,
                     request.icp,
                 ));
-                stage_results.push(StageResult::of_icp(source.len(), target.len(), &r, t));
+                stage_results.push(StageResult::of_icp(source.len(), index.len(), &r, t));
                 progress.advance(1);
             }
             let source = uniform_down_sample(nonempty(crop_moved(&t), "reconstructed")?);
-            let target = uniform_down_sample(gt_cropped.clone());
-            let index = CloudIndex::new(&target)?;
-            let r = registration_icp(&source, &target, &index, 2.0 * tau, request.icp);
+            let index = KdCloud::new(&uniform_down_sample(gt_cropped.clone()))?;
+            let r = registration_icp(&source, &index, 2.0 * tau, request.icp);
             t = matrix::mul(&r.transformation, &t);
             stage_params.push(StageParams::new(
                 "uniform",
@@ -228,7 +226,7 @@ pub fn evaluate(
                 2.0 * tau,
                 request.icp,
             ));
-            stage_results.push(StageResult::of_icp(source.len(), target.len(), &r, t));
+            stage_results.push(StageResult::of_icp(source.len(), index.len(), &r, t));
             progress.advance(1);
             if aligned.fitness < 0.5 {
                 warnings.push(format!(
@@ -271,7 +269,7 @@ pub fn evaluate(
         );
         Vec::new()
     } else {
-        let recon_index = CloudIndex::new(&precision_points)?;
+        let recon_index = KdCloud::new(&precision_points)?;
         progress.start(Stage::Completeness, gt_half.len() as u64);
         let d = parallel::map_points(&gt_half, progress, |p| recon_index.nearest(*p).0);
         progress.finish();

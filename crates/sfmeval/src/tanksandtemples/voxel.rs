@@ -40,7 +40,10 @@ pub fn voxel_down_sample(points: &[Point3], size: f64) -> Result<Vec<Point3>> {
     let cells = (0..3)
         .map(|k| ((max[k] - start[k]) / size).floor())
         .fold(0.0, f64::max);
-    let index = |p: &Point3| [0, 1, 2].map(|k| ((p[k] - start[k]) / size).floor() as i32);
+    // `(p − start) / size` is not negative (`start` is half a voxel below the minimum), so the
+    // truncation of `as` is the floor (and saturates the same for ±∞ and NaN) without a call
+    // to `floor`.
+    let index = |p: &Point3| [0, 1, 2].map(|k| ((p[k] - start[k]) / size) as i32);
     let sums = if cells < f64::from(1u32 << 21) {
         group(points, |p| {
             let [x, y, z] = index(p).map(|i| u64::from(i as u32));
@@ -59,19 +62,30 @@ pub fn voxel_down_sample(points: &[Point3], size: f64) -> Result<Vec<Point3>> {
 }
 
 /// Sums and counts per key, in the order keys first appear, points summed in input order.
-fn group<K: std::hash::Hash + Eq>(
+/// A point in the previous point's voxel reuses its slot without a hash look-up (clouds
+/// written in spatial runs, as scanners write them; on a shuffled cloud it costs one comparison).
+fn group<K: std::hash::Hash + Eq + Copy>(
     points: &[Point3],
     key: impl Fn(&Point3) -> K,
 ) -> Vec<([f64; 3], u32)> {
     let mut voxel_of: HashMap<K, u32, BuildHasherDefault<VoxelHasher>> =
         HashMap::with_capacity_and_hasher(points.len() / 4, Default::default());
     let mut sums: Vec<([f64; 3], u32)> = Vec::new();
+    let mut last: Option<(K, u32)> = None;
     for p in points {
-        let next = sums.len() as u32;
-        let slot = *voxel_of.entry(key(p)).or_insert(next);
-        if slot == next {
-            sums.push(([0.0; 3], 0));
-        }
+        let key = key(p);
+        let slot = match last {
+            Some((k, slot)) if k == key => slot,
+            _ => {
+                let next = sums.len() as u32;
+                let slot = *voxel_of.entry(key).or_insert(next);
+                if slot == next {
+                    sums.push(([0.0; 3], 0));
+                }
+                last = Some((key, slot));
+                slot
+            }
+        };
         let (sum, n) = &mut sums[slot as usize];
         for k in 0..3 {
             sum[k] += p[k];
