@@ -63,14 +63,17 @@ async function restartWorker() {
   pending.clear();
   for (const p of stopped) p.reject(new Cancelled());
   startWorker();
-  await call('init', { threads: threadsParam });
+  sharedProgress = (await call('init', { threads: threadsParam })).progress;
   const reload = async (type, src, extra = {}) => {
     if (!src) return;
     const { files, transfer } = await readFiles(src.files);
     await call(type, { files, ...extra }, transfer);
   };
   await reload('loadGt', sources.gt, { maxTriangles: Number($('max-triangles').value) || undefined });
-  await reload('loadRecon', sources.recon, { name: sources.recon && sources.recon.name });
+  const single = sources.recon && sources.recon.files.length === 1 && !sources.recon.files[0].webkitRelativePath
+    && /\.ply$/i.test(sources.recon.files[0].name) ? sources.recon.files[0] : null;
+  if (single) await call('loadRecon', { file: single, name: sources.recon.name });
+  else await reload('loadRecon', sources.recon, { name: sources.recon && sources.recon.name });
   await reload('loadCameras', sources.cams);
   await reload('loadDepth', sources.depth);
 }
@@ -777,12 +780,30 @@ function options() {
   return o;
 }
 
+/**
+ * The threaded build's progress counters in its shared memory (`sharedProgress()` of the
+ * package), read while a run is under way: the worker that runs the call is blocked in it and
+ * its pool's threads cannot post messages. Null with the single-thread build, which posts.
+ */
+let sharedProgress = null;
+function pollSharedProgress() {
+  if (!sharedProgress) return null;
+  const { buffer, ptr, stages } = sharedProgress;
+  const counters = new BigUint64Array(buffer, ptr, 3);
+  return setInterval(() => {
+    if (!state.running) return;
+    const [stage, done, total] = [0, 1, 2].map((k) => Number(Atomics.load(counters, k)));
+    if (total > 0) showProgress(stages[stage] ?? '', done, total);
+  }, 100);
+}
+
 async function runEvaluation() {
   showError('');
   if (state.picking) $('pick').click();
   state.running = true;
   setRunNote('');
   showProgress('starting', 0, 1);
+  const poll = pollSharedProgress();
   try {
     const r = await call('evaluate', { options: options() });
     r.report = JSON.parse(r.reportJson);
@@ -808,6 +829,7 @@ async function runEvaluation() {
       setRunNote('✗ The evaluation failed: see the message at the top.', true);
     }
   } finally {
+    if (poll) clearInterval(poll);
     state.running = false;
     hideProgress();
     updateRunButton();
@@ -974,6 +996,7 @@ $('dl-csv').onclick = async () => {
 
 // ---- start ------------------------------------------------------------------------------
 call('init', { threads: threadsParam }).then((m) => {
+  sharedProgress = m.progress;
   $('version').textContent = `core ${m.version} · ${m.threads === 1 ? '1 thread' : `${m.threads} threads`}`;
   // threads wanted but off: say why (a static host must send the COOP/COEP headers)
   const note = $('threads-note');

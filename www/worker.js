@@ -101,8 +101,13 @@ const handlers = {
         parseTransform, parsePointPairs, errorColors, POSE_STRIDE, comparisonTables, runRow,
       } = core);
     }
-    // threads: the pool's size (1: the single-thread build); threadsOff: why threads are off
-    return { version: version(), threads: raw.threadCount(), threadsOff: api.note };
+    // threads: the pool's size (1: the single-thread build); threadsOff: why threads are off;
+    // progress: the shared counters the page reads while this worker is blocked in a call
+    // whose work runs on the pool (null for the single-thread build, which calls back)
+    return {
+      version: version(), threads: raw.threadCount(), threadsOff: api.note,
+      progress: api.core.sharedProgress ? api.core.sharedProgress() : null,
+    };
   },
   loadGt({ files, maxTriangles }) {
     const bytes = {};

@@ -114,12 +114,20 @@ try {
   await page.check('input[name=align][value=given]');
   await page.fill('#transform', readFileSync(identity, 'utf8'));
   const before = Number(await page.evaluate(() => document.body.dataset.evaluated || 0));
+  await page.evaluate(() => { window.__progressSeen = []; });
   const t1 = Date.now();
   await page.click('#run');
   await page.waitForFunction((n) => Number(document.body.dataset.evaluated || 0) > n || document.getElementById('error').textContent, before, { timeout: 1200000 });
   const evalMs = Date.now() - t1;
   const runErr = await page.textContent('#error');
   check('dense-evaluates', !runErr, runErr);
+  // progress moves during the run, also in the threaded build (whose pool's threads write
+  // shared counters the page reads): some stage seen part-way
+  const during = await page.evaluate(() => window.__progressSeen);
+  const partway = during.map((t) => /^(.*\S) (\d+)\/(\d+)$/.exec(t)).filter((m) => m && Number(m[2]) > 0 && Number(m[2]) < Number(m[3]));
+  check('dense-progress-during-evaluation', partway.length > 0, JSON.stringify(during.slice(0, 8)));
+  const threads = await page.textContent('#version');
+  console.log(`note: dense evaluation on ${threads}; progress seen part-way ${partway.length} times (${[...new Set(partway.map((m) => m[1]))].join(', ')})`);
   const pageReport = await page.evaluate(() => window.sfmeval.state.result.reportJson);
   const cliReport = join(out, 'cli-dense.json');
   const tc = Date.now();

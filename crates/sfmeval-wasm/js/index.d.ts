@@ -139,6 +139,10 @@ export function loadGroundTruth(
 ): RawGroundTruth;
 /** Reads a reconstruction (PLY, or an SfM model's files). */
 export function loadReconstruction(files: Files | RawReconstruction, name?: string): RawReconstruction;
+/** Where a running evaluation's progress can be read from another thread when the module's
+ * memory is shared (the page's threaded build), else `null`: `new BigUint64Array(buffer, ptr, 3)`
+ * holds the stage index into `stages`, done and total. */
+export function sharedProgress(): { buffer: SharedArrayBuffer; ptr: number; stages: string[] } | null;
 /** Bytes of WebAssembly memory a streamed reconstruction point needs through an evaluation. */
 export const BYTES_PER_POINT: number;
 /** WebAssembly memory a reconstruction may take (bytes). */

@@ -3,6 +3,7 @@
 import initWasm, * as wasm from './sfmeval_wasm.js';
 
 let ready = null;
+let exports = null; // the instance's exports (its memory)
 
 const isNode = typeof process !== 'undefined' && !!(process.versions && process.versions.node);
 
@@ -19,7 +20,7 @@ export function init(input) {
         const fs = await import('node:fs/promises');
         source = await fs.readFile(new URL('./sfmeval_wasm_bg.wasm', import.meta.url));
       }
-      await initWasm(source === undefined ? undefined : { module_or_path: source });
+      exports = await initWasm(source === undefined ? undefined : { module_or_path: source });
     })();
   }
   return ready;
@@ -27,8 +28,20 @@ export function init(input) {
 
 /** Synchronous initialisation from bytes or a compiled module (e.g. inside a worker). */
 export function initSync(module) {
-  wasm.initSync({ module });
+  exports = wasm.initSync({ module });
   ready = Promise.resolve();
+}
+
+/**
+ * Where a running evaluation's progress can be read from another thread, when the module's
+ * memory is shared (the page's threaded build; `null` otherwise): `{buffer, ptr, stages}`;
+ * `new BigUint64Array(buffer, ptr, 3)` holds the stage index into `stages`, done and total
+ * (read them with `Atomics.load`).
+ */
+export function sharedProgress() {
+  const memory = exports && exports.memory;
+  if (!memory || typeof SharedArrayBuffer === 'undefined' || !(memory.buffer instanceof SharedArrayBuffer)) return null;
+  return { buffer: memory.buffer, ptr: wasm.progressCounters(), stages: wasm.progressStages() };
 }
 
 /** The core's version (the report's `tool.version`). */

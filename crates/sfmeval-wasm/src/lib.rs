@@ -349,11 +349,27 @@ impl Cameras {
     }
 }
 
-/// Forwards the core's progress to a JS callback `(stage, done, total)`.
-struct JsProgress {
-    stage: AtomicU64,
-    done: AtomicU64,
-    total: AtomicU64,
+/// Forwards the core's progress to a JS callback `(stage, done, total)` from the calling
+/// thread, and keeps it in [`PROGRESS`] for the threads that cannot call JS.
+struct JsProgress;
+
+/// The running call's progress: the stage (an index into [`progress_stages`]), done and
+/// total. Every thread writes it; in the threaded build the memory is shared, so the page's
+/// main thread reads it while the worker that called is blocked in the call (the pool's
+/// threads cannot call back into JavaScript).
+static PROGRESS: [AtomicU64; 3] = [const { AtomicU64::new(0) }; 3];
+
+/// Byte address of the progress counters in the module's memory: three `u64` (stage index,
+/// done, total), to read with `Atomics.load` on a `BigUint64Array` over the shared memory.
+#[wasm_bindgen(js_name = progressCounters)]
+pub fn progress_counters() -> usize {
+    PROGRESS.as_ptr() as usize
+}
+
+/// The stage labels the progress counters' stage index points into.
+#[wasm_bindgen(js_name = progressStages)]
+pub fn progress_stages() -> Vec<String> {
+    STAGES.iter().map(|s| s.label().to_string()).collect()
 }
 
 const STAGES: [Stage; 8] = [
@@ -372,22 +388,9 @@ thread_local! {
 }
 
 impl JsProgress {
-    fn new() -> Self {
-        JsProgress {
-            stage: AtomicU64::new(0),
-            done: AtomicU64::new(0),
-            total: AtomicU64::new(0),
-        }
-    }
-
     fn emit(&self) {
-        let label = STAGES
-            .get(self.stage.load(Ordering::Relaxed) as usize)
-            .map_or("", |s| s.label());
-        let (done, total) = (
-            self.done.load(Ordering::Relaxed),
-            self.total.load(Ordering::Relaxed),
-        );
+        let [stage, done, total] = PROGRESS.each_ref().map(|c| c.load(Ordering::Relaxed));
+        let label = STAGES.get(stage as usize).map_or("", |s| s.label());
         CALLBACK.with(|c| {
             if let Some(f) = c.borrow().as_ref() {
                 let _ = f.call3(
@@ -404,18 +407,19 @@ impl JsProgress {
 impl Progress for JsProgress {
     fn start(&self, stage: Stage, total: u64) {
         let i = STAGES.iter().position(|s| *s == stage).unwrap_or(0);
-        self.stage.store(i as u64, Ordering::Relaxed);
-        self.done.store(0, Ordering::Relaxed);
-        self.total.store(total, Ordering::Relaxed);
+        let [s, d, t] = &PROGRESS;
+        s.store(i as u64, Ordering::Relaxed);
+        d.store(0, Ordering::Relaxed);
+        t.store(total, Ordering::Relaxed);
         self.emit();
     }
     fn advance(&self, n: u64) {
-        self.done.fetch_add(n, Ordering::Relaxed);
+        PROGRESS[1].fetch_add(n, Ordering::Relaxed);
         self.emit();
     }
     fn finish(&self) {
-        self.done
-            .store(self.total.load(Ordering::Relaxed), Ordering::Relaxed);
+        let [_, d, t] = &PROGRESS;
+        d.store(t.load(Ordering::Relaxed), Ordering::Relaxed);
         self.emit();
     }
 }
@@ -655,7 +659,7 @@ pub fn evaluate(
         ..EvalRequest::default()
     };
     let _guard = CallbackGuard::set(progress);
-    let bar = JsProgress::new();
+    let bar = JsProgress;
     let inner = pipeline::run(&mut gt.dataset, &recon.input, &request, &bar).map_err(|e| {
         if e.concerns_point_pairs() {
             js_err("options.pairs", e)
