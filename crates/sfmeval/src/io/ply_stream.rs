@@ -23,6 +23,8 @@ pub const HEAD_BYTES: usize = 1 << 16;
 pub struct PlyCloudStream {
     data: PlyData,
     records: VertexRecords,
+    /// The declared vertex count, as `usize`.
+    count: usize,
     declared: u64,
     body_start: usize,
     /// Body bytes pushed so far.
@@ -64,11 +66,14 @@ impl PlyCloudStream {
         let count = usize::try_from(vertex.count)
             .map_err(|_| Error::unsupported(FMT, "more vertices than this machine can address"))?;
         let mut data = data;
-        data.vertices = records.empty_positions(count);
-        data.colors = records.has_colors().then(|| Vec::with_capacity(count));
+        // Nothing is reserved yet: a caller that refuses the declared count (the page's memory
+        // check) has allocated nothing; the first piece reserves it all.
+        data.vertices = records.empty_positions(0);
+        data.colors = records.has_colors().then(Vec::new);
         Ok(Some(PlyCloudStream {
             data,
             records,
+            count,
             declared: vertex.count,
             body_start: header.body_start,
             received: 0,
@@ -100,6 +105,12 @@ impl PlyCloudStream {
     /// the last declared vertex are ignored.
     pub fn push(&mut self, piece: &[u8]) {
         let stride = self.records.stride();
+        if self.received == 0 && !piece.is_empty() {
+            self.data.vertices = self.records.empty_positions(self.count);
+            if let Some(colors) = self.data.colors.as_mut() {
+                colors.reserve_exact(self.count);
+            }
+        }
         let wanted = (self.declared * stride as u64).saturating_sub(self.received);
         let mut piece = &piece[..(piece.len() as u64).min(wanted) as usize];
         self.received += piece.len() as u64;
