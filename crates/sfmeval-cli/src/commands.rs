@@ -18,7 +18,7 @@ use sfmeval::model;
 use sfmeval::pipeline::{self, EvalRequest, ReconInput, read_reconstruction};
 use sfmeval::pose::PoseOptions;
 use sfmeval::transform::Similarity;
-use sfmeval_fs::{Disk, name_of, path_str, read, read_input_files, read_ply_cloud, write_atomic};
+use sfmeval_fs::{Disk, name_of, path_str, read, read_input_files, write_atomic};
 
 use crate::progress::Bars;
 use crate::summary;
@@ -383,34 +383,14 @@ fn run_error(e: sfmeval::Error, input: &InputArgs) -> anyhow::Error {
 /// in pieces, so a dense cloud is never in memory twice (file bytes and points).
 fn read_recon(input: &InputArgs) -> Result<ReconInput> {
     let name = input.name.clone().unwrap_or_else(|| name_of(&input.recon));
-    let context = || format!("reconstruction '{}'", input.recon.display());
-    if input.recon_cameras.is_none()
-        && is_ply_file(&input.recon)
-        && let Some(ply) = read_ply_cloud(&input.recon).with_context(context)?
-    {
-        let loaded = io::point_cloud_from_ply(&name_of(&input.recon), ply)
-            .map_err(anyhow::Error::new)
-            .with_context(context)?;
-        return Ok(pipeline::reconstruction_from_cloud(&name, loaded));
-    }
+    let Some(cameras_path) = &input.recon_cameras else {
+        return sfmeval_fs::read_reconstruction(&input.recon, &name);
+    };
     let files = read_input_files(&input.recon)?;
-    match &input.recon_cameras {
-        Some(p) => {
-            let cameras = model::read_model_files(&read_input_files(p)?)
-                .with_context(|| format!("reconstruction cameras '{}'", p.display()))?;
-            pipeline::read_reconstruction_with_cameras(&name, &files, cameras, &name_of(p))
-        }
-        None => read_reconstruction(&name, &files),
-    }
-    .with_context(context)
-}
-
-/// Whether `path` is a file named `*.ply` (any case).
-fn is_ply_file(path: &Path) -> bool {
-    path.is_file()
-        && path
-            .extension()
-            .is_some_and(|e| e.eq_ignore_ascii_case("ply"))
+    let cameras = model::read_model_files(&read_input_files(cameras_path)?)
+        .with_context(|| format!("reconstruction cameras '{}'", cameras_path.display()))?;
+    pipeline::read_reconstruction_with_cameras(&name, &files, cameras, &name_of(cameras_path))
+        .with_context(|| format!("reconstruction '{}'", input.recon.display()))
 }
 
 fn eval(args: &EvalArgs) -> Result<()> {

@@ -90,11 +90,7 @@ pub fn tnt_cmd(args: &TntArgs) -> Result<()> {
             bail!("give --trajectory FILE.log (or --transform FILE to skip the registration)")
         }
     };
-    let recon = sfmeval::pipeline::read_reconstruction(
-        &name_of(&args.recon),
-        &read_input_files(&args.recon)?,
-    )
-    .with_context(|| format!("reconstruction '{}'", args.recon.display()))?;
+    let recon = sfmeval_fs::read_reconstruction(&args.recon, &name_of(&args.recon))?;
     let request = TntRequest {
         tau: args.tau,
         registration,

@@ -8,6 +8,9 @@ use std::path::Path;
 use anyhow::{Context as _, Result};
 use sfmeval::io::ply::PlyData;
 use sfmeval::io::ply_stream::{HEAD_BYTES, PlyCloudStream};
+use sfmeval::pipeline::{self, ReconInput};
+
+use crate::disk::{name_of, read_input_files};
 
 /// Bytes read from the file at a time.
 const PIECE_BYTES: usize = 8 << 20;
@@ -39,4 +42,29 @@ pub fn read_ply_cloud(path: &Path) -> Result<Option<PlyData>> {
         stream.push(&piece[..n]);
     }
     Ok(Some(stream.finish()?))
+}
+
+/// The reconstruction at `path` (a PLY cloud, a model folder or file), named `name` in the
+/// report: a binary PLY cloud is read in pieces ([`read_ply_cloud`]), anything else through
+/// [`read_input_files`] and [`pipeline::read_reconstruction`]; the same [`ReconInput`] either
+/// way. Errors name the path.
+pub fn read_reconstruction(path: &Path, name: &str) -> Result<ReconInput> {
+    let context = || format!("reconstruction '{}'", path.display());
+    if is_ply_file(path)
+        && let Some(ply) = read_ply_cloud(path).with_context(context)?
+    {
+        let loaded = sfmeval::io::point_cloud_from_ply(&name_of(path), ply)
+            .map_err(anyhow::Error::new)
+            .with_context(context)?;
+        return Ok(pipeline::reconstruction_from_cloud(name, loaded));
+    }
+    pipeline::read_reconstruction(name, &read_input_files(path)?).with_context(context)
+}
+
+/// Whether `path` is a file named `*.ply` (any case).
+fn is_ply_file(path: &Path) -> bool {
+    path.is_file()
+        && path
+            .extension()
+            .is_some_and(|e| e.eq_ignore_ascii_case("ply"))
 }
