@@ -91,6 +91,21 @@ function cameraData(r, report) {
   return { gtPoses, estPoses, estErrors, estColors: errorColors(estErrors, camClip), camClip };
 }
 
+/**
+ * A progress callback `(stage, done, total)` for call `id` that posts at most one message each
+ * `ms` milliseconds (and always the last, `done === total`).
+ */
+function progressPoster(id, ms) {
+  let lastPost = 0;
+  return (stage, done, total) => {
+    const now = performance.now();
+    if (now - lastPost > ms || done === total) {
+      lastPost = now;
+      postMessage({ type: 'progress', id, stage, done, total });
+    }
+  };
+}
+
 const handlers = {
   async init({ threads }) {
     if (!api) {
@@ -131,15 +146,8 @@ const handlers = {
     if (file) {
       // One file: a binary PLY cloud streams in pieces (a dense cloud never sits in memory
       // twice), with progress; anything else is read whole.
-      let lastPost = 0;
-      const onProgress = (done, total) => {
-        const now = performance.now();
-        if (now - lastPost > 100 || done === total) {
-          lastPost = now;
-          postMessage({ type: 'progress', id, stage: 'reading', done, total });
-        }
-      };
-      r = await loadReconstructionFile(file, { name, onProgress });
+      const post = progressPoster(id, 100);
+      r = await loadReconstructionFile(file, { name, onProgress: (done, total) => post('reading', done, total) });
     } else {
       const bytes = {};
       for (const [n, b] of Object.entries(files)) bytes[n] = new Uint8Array(b);
@@ -189,14 +197,7 @@ const handlers = {
   evaluate({ options, id }) {
     if (!gt) throw new Error('load a ground truth first');
     if (!recon) throw new Error('load a reconstruction first');
-    let lastPost = 0;
-    const progress = (stage, done, total) => {
-      const now = performance.now();
-      if (now - lastPost > 50 || done === total) {
-        lastPost = now;
-        postMessage({ type: 'progress', id, stage, done, total });
-      }
-    };
+    const progress = progressPoster(id, 50);
     const t0 = performance.now();
     if (cameraFiles && !gt.hasCameras) gt.setCameras(loadCameras(cameraFiles));
     if (depthFiles && !gt.hasDepthMaps) {

@@ -11,5 +11,5 @@ mod write;
 pub use disk::{
     Disk, IMAGE_EXTENSIONS, image_names, name_of, path_str, read, read_dataset, read_input_files,
 };
-pub use stream::{read_ply_cloud, read_reconstruction};
+pub use stream::read_reconstruction;
 pub use write::write_atomic;

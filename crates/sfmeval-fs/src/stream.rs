@@ -18,7 +18,7 @@ const PIECE_BYTES: usize = 8 << 20;
 /// The binary PLY point cloud at `path`, read a piece at a time; `Ok(None)` when the file is
 /// not one that streams (ascii, a mesh, ...: read it whole). Errors reading the file name it;
 /// format errors are the core's, as from a whole-file read.
-pub fn read_ply_cloud(path: &Path) -> Result<Option<PlyData>> {
+fn read_ply_cloud(path: &Path) -> Result<Option<PlyData>> {
     let what = || format!("cannot read '{}'", path.display());
     let mut file = File::open(path).with_context(what)?;
     let len = file.metadata().with_context(what)?.len();
@@ -45,9 +45,9 @@ pub fn read_ply_cloud(path: &Path) -> Result<Option<PlyData>> {
 }
 
 /// The reconstruction at `path` (a PLY cloud, a model folder or file), named `name` in the
-/// report: a binary PLY cloud is read in pieces ([`read_ply_cloud`]), anything else through
-/// [`read_input_files`] and [`pipeline::read_reconstruction`]; the same [`ReconInput`] either
-/// way. Errors name the path.
+/// report: a binary PLY cloud is read 8 MiB at a time through `sfmeval::io::ply_stream`,
+/// anything else through [`read_input_files`] and [`pipeline::read_reconstruction`]; the same
+/// [`ReconInput`] either way. Errors name the path.
 pub fn read_reconstruction(path: &Path, name: &str) -> Result<ReconInput> {
     let context = || format!("reconstruction '{}'", path.display());
     if is_ply_file(path)
