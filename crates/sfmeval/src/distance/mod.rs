@@ -3,6 +3,7 @@
 mod bvh;
 mod cloud;
 pub(crate) mod kd_cloud;
+mod leaf_bound;
 mod mesh;
 pub(crate) mod slot_tree;
 
