@@ -62,6 +62,30 @@ where
     }
 }
 
+/// Maps `f` over `items` with each item's index and mutable access to it, keeping order (no
+/// progress).
+pub(crate) fn map_mut<T, R, F>(items: &mut [T], f: F) -> Vec<R>
+where
+    T: Send,
+    R: Send,
+    F: Fn(usize, &mut T) -> R + Sync + Send,
+{
+    #[cfg(feature = "parallel")]
+    {
+        use rayon::prelude::*;
+        items
+            .par_iter_mut()
+            .enumerate()
+            .with_min_len(256)
+            .map(|(k, t)| f(k, t))
+            .collect()
+    }
+    #[cfg(not(feature = "parallel"))]
+    {
+        items.iter_mut().enumerate().map(|(k, t)| f(k, t)).collect()
+    }
+}
+
 /// Maps `f` over `start..end`, keeping order, reporting progress per chunk.
 pub(crate) fn map_range_progress<R, F>(
     start: usize,

@@ -63,6 +63,26 @@ impl KdCloud {
         self.tree
             .nearest_below(p, bound, |k| self.points[k], |_| true)
     }
+
+    /// The `K` nearest points strictly closer to `p` than `radius2` (squared), nearest first,
+    /// as `(d², slot)` into `out`; returns how many, and the squared radius below which every
+    /// point is among them (`radius2`, or the `K`-th distance when `K` were found). `p` must be
+    /// finite.
+    pub(crate) fn nearest_k_below<const K: usize>(
+        &self,
+        p: Point3,
+        radius2: f64,
+        out: &mut [(f64, u32); K],
+    ) -> (usize, f64) {
+        self.tree
+            .nearest_k_below(p, radius2, out, |k| self.points[k], |_| true)
+    }
+
+    /// Whether [`KdCloud::nearest_below`] for `p` reaches slot `a` before slot `b`: of two
+    /// points at the same distance it answers the first.
+    pub(crate) fn visits_before(&self, p: &Point3, a: usize, b: usize) -> bool {
+        self.tree.visits_before(p, a, b)
+    }
 }
 
 /// `(a₀−b₀)² + (a₁−b₁)² + (a₂−b₂)²` summed in that order, the squared distance every tree here

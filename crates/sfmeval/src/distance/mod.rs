@@ -4,6 +4,7 @@ mod bvh;
 mod cloud;
 pub(crate) mod kd_cloud;
 mod mesh;
+pub(crate) mod neighbour_list;
 pub(crate) mod slot_tree;
 
 pub use cloud::CloudIndex;
