@@ -53,6 +53,21 @@ impl KdCloud {
         }
     }
 
+    /// [`KdCloud::nearest`]'s distance (bit for bit), the search bounded from the start by the
+    /// point in slot `start` (a neighbouring query's answer; [`NO_POINT`] for none). The slot
+    /// returned is a nearest point's, not necessarily the one `nearest` names among equally
+    /// near points.
+    pub(crate) fn nearest_from(&self, p: Point3, start: usize) -> (f64, usize) {
+        if start >= self.points.len() || !p.iter().all(|v| v.is_finite()) {
+            return self.nearest(p);
+        }
+        let bound = (distance2(self.points[start], p), start);
+        let (d2, k) = self
+            .tree
+            .nearest_below(p, bound, |k| self.points[k], |_| true);
+        (d2.sqrt(), k)
+    }
+
     /// The nearest point strictly closer to `p` than `bound.0` (squared distance), with its
     /// slot; `bound` when there is none. `bound` is `(d², slot)` of a known point or
     /// `(r², NO_POINT)` for a radius `r`.
@@ -157,8 +172,15 @@ mod tests {
             let got = tree.nearest_below(q, bound);
             assert_eq!(got.0.to_bits(), want.to_bits());
             assert_eq!(distance2(tree.point(got.1), q).to_bits(), want.to_bits());
+            // Started from that point (or from none): `nearest`'s distance.
+            for start in [slot, NO_POINT, tree.len()] {
+                let (d, k) = tree.nearest_from(q, start);
+                assert_eq!(d.to_bits(), want.sqrt().to_bits());
+                assert_eq!(distance2(tree.point(k), q).to_bits(), want.to_bits());
+            }
         }
         assert_eq!(tree.nearest([f64::NAN, 0.0, 0.0]).1, NO_POINT);
+        assert_eq!(tree.nearest_from([f64::NAN, 0.0, 0.0], 3).1, NO_POINT);
         assert_eq!(tree.nearest_below([f64::NAN, 0.0, 0.0], (1.0, 3)), (1.0, 3));
         assert!(KdCloud::new(&[]).is_err());
     }

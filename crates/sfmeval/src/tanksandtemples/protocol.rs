@@ -21,7 +21,7 @@ use super::trajectory::{LogFrame, MAPPING_ABOVE_FRAMES};
 use super::trajectory_alignment::{TrajectoryAlignmentOptions, align_trajectories};
 use super::voxel::voxel_down_sample;
 use crate::crop::{Axis, Volume};
-use crate::distance::kd_cloud::KdCloud;
+use crate::distance::kd_cloud::{KdCloud, NO_POINT};
 use crate::error::{Error, Result};
 use crate::geometry::Point3;
 use crate::parallel;
@@ -260,8 +260,7 @@ pub fn evaluate(
     let precision_points = voxel_down_sample(&recon_cropped, tau / 2.0)?;
     drop(recon_cropped);
     progress.start(Stage::Accuracy, precision_points.len() as u64);
-    let precision_distances =
-        parallel::map_points(&precision_points, progress, |p| gt_half_index.nearest(*p).0);
+    let precision_distances = nearest_distances(&precision_points, &gt_half_index, progress);
     progress.finish();
     let recall_distances = if precision_points.is_empty() {
         warnings.push(
@@ -271,7 +270,7 @@ pub fn evaluate(
     } else {
         let recon_index = KdCloud::new(&precision_points)?;
         progress.start(Stage::Completeness, gt_half.len() as u64);
-        let d = parallel::map_points(&gt_half, progress, |p| recon_index.nearest(*p).0);
+        let d = nearest_distances(&gt_half, &recon_index, progress);
         progress.finish();
         d
     };
@@ -382,6 +381,19 @@ pub fn evaluate(
         precision_distances,
         recall_points: gt_half,
         recall_distances,
+    })
+}
+
+/// Each point's distance to its nearest point of `index` (the toolbox's
+/// `compute_point_cloud_distance`), each search bounded from the start by the previous point's
+/// answer in the Morton visiting order; the distances are those of an unbounded search.
+fn nearest_distances(points: &[Point3], index: &KdCloud, progress: &dyn Progress) -> Vec<f64> {
+    parallel::map_points_with_state(points, progress, |previous: &mut Option<usize>, p| {
+        let (d, k) = index.nearest_from(*p, previous.unwrap_or(NO_POINT));
+        if k != NO_POINT {
+            *previous = Some(k);
+        }
+        d
     })
 }
 
