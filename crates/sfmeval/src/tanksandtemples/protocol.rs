@@ -25,7 +25,7 @@ use crate::distance::kd_cloud::{KdCloud, NO_POINT};
 use crate::error::{Error, Result};
 use crate::geometry::Point3;
 use crate::parallel;
-use crate::progress::{Progress, Stage};
+use crate::progress::{NoProgress, Progress, Stage};
 use crate::report::Tool;
 
 /// The toolbox's point budget of the last refinement (`MAX_POINT_NUMBER`).
@@ -143,17 +143,23 @@ pub fn evaluate(
         });
     }
     let volume = &scene.crop;
+    // The crop tests run in parallel (a flag a point), the kept points are collected in order.
     let crop = |pts: &[Point3]| -> Vec<Point3> {
+        let inside = parallel::map(pts, &NoProgress, |p| volume.contains(*p));
         pts.iter()
-            .copied()
-            .filter(|p| volume.contains(*p))
+            .zip(inside)
+            .filter_map(|(p, inside)| inside.then_some(*p))
             .collect()
     };
     let crop_moved = |t: &Matrix4| -> Vec<Point3> {
+        let inside = parallel::map(recon_points, &NoProgress, |p| {
+            volume.contains(matrix::apply(t, *p))
+        });
         recon_points
             .iter()
-            .map(|p| matrix::apply(t, *p))
-            .filter(|p| volume.contains(*p))
+            .zip(inside)
+            .filter(|(_, inside)| *inside)
+            .map(|(p, _)| matrix::apply(t, *p))
             .collect()
     };
     let nonempty = |pts: Vec<Point3>, what: &str| -> Result<Vec<Point3>> {
