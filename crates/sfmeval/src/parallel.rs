@@ -97,36 +97,6 @@ where
     }
 }
 
-/// Runs `f(0)`, ..., `f(n - 1)` as separate tasks (a few large ones: one per thread), keeping
-/// order.
-pub(crate) fn map_tasks<R, F>(n: usize, f: F) -> Vec<R>
-where
-    R: Send,
-    F: Fn(usize) -> R + Sync + Send,
-{
-    #[cfg(feature = "parallel")]
-    {
-        use rayon::prelude::*;
-        (0..n).into_par_iter().map(f).collect()
-    }
-    #[cfg(not(feature = "parallel"))]
-    {
-        (0..n).map(f).collect()
-    }
-}
-
-/// Threads the parallel maps use (1 without the `parallel` feature).
-pub(crate) fn threads() -> usize {
-    #[cfg(feature = "parallel")]
-    {
-        rayon::current_num_threads()
-    }
-    #[cfg(not(feature = "parallel"))]
-    {
-        1
-    }
-}
-
 /// Maps `f` over `start..end`, keeping order, reporting progress per chunk.
 pub(crate) fn map_range_progress<R, F>(
     start: usize,

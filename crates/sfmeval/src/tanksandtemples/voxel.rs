@@ -5,12 +5,10 @@
 //! order of their first point (Open3D's order is its hash map's; the set of points is the same).
 
 use std::collections::HashMap;
-use std::hash::{BuildHasher, BuildHasherDefault, Hasher};
+use std::hash::{BuildHasherDefault, Hasher};
 
 use crate::error::{Error, Result};
 use crate::geometry::Point3;
-use crate::parallel;
-use crate::progress::NoProgress;
 
 /// The voxel means of `points` for voxels of edge `size`.
 pub fn voxel_down_sample(points: &[Point3], size: f64) -> Result<Vec<Point3>> {
@@ -64,74 +62,31 @@ pub fn voxel_down_sample(points: &[Point3], size: f64) -> Result<Vec<Point3>> {
 }
 
 /// Sums and counts per key, in the order keys first appear, points summed in input order.
-///
-/// In parallel without changing a bit: the keys are computed in parallel, then each of a few
-/// parts takes the voxels whose key hashes to it and sums them over the whole input in order
-/// (so every voxel's sum is the sequential one), and the parts' voxels, each part's in order of
-/// first appearance, are merged by their first point.
-fn group<K>(points: &[Point3], key: impl Fn(&Point3) -> K + Sync) -> Vec<([f64; 3], u32)>
-where
-    K: std::hash::Hash + Eq + Copy + Send + Sync,
-{
-    let keys: Vec<K> = parallel::map(points, &NoProgress, |p| key(p));
-    let parts = parallel::threads().clamp(1, MAX_PARTS);
-    let hasher = BuildHasherDefault::<VoxelHasher>::default();
-    let grouped = parallel::map_tasks(parts, |part| {
-        group_part(points, &keys, |k| {
-            parts == 1 || hasher.hash_one(k) as usize % parts == part
-        })
-    });
-    // Merge the parts by first point (each part's list is in that order already).
-    let mut heads = vec![0usize; parts];
-    let total = grouped.iter().map(Vec::len).sum();
-    let mut out = Vec::with_capacity(total);
-    for _ in 0..total {
-        let Some(part) = (0..parts)
-            .filter(|&p| heads[p] < grouped[p].len())
-            .min_by_key(|&p| grouped[p][heads[p]].0)
-        else {
-            break;
-        };
-        let (_, sum, n) = grouped[part][heads[part]];
-        out.push((sum, n));
-        heads[part] += 1;
-    }
-    out
-}
-
-/// Parts of [`group`] at most (one per thread).
-const MAX_PARTS: usize = 8;
-
-/// [`group`] of the points whose key `mine` accepts: (first point, sum, count) per key in the
-/// order keys first appear. A point in the previous accepted point's voxel reuses its slot
-/// without a hash look-up (clouds written in spatial runs, as scanners write them; on a
-/// shuffled cloud it costs one comparison).
-fn group_part<K: std::hash::Hash + Eq + Copy>(
+/// A point in the previous point's voxel reuses its slot without a hash look-up (clouds
+/// written in spatial runs, as scanners write them; on a shuffled cloud it costs one comparison).
+fn group<K: std::hash::Hash + Eq + Copy>(
     points: &[Point3],
-    keys: &[K],
-    mine: impl Fn(&K) -> bool,
-) -> Vec<(usize, [f64; 3], u32)> {
+    key: impl Fn(&Point3) -> K,
+) -> Vec<([f64; 3], u32)> {
     let mut voxel_of: HashMap<K, u32, BuildHasherDefault<VoxelHasher>> =
-        HashMap::with_capacity_and_hasher(points.len() / 8, Default::default());
-    let mut sums: Vec<(usize, [f64; 3], u32)> = Vec::new();
+        HashMap::with_capacity_and_hasher(points.len() / 4, Default::default());
+    let mut sums: Vec<([f64; 3], u32)> = Vec::new();
     let mut last: Option<(K, u32)> = None;
-    for (i, (p, key)) in points.iter().zip(keys).enumerate() {
+    for p in points {
+        let key = key(p);
         let slot = match last {
-            Some((k, slot)) if k == *key => slot,
+            Some((k, slot)) if k == key => slot,
             _ => {
-                if !mine(key) {
-                    continue;
-                }
                 let next = sums.len() as u32;
-                let slot = *voxel_of.entry(*key).or_insert(next);
+                let slot = *voxel_of.entry(key).or_insert(next);
                 if slot == next {
-                    sums.push((i, [0.0; 3], 0));
+                    sums.push(([0.0; 3], 0));
                 }
-                last = Some((*key, slot));
+                last = Some((key, slot));
                 slot
             }
         };
-        let (_, sum, n) = &mut sums[slot as usize];
+        let (sum, n) = &mut sums[slot as usize];
         for k in 0..3 {
             sum[k] += p[k];
         }
@@ -207,48 +162,5 @@ mod tests {
             voxel_down_sample(&wide, 1.0).unwrap(),
             vec![[0.1, 0.0, 0.0], [5e6, 1.0, 1.0]]
         );
-    }
-
-    /// A shuffled cloud with many points a voxel against the plain sequential grouping (one
-    /// map, first appearance, sums in input order), bit for bit.
-    #[test]
-    fn parallel_grouping_equals_the_sequential_one() {
-        let mut s = 0x2545_f491_4f6c_dd1du64;
-        let mut next = move || {
-            s ^= s << 13;
-            s ^= s >> 7;
-            s ^= s << 17;
-            (s >> 11) as f64 / (1u64 << 53) as f64
-        };
-        let pts: Vec<Point3> = (0..20_000)
-            .map(|_| [next() * 3.0, next() * 2.0 - 1.0, next() * 0.1])
-            .collect();
-        let size = 0.1;
-        let got = voxel_down_sample(&pts, size).unwrap();
-        let start =
-            [0, 1, 2].map(|k| pts.iter().map(|p| p[k]).fold(f64::INFINITY, f64::min) - size * 0.5);
-        let mut first: HashMap<[i32; 3], usize> = HashMap::new();
-        let mut sums: Vec<([f64; 3], u32)> = Vec::new();
-        for p in &pts {
-            let key = [0, 1, 2].map(|k| ((p[k] - start[k]) / size) as i32);
-            let next = sums.len();
-            let slot = *first.entry(key).or_insert(next);
-            if slot == next {
-                sums.push(([0.0; 3], 0));
-            }
-            for (sum, v) in sums[slot].0.iter_mut().zip(p) {
-                *sum += v;
-            }
-            sums[slot].1 += 1;
-        }
-        let want: Vec<Point3> = sums
-            .iter()
-            .map(|(s, n)| s.map(|v| v / f64::from(*n)))
-            .collect();
-        assert!(want.len() < pts.len() / 4);
-        assert_eq!(got.len(), want.len());
-        for (g, w) in got.iter().zip(&want) {
-            assert_eq!(g.map(f64::to_bits), w.map(f64::to_bits));
-        }
     }
 }
