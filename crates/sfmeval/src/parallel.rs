@@ -15,19 +15,31 @@ where
     R: Send,
     F: Fn(&T) -> R + Sync + Send,
 {
+    map_with_state(items, progress, |_: &mut (), t| f(t))
+}
+
+/// [`map`] where `f` also gets a state that starts as `S::default()` in each work unit and
+/// goes from one item to the next in order, to carry a hint (e.g. the previous query's answer);
+/// for results independent of the thread count they must not depend on it.
+pub(crate) fn map_with_state<T, R, S, F>(items: &[T], progress: &dyn Progress, f: F) -> Vec<R>
+where
+    T: Sync,
+    R: Send,
+    S: Default,
+    F: Fn(&mut S, &T) -> R + Sync + Send,
+{
+    let run = |c: &[T]| {
+        let mut state = S::default();
+        let out: Vec<R> = c.iter().map(|t| f(&mut state, t)).collect();
+        progress.advance(c.len() as u64);
+        out
+    };
     #[cfg(feature = "parallel")]
     {
         use rayon::prelude::*;
         // Small inputs (ICP's coarse phase) still get split over every thread.
         let chunk = (items.len() / (4 * rayon::current_num_threads())).clamp(256, CHUNK);
-        let chunks: Vec<Vec<R>> = items
-            .par_chunks(chunk)
-            .map(|c| {
-                let out: Vec<R> = c.iter().map(&f).collect();
-                progress.advance(c.len() as u64);
-                out
-            })
-            .collect();
+        let chunks: Vec<Vec<R>> = items.par_chunks(chunk).map(run).collect();
         let mut out = Vec::with_capacity(items.len());
         for c in chunks {
             out.extend(c);
@@ -38,8 +50,7 @@ where
     {
         let mut out = Vec::with_capacity(items.len());
         for c in items.chunks(CHUNK) {
-            out.extend(c.iter().map(&f));
-            progress.advance(c.len() as u64);
+            out.extend(run(c));
         }
         out
     }
@@ -59,6 +70,30 @@ where
     #[cfg(not(feature = "parallel"))]
     {
         (0..n).map(f).collect()
+    }
+}
+
+/// Maps `f` over `items` with each item's index and mutable access to it, keeping order (no
+/// progress).
+pub(crate) fn map_mut<T, R, F>(items: &mut [T], f: F) -> Vec<R>
+where
+    T: Send,
+    R: Send,
+    F: Fn(usize, &mut T) -> R + Sync + Send,
+{
+    #[cfg(feature = "parallel")]
+    {
+        use rayon::prelude::*;
+        items
+            .par_iter_mut()
+            .enumerate()
+            .with_min_len(256)
+            .map(|(k, t)| f(k, t))
+            .collect()
+    }
+    #[cfg(not(feature = "parallel"))]
+    {
+        items.iter_mut().enumerate().map(|(k, t)| f(k, t)).collect()
     }
 }
 
@@ -106,6 +141,24 @@ where
     map_in_order(&order, progress, |i| f(&points[i]))
 }
 
+/// [`map_points`] where `f` also gets a state carried from one point to the next in the
+/// visiting order, as in [`map_with_state`]: neighbours in space follow each other, so the
+/// previous answer is a good start.
+pub(crate) fn map_points_with_state<R, S, F>(
+    points: &[Point3],
+    progress: &dyn Progress,
+    f: F,
+) -> Vec<R>
+where
+    R: Send + Copy,
+    S: Default,
+    F: Fn(&mut S, &Point3) -> R + Sync + Send,
+{
+    let order = morton_order(points);
+    let visited = map_with_state(&order, progress, |s, &i| f(s, &points[i as usize]));
+    by_index(&order, visited)
+}
+
 /// Maps `f` over `0..order.len()` visiting the indices in `order` (a permutation) and returns
 /// the results by index, like [`map`]: [`map_points`] with an order computed once and reused.
 pub(crate) fn map_in_order<R, F>(order: &[u32], progress: &dyn Progress, f: F) -> Vec<R>
@@ -114,6 +167,11 @@ where
     F: Fn(usize) -> R + Sync + Send,
 {
     let visited = map(order, progress, |&i| f(i as usize));
+    by_index(order, visited)
+}
+
+/// `visited[k]` is the result for index `order[k]`: the results by index.
+fn by_index<R: Copy>(order: &[u32], visited: Vec<R>) -> Vec<R> {
     let mut position = vec![0u32; order.len()];
     for (k, &i) in order.iter().enumerate() {
         position[i as usize] = k as u32;

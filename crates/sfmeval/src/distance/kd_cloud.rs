@@ -53,6 +53,21 @@ impl KdCloud {
         }
     }
 
+    /// [`KdCloud::nearest`]'s distance (bit for bit), the search bounded from the start by the
+    /// point in slot `start` (a neighbouring query's answer; [`NO_POINT`] for none). The slot
+    /// returned is a nearest point's, not necessarily the one `nearest` names among equally
+    /// near points.
+    pub(crate) fn nearest_from(&self, p: Point3, start: usize) -> (f64, usize) {
+        if start >= self.points.len() || !p.iter().all(|v| v.is_finite()) {
+            return self.nearest(p);
+        }
+        let bound = (distance2(self.points[start], p), start);
+        let (d2, k) = self
+            .tree
+            .nearest_below(p, bound, |k| self.points[k], |_| true);
+        (d2.sqrt(), k)
+    }
+
     /// The nearest point strictly closer to `p` than `bound.0` (squared distance), with its
     /// slot; `bound` when there is none. `bound` is `(d², slot)` of a known point or
     /// `(r², NO_POINT)` for a radius `r`.
@@ -62,6 +77,26 @@ impl KdCloud {
         }
         self.tree
             .nearest_below(p, bound, |k| self.points[k], |_| true)
+    }
+
+    /// The `K` nearest points strictly closer to `p` than `radius2` (squared), nearest first,
+    /// as `(d², slot)` into `out`; returns how many, and the squared radius below which every
+    /// point is among them (`radius2`, or the `K`-th distance when `K` were found). `p` must be
+    /// finite.
+    pub(crate) fn nearest_k_below<const K: usize>(
+        &self,
+        p: Point3,
+        radius2: f64,
+        out: &mut [(f64, u32); K],
+    ) -> (usize, f64) {
+        self.tree
+            .nearest_k_below(p, radius2, out, |k| self.points[k], |_| true)
+    }
+
+    /// Whether [`KdCloud::nearest_below`] for `p` reaches slot `a` before slot `b`: of two
+    /// points at the same distance it answers the first.
+    pub(crate) fn visits_before(&self, p: &Point3, a: usize, b: usize) -> bool {
+        self.tree.visits_before(p, a, b)
     }
 }
 
@@ -137,8 +172,15 @@ mod tests {
             let got = tree.nearest_below(q, bound);
             assert_eq!(got.0.to_bits(), want.to_bits());
             assert_eq!(distance2(tree.point(got.1), q).to_bits(), want.to_bits());
+            // Started from that point (or from none): `nearest`'s distance.
+            for start in [slot, NO_POINT, tree.len()] {
+                let (d, k) = tree.nearest_from(q, start);
+                assert_eq!(d.to_bits(), want.sqrt().to_bits());
+                assert_eq!(distance2(tree.point(k), q).to_bits(), want.to_bits());
+            }
         }
         assert_eq!(tree.nearest([f64::NAN, 0.0, 0.0]).1, NO_POINT);
+        assert_eq!(tree.nearest_from([f64::NAN, 0.0, 0.0], 3).1, NO_POINT);
         assert_eq!(tree.nearest_below([f64::NAN, 0.0, 0.0], (1.0, 3)), (1.0, 3));
         assert!(KdCloud::new(&[]).is_err());
     }

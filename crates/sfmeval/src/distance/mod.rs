@@ -5,6 +5,7 @@ mod cloud;
 pub(crate) mod kd_cloud;
 mod leaf_bound;
 mod mesh;
+pub(crate) mod neighbour_list;
 pub(crate) mod slot_tree;
 
 pub use cloud::CloudIndex;

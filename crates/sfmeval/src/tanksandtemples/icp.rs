@@ -8,13 +8,18 @@
 //! The toolbox passes `ICPConvergenceCriteria(1e-6, 20)`, which Open3D reads positionally as
 //! `relative_fitness = 1e-6`, `relative_rmse = 20` with the default `max_iteration = 30`: a stage
 //! stops as soon as the number of matches stops changing. [`IcpCriteria::TOOLBOX`] is that.
+//!
+//! Speed: each source point keeps a neighbour list ([`NeighbourList`]) between iterations, so
+//! that once the moves shrink below the point spacing a match is read from 8 points instead of
+//! a walk down the target's tree; the answers are the tree's, so the matches, the fits and the
+//! iteration counts are those of a plain nearest-neighbour query.
 
 use super::matrix::{self, IDENTITY, Matrix4};
 use crate::align::umeyama;
 use crate::distance::kd_cloud::{KdCloud, NO_POINT, distance2};
+use crate::distance::neighbour_list::NeighbourList;
 use crate::geometry::Point3;
 use crate::parallel;
-use crate::progress::NoProgress;
 use crate::spatial_order::morton_order;
 
 /// When ICP stops.
@@ -58,53 +63,70 @@ struct Matches {
     inlier_rmse: f64,
 }
 
-/// No match (in `Matches::slots`).
+/// No match (in `Query::slot`).
 const UNMATCHED: u32 = u32::MAX;
 
+/// What a source point's query keeps between iterations: its match and its neighbour list.
+#[derive(Clone, Copy)]
+struct Query {
+    slot: u32,
+    list: NeighbourList,
+}
+
+/// The lists are made from the target points within this many correspondence distances, so
+/// that a point with no match keeps an empty list while it moves by less than half of one.
+const LIST_REACH: f64 = 1.5;
+
 /// Each source point's nearest target point strictly closer than the correspondence distance
-/// (`limit` = its square), the query visiting the points in `order`. A point matched before
-/// starts from its previous match (it moved a little: the nearest now is at most that far), the
-/// others from the radius; the nearest found is the exact one either way, so the matches are
-/// those of an unbounded nearest-neighbour query filtered by the distance. `slots` gets each
-/// point's matched slot (or [`UNMATCHED`]) for the next call.
+/// (`limit` = its square). `moved` and `queries` are in the visiting order (Morton), `position`
+/// maps a source index to its place there. A point matched before starts from its previous
+/// match (it moved a little: the nearest now is at most that far), the others from the radius;
+/// the nearest found is the exact one either way (through the point's neighbour list, which
+/// answers as the tree does), so the matches are those of an unbounded nearest-neighbour query
+/// filtered by the distance. Pairs and the error sum come in source order.
 fn matches(
-    source: &[Point3],
-    order: &[u32],
+    moved: &[Point3],
+    position: &[u32],
     target: &KdCloud,
     limit: f64,
-    slots: &mut [u32],
+    queries: &mut [Query],
 ) -> Matches {
-    let found = parallel::map_in_order(order, &NoProgress, |i| {
-        let q = source[i];
-        let bound = match slots[i] {
+    let reach2 = limit * LIST_REACH * LIST_REACH;
+    let found = parallel::map_mut(queries, |k, query| {
+        let q = moved[k];
+        let bound = match query.slot {
             UNMATCHED => (limit, NO_POINT),
-            k => {
-                let d2 = distance2(target.point(k as usize), q);
+            slot => {
+                let d2 = distance2(target.point(slot as usize), q);
                 if d2 < limit {
-                    (d2, k as usize)
+                    (d2, slot as usize)
                 } else {
                     (limit, NO_POINT)
                 }
             }
         };
-        target.nearest_below(q, bound)
+        let (d2, slot) = query.list.nearest_below(target, q, bound, reach2);
+        query.slot = if slot == NO_POINT {
+            UNMATCHED
+        } else {
+            slot as u32
+        };
+        (d2, query.slot)
     });
     let mut pairs = Vec::new();
     let mut error2 = 0.0;
-    for (i, (d2, k)) in found.into_iter().enumerate() {
-        if k != NO_POINT {
+    for (i, &k) in position.iter().enumerate() {
+        let (d2, slot) = found[k as usize];
+        if slot != UNMATCHED {
             error2 += d2;
-            pairs.push((i as u32, k as u32));
-            slots[i] = k as u32;
-        } else {
-            slots[i] = UNMATCHED;
+            pairs.push((i as u32, slot));
         }
     }
     let (fitness, inlier_rmse) = if pairs.is_empty() {
         (0.0, 0.0)
     } else {
         (
-            pairs.len() as f64 / source.len() as f64,
+            pairs.len() as f64 / position.len() as f64,
             (error2 / pairs.len() as f64).sqrt(),
         )
     };
@@ -123,15 +145,31 @@ pub fn registration_icp(
     criteria: IcpCriteria,
 ) -> IcpResult {
     let limit = max_distance * max_distance;
-    let mut moved = source.to_vec();
-    // The moves are small: one spatial visiting order serves every iteration.
-    let order = morton_order(&moved);
-    let mut slots = vec![UNMATCHED; source.len()];
+    // The moves are small: one spatial visiting order serves every iteration, and the moved
+    // points and their queries are kept in it (neighbours in space, neighbours in memory).
+    let order = morton_order(source);
+    let mut moved: Vec<Point3> = order.iter().map(|&i| source[i as usize]).collect();
+    let mut position = vec![0u32; order.len()];
+    for (k, &i) in order.iter().enumerate() {
+        position[i as usize] = k as u32;
+    }
+    drop(order);
+    let mut queries = vec![
+        Query {
+            slot: UNMATCHED,
+            list: NeighbourList::NONE,
+        };
+        source.len()
+    ];
     let mut transformation = IDENTITY;
-    let mut current = matches(&moved, &order, target, limit, &mut slots);
+    let mut current = matches(&moved, &position, target, limit, &mut queries);
     let mut iterations = 0;
     while iterations < criteria.max_iterations {
-        let update = fit(&moved, |k| target.point(k), &current.pairs);
+        let update = fit(
+            |i| moved[position[i] as usize],
+            |k| target.point(k),
+            &current.pairs,
+        );
         transformation = matrix::mul(&update, &transformation);
         for p in moved.iter_mut() {
             *p = matrix::apply(&update, *p);
@@ -139,7 +177,7 @@ pub fn registration_icp(
         iterations += 1;
         let previous = std::mem::replace(
             &mut current,
-            matches(&moved, &order, target, limit, &mut slots),
+            matches(&moved, &position, target, limit, &mut queries),
         );
         if (previous.fitness - current.fitness).abs() < criteria.relative_fitness
             && (previous.inlier_rmse - current.inlier_rmse).abs() < criteria.relative_rmse
@@ -158,14 +196,14 @@ pub fn registration_icp(
 /// The scaled Umeyama fit of the matches; the identity without matches or when they are
 /// degenerate (Open3D returns the identity for no matches).
 pub(crate) fn fit(
-    source: &[Point3],
+    source: impl Fn(usize) -> Point3,
     target: impl Fn(usize) -> Point3,
     pairs: &[(u32, u32)],
 ) -> Matrix4 {
     if pairs.is_empty() {
         return IDENTITY;
     }
-    let src: Vec<Point3> = pairs.iter().map(|&(i, _)| source[i as usize]).collect();
+    let src: Vec<Point3> = pairs.iter().map(|&(i, _)| source(i as usize)).collect();
     let dst: Vec<Point3> = pairs.iter().map(|&(_, j)| target(j as usize)).collect();
     umeyama(&src, &dst, true).map_or(IDENTITY, |s| s.matrix)
 }

@@ -21,11 +21,11 @@ use super::trajectory::{LogFrame, MAPPING_ABOVE_FRAMES};
 use super::trajectory_alignment::{TrajectoryAlignmentOptions, align_trajectories};
 use super::voxel::voxel_down_sample;
 use crate::crop::{Axis, Volume};
-use crate::distance::kd_cloud::KdCloud;
+use crate::distance::kd_cloud::{KdCloud, NO_POINT};
 use crate::error::{Error, Result};
 use crate::geometry::Point3;
 use crate::parallel;
-use crate::progress::{Progress, Stage};
+use crate::progress::{NoProgress, Progress, Stage};
 use crate::report::Tool;
 
 /// The toolbox's point budget of the last refinement (`MAX_POINT_NUMBER`).
@@ -143,17 +143,23 @@ pub fn evaluate(
         });
     }
     let volume = &scene.crop;
+    // The crop tests run in parallel (a flag a point), the kept points are collected in order.
     let crop = |pts: &[Point3]| -> Vec<Point3> {
+        let inside = parallel::map(pts, &NoProgress, |p| volume.contains(*p));
         pts.iter()
-            .copied()
-            .filter(|p| volume.contains(*p))
+            .zip(inside)
+            .filter_map(|(p, inside)| inside.then_some(*p))
             .collect()
     };
     let crop_moved = |t: &Matrix4| -> Vec<Point3> {
+        let inside = parallel::map(recon_points, &NoProgress, |p| {
+            volume.contains(matrix::apply(t, *p))
+        });
         recon_points
             .iter()
-            .map(|p| matrix::apply(t, *p))
-            .filter(|p| volume.contains(*p))
+            .zip(inside)
+            .filter(|(_, inside)| *inside)
+            .map(|(p, _)| matrix::apply(t, *p))
             .collect()
     };
     let nonempty = |pts: Vec<Point3>, what: &str| -> Result<Vec<Point3>> {
@@ -260,8 +266,7 @@ pub fn evaluate(
     let precision_points = voxel_down_sample(&recon_cropped, tau / 2.0)?;
     drop(recon_cropped);
     progress.start(Stage::Accuracy, precision_points.len() as u64);
-    let precision_distances =
-        parallel::map_points(&precision_points, progress, |p| gt_half_index.nearest(*p).0);
+    let precision_distances = nearest_distances(&precision_points, &gt_half_index, progress);
     progress.finish();
     let recall_distances = if precision_points.is_empty() {
         warnings.push(
@@ -271,7 +276,7 @@ pub fn evaluate(
     } else {
         let recon_index = KdCloud::new(&precision_points)?;
         progress.start(Stage::Completeness, gt_half.len() as u64);
-        let d = parallel::map_points(&gt_half, progress, |p| recon_index.nearest(*p).0);
+        let d = nearest_distances(&gt_half, &recon_index, progress);
         progress.finish();
         d
     };
@@ -382,6 +387,19 @@ pub fn evaluate(
         precision_distances,
         recall_points: gt_half,
         recall_distances,
+    })
+}
+
+/// Each point's distance to its nearest point of `index` (the toolbox's
+/// `compute_point_cloud_distance`), each search bounded from the start by the previous point's
+/// answer in the Morton visiting order; the distances are those of an unbounded search.
+fn nearest_distances(points: &[Point3], index: &KdCloud, progress: &dyn Progress) -> Vec<f64> {
+    parallel::map_points_with_state(points, progress, |previous: &mut Option<usize>, p| {
+        let (d, k) = index.nearest_from(*p, previous.unwrap_or(NO_POINT));
+        if k != NO_POINT {
+            *previous = Some(k);
+        }
+        d
     })
 }
 

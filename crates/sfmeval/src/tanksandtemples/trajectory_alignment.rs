@@ -99,7 +99,7 @@ pub fn align_trajectories(
     // its match count reached at most and its squared error already larger. Pruning never
     // drops a sample that would have won, so the winner is the exhaustive search's.
     let score = |sample: &Vec<(u32, u32)>, bound: Option<(usize, f64)>| -> Option<(usize, f64)> {
-        let t = fit(recon_centers, |j| reference_in_gt[j], sample);
+        let t = fit(|i| recon_centers[i], |j| reference_in_gt[j], sample);
         let (mut matched, mut error2) = (0usize, 0.0);
         for (k, p) in recon_centers.iter().enumerate() {
             let (d2, _) = index.nearest_squared(matrix::apply(&t, *p));
@@ -145,7 +145,7 @@ pub fn align_trajectories(
         )));
     }
     Ok(TrajectoryAlignment {
-        gt_from_recon: fit(recon_centers, |j| reference_in_gt[j], &samples[best]),
+        gt_from_recon: fit(|i| recon_centers[i], |j| reference_in_gt[j], &samples[best]),
         fitness,
         inlier_rmse,
         iterations: options.max_iterations,
