@@ -199,8 +199,32 @@ impl SlotTree {
         live: impl Fn(usize) -> bool,
     ) -> (f64, usize) {
         let mut best = bound;
-        // A depth-first stack: each level pushes two entries and pops one, so it never holds
-        // more than `depth + 2` (`depth` < 64 for any `usize` count).
+        self.walk(q, bound.0, |s, e| {
+            for k in s..e {
+                if !live(k) {
+                    continue;
+                }
+                let a = point(k);
+                let d2 = (a[0] - q[0]) * (a[0] - q[0])
+                    + (a[1] - q[1]) * (a[1] - q[1])
+                    + (a[2] - q[2]) * (a[2] - q[2]);
+                if d2 < best.0 {
+                    best = (d2, k);
+                }
+            }
+            best.0
+        });
+        best
+    }
+
+    /// The depth-first walk both bounded searches share: leaves whose box is nearer to `q` than
+    /// the bound, the child whose box is nearer first (the left one on a tie); `leaf(s, e)`
+    /// scans slots `s..e` and returns the new bound (never larger).
+    #[inline]
+    fn walk(&self, q: Point3, bound: f64, mut leaf: impl FnMut(usize, usize) -> f64) {
+        let mut bound = bound;
+        // Each level pushes two entries and pops one, so the stack never holds more than
+        // `depth + 2` (`depth` < 64 for any `usize` count).
         // (node, first slot, end slot, level, box distance)
         let mut stack = [(0usize, 0usize, 0usize, 0u32, 0f64); 66];
         let mut top = 1;
@@ -208,43 +232,31 @@ impl SlotTree {
         while top > 0 {
             top -= 1;
             let (node, s, e, level, d) = stack[top];
-            if d >= best.0 {
+            if d >= bound {
                 continue;
             }
             if level == self.depth {
-                for k in s..e {
-                    if !live(k) {
-                        continue;
-                    }
-                    let a = point(k);
-                    let d2 = (a[0] - q[0]) * (a[0] - q[0])
-                        + (a[1] - q[1]) * (a[1] - q[1])
-                        + (a[2] - q[2]) * (a[2] - q[2]);
-                    if d2 < best.0 {
-                        best = (d2, k);
-                    }
-                }
+                bound = leaf(s, e);
                 continue;
             }
             let m = s + (e - s) / 2;
             let (l, r) = (2 * node + 1, 2 * node + 2);
             let (dl, dr) = (self.boxes[l].distance2(&q), self.boxes[r].distance2(&q));
-            // Nearer child popped first; a child no nearer than the best is not pushed.
+            // Nearer child popped first; a child no nearer than the bound is not pushed.
             let (near, far) = if dl <= dr {
                 ((l, s, m, dl), (r, m, e, dr))
             } else {
                 ((r, m, e, dr), (l, s, m, dl))
             };
-            if far.3 < best.0 {
+            if far.3 < bound {
                 stack[top] = (far.0, far.1, far.2, level + 1, far.3);
                 top += 1;
             }
-            if near.3 < best.0 {
+            if near.3 < bound {
                 stack[top] = (near.0, near.1, near.2, level + 1, near.3);
                 top += 1;
             }
         }
-        best
     }
 }
 
@@ -266,60 +278,34 @@ impl SlotTree {
         const { assert!(K > 0) };
         let mut count = 0;
         let mut bound = radius2;
-        let mut stack = [(0usize, 0usize, 0usize, 0u32, 0f64); 66];
-        let mut top = 1;
-        stack[0] = (0, 0, self.n, 0, self.boxes[0].distance2(&q));
-        while top > 0 {
-            top -= 1;
-            let (node, s, e, level, d) = stack[top];
-            if d >= bound {
-                continue;
-            }
-            if level == self.depth {
-                for k in s..e {
-                    if !live(k) {
-                        continue;
+        self.walk(q, radius2, |s, e| {
+            for k in s..e {
+                if !live(k) {
+                    continue;
+                }
+                let a = point(k);
+                let d2 = (a[0] - q[0]) * (a[0] - q[0])
+                    + (a[1] - q[1]) * (a[1] - q[1])
+                    + (a[2] - q[2]) * (a[2] - q[2]);
+                if d2 < bound {
+                    // Insert in distance order (after equal distances), dropping the
+                    // farthest when full.
+                    let mut j = count.min(K - 1);
+                    while j > 0 && out[j - 1].0 > d2 {
+                        out[j] = out[j - 1];
+                        j -= 1;
                     }
-                    let a = point(k);
-                    let d2 = (a[0] - q[0]) * (a[0] - q[0])
-                        + (a[1] - q[1]) * (a[1] - q[1])
-                        + (a[2] - q[2]) * (a[2] - q[2]);
-                    if d2 < bound {
-                        // Insert in distance order (after equal distances), dropping the
-                        // farthest when full.
-                        let mut j = count.min(K - 1);
-                        while j > 0 && out[j - 1].0 > d2 {
-                            out[j] = out[j - 1];
-                            j -= 1;
-                        }
-                        out[j] = (d2, k as u32);
-                        if count < K {
-                            count += 1;
-                        }
-                        if count == K {
-                            bound = out[K - 1].0;
-                        }
+                    out[j] = (d2, k as u32);
+                    if count < K {
+                        count += 1;
+                    }
+                    if count == K {
+                        bound = out[K - 1].0;
                     }
                 }
-                continue;
             }
-            let m = s + (e - s) / 2;
-            let (l, r) = (2 * node + 1, 2 * node + 2);
-            let (dl, dr) = (self.boxes[l].distance2(&q), self.boxes[r].distance2(&q));
-            let (near, far) = if dl <= dr {
-                ((l, s, m, dl), (r, m, e, dr))
-            } else {
-                ((r, m, e, dr), (l, s, m, dl))
-            };
-            if far.3 < bound {
-                stack[top] = (far.0, far.1, far.2, level + 1, far.3);
-                top += 1;
-            }
-            if near.3 < bound {
-                stack[top] = (near.0, near.1, near.2, level + 1, near.3);
-                top += 1;
-            }
-        }
+            bound
+        });
         (count, bound)
     }
 
