@@ -147,11 +147,12 @@ def test_compare_run_and_cancel_in_a_window(tmp_path):
     assert any(x.startswith("cancelled ") for x in res["labels"]), res["labels"]
     assert "# cancelled" in res["log"]
     assert not os.path.exists(os.path.join(ds, "runs", "demo", "slow", "run.json"))
-    # responsive throughout: no gap between UI ticks over 4 s (software GL redraws
-    # take about a second), ticks after the run ended
-    # (the screenshots' phases wait for redraws on purpose)
+    # responsive throughout, ticks after the run ended (the screenshots' phases wait for
+    # redraws on purpose). A blocking call would stop the timer for a whole run (the slow
+    # tool sleeps 60 s until cancelled); a software-GL redraw takes about a second idle and
+    # took 4.8 s once under a load of 8, so the bound is 10 s, not a timing measurement.
     times = [t[0] for t in ticks if not t[1].startswith("shoot")]
-    assert max(np.diff(times)) < 4.0, max(np.diff(times))
+    assert max(np.diff(times)) < 10.0, max(np.diff(times))
     assert any(t[1] == "cancelled" and not t[2] for t in ticks), ticks
     # (c) the screenshot: the window, not a blank image
     from PIL import Image
