@@ -38,7 +38,7 @@ if ! scripts/build-web.sh >"$log/build.log" 2>&1; then
   fail "build-web" "$log/build.log"; echo "$passed passed, $failed failed"; exit 1
 fi
 tail -1 "$log/build.log"
-cargo build --release --locked -p sfmeval-cli >"$log/cli.log" 2>&1 || fail "cli build" "$log/cli.log"
+scripts/build-release.sh >"$log/cli.log" 2>&1 || fail "cli build" "$log/cli.log"
 echo "build: $((SECONDS - t)) s"
 (cd tests/browser && [ -f node_modules/axe-core/axe.min.js ] || npm ci --no-audit --no-fund --silent)
 
@@ -133,7 +133,7 @@ cp data/demo/ground_truth.glb data/demo/cameras.json "$cmp/statue/"
 # the custom commands never read the images: empty files give the dataset its 36 image names
 for i in $(seq -f %04g 0 35); do : > "$cmp/statue/images/$i.jpg"; done
 fx=$ROOT/tests/fixtures/global
-if cargo build --release --locked -p sfmeval-runner >"$log/runner.log" 2>&1 &&
+if scripts/build-release.sh >"$log/runner.log" 2>&1 &&
   ./target/release/sfmeval-runner run --datasets "$cmp/statue" --intrinsics known --out "$cmp/runs" \
     --pipelines 'sparse-colmap;pycolmap-ply;theia-ply;broken' --custom "broken=exit 3; {out}" \
     --custom "sparse-colmap=cp '$ROOT/data/demo/sparse/'*.txt {out}/" \
@@ -154,7 +154,7 @@ echo "compare: $((SECONDS - t)) s (screenshots compare*.png in $out)"
 if [ "${SFMEVAL_BENCH:-0}" = 1 ]; then
   node tests/browser/bench.mjs --url "http://127.0.0.1:$port/" --cli target/release/sfmeval 2>&1 | tee "$log/bench.log"
   # per operation, npm package in Node vs native with one thread (needs examples/bench_op)
-  cargo build --release --locked -q -p sfmeval --features parallel --example bench_op &&
+  scripts/build-release.sh -q &&
     node tests/browser/bench-ops.mjs 2>&1 | tee "$log/bench-ops.log"
 fi
 kill $server $plain_server 2>/dev/null

@@ -30,17 +30,22 @@ check() { # name, command...
 }
 
 check fmt cargo fmt --all --check
+# --all-targets: the benches and examples type-check too (bench/compare.py below builds and runs
+# bench_op; a full `cargo bench --no-run` cost 400+ s of release builds for no further check).
 check clippy cargo clippy --workspace --all-targets --locked -- -D warnings
 check doc env RUSTDOCFLAGS="-D warnings" cargo doc --workspace --no-deps --locked
-check wasm32-core cargo build -p sfmeval --target wasm32-unknown-unknown --release --locked
-check bench-compiles cargo bench --workspace --no-run --locked
+# The core alone for wasm32 (no wasm-bindgen): scripts/build-web.sh in test-browser.sh builds
+# and runs the real wasm packages.
+check wasm32-core cargo check -p sfmeval --target wasm32-unknown-unknown --locked
 # Module import graphs without cycles (core and runner): every arrow points down.
 check import-graph-core python3 scripts/import-graph.py crates/sfmeval/src
 check import-graph-runner python3 scripts/import-graph.py native_runner/src
 
 # Rust tests: count each test.
 t=$SECONDS
-cargo build --release --locked -p sfmeval-cli >"$log/build.log" 2>&1 || { failed=$((failed + 1)); failures+=("release build"); tail -40 "$log/build.log"; }
+# Every binary and example once (scripts/build-release.sh: the features `cargo test` resolves too,
+# and the one release build command of the Python tests, bench/compare.py and test-browser.sh).
+scripts/build-release.sh >"$log/build.log" 2>&1 || { failed=$((failed + 1)); failures+=("release build"); tail -40 "$log/build.log"; }
 cargo test --workspace --release --locked >"$log/cargo-test.log" 2>&1
 rc=$?
 p=$(grep -Eo '^test result: .* ([0-9]+) passed' "$log/cargo-test.log" | grep -Eo '[0-9]+ passed' | awk '{s+=$1} END {print s+0}')
@@ -67,7 +72,7 @@ while read -r line; do skip "bench-compare-quick" "$line"; done < <(
 check bench-tnt-quick .venv/bin/python bench/tanksandtemples.py --quick
 
 # Python tests (reference tools, real files).
-export SFMEVAL_BIN="$PWD/target/release/sfmeval"
+export SFMEVAL_BIN="$PWD/target/release/sfmeval" SFMEVAL_RUNNER_BIN="$PWD/target/release/sfmeval-runner"
 pytest_dirs=()
 for d in tests/python blender_scripts/tests native_runner/tests; do [ -d "$d" ] && pytest_dirs+=("$d"); done
 if [ ${#pytest_dirs[@]} -gt 0 ]; then

@@ -1,7 +1,7 @@
 """Fixtures and helpers of the sfmeval-runner tests (imported by conftest.py; a unique module
 name so that one pytest session can hold every test folder).
 
-- `runner_bin`: $SFMEVAL_RUNNER_BIN, else `cargo build --release -p sfmeval-runner`.
+- `runner_bin`: $SFMEVAL_RUNNER_BIN, else built by `scripts/build-release.sh`.
 - `small_dataset`: the generator's `small` preset (36 views, 640×360; no depth/mask pass),
   rendered once with PyPI bpy into target/test-data/small-<key>/, where <key> hashes the full
   resolved generator config (`generate.py --print-config`) and the generator's source, and
@@ -78,7 +78,7 @@ def runner_bin():
     if b:
         assert os.path.isfile(b), b
         return b
-    subprocess.run(["cargo", "build", "--release", "-p", "sfmeval-runner"], cwd=REPO, check=True)
+    subprocess.run([os.path.join(REPO, "scripts", "build-release.sh")], cwd=REPO, check=True)
     return os.path.join(REPO, "target", "release", "sfmeval-runner")
 
 

@@ -48,7 +48,7 @@ def sfmeval_bin():
         return os.path.abspath(b)
     b = os.path.join(REPO, "target", "release", "sfmeval")
     if not os.path.isfile(b):
-        subprocess.run(["cargo", "build", "--release", "-p", "sfmeval-cli"], cwd=REPO, check=True)
+        subprocess.run([os.path.join(REPO, "scripts", "build-release.sh")], cwd=REPO, check=True)
     return b
 
 

@@ -83,5 +83,5 @@ def test_runner_equals_the_cli(scene_report, batch, sfmeval_cli):
 def sfmeval_cli():
     b = os.environ.get("SFMEVAL_BIN") or os.path.join(REPO, "target", "release", "sfmeval")
     if not os.path.isfile(b):
-        subprocess.run(["cargo", "build", "--release", "-p", "sfmeval-cli"], cwd=REPO, check=True)
+        subprocess.run([os.path.join(REPO, "scripts", "build-release.sh")], cwd=REPO, check=True)
     return b

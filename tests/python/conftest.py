@@ -15,7 +15,7 @@ def sfmeval_bin() -> str:
     env_bin = os.environ.get("SFMEVAL_BIN")
     if env_bin and Path(env_bin).exists():
         return env_bin
-    subprocess.run(["cargo", "build", "--release", "-q", "-p", "sfmeval-cli"], cwd=ROOT, check=True)
+    subprocess.run([str(ROOT / "scripts" / "build-release.sh"), "-q"], cwd=ROOT, check=True)
     return str(ROOT / "target" / "release" / "sfmeval")
 
 

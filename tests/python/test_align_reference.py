@@ -32,8 +32,7 @@ def tool_path() -> str:
     env = os.environ.get("SFMEVAL_ALIGN_TOOL")
     if env and Path(env).exists():
         return env
-    subprocess.run(["cargo", "build", "--release", "-q", "--features", "parallel", "-p", "sfmeval",
-                    "--example", "align_tool"], cwd=ROOT, check=True)
+    subprocess.run([str(ROOT / "scripts" / "build-release.sh"), "-q"], cwd=ROOT, check=True)
     return str(ROOT / "target" / "release" / "examples" / "align_tool")
 
 
