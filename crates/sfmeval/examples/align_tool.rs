@@ -123,12 +123,17 @@ fn run(args: &[String]) -> Result<serde_json::Value, String> {
                 .map_err(|e| e.to_string())?;
             let pts: Vec<[f64; 3]> = recon.iter().take(16_384).map(|p| start.apply(*p)).collect();
             let t0 = Instant::now();
-            let d: f64 = pts.iter().map(|p| gt.closest_point(*p).1).sum();
+            let d: f64 = pts
+                .iter()
+                .map(|p| gt.closest_point(*p, &mut Default::default()).1)
+                .sum();
             let serial = t0.elapsed().as_secs_f64();
             let t0 = Instant::now();
-            let d2: f64 = sfmeval::parallel::map(&pts, &NoProgress, |p| gt.closest_point(*p).1)
-                .iter()
-                .sum();
+            let d2: f64 = sfmeval::parallel::map(&pts, &NoProgress, |p| {
+                gt.closest_point(*p, &mut Default::default()).1
+            })
+            .iter()
+            .sum();
             let par = t0.elapsed().as_secs_f64();
             Ok(
                 serde_json::json!({"queries": pts.len(), "serial_seconds": serial, "parallel_seconds": par, "mean": d / pts.len() as f64, "same": d == d2}),

@@ -142,7 +142,9 @@ fn main() -> Res<()> {
             let c = read_cloud(cloud_path()?)?;
             let t = Instant::now();
             let idx = MeshIndex::new(&m)?;
-            let d = sfmeval::parallel::map_points(&c, &NoProgress, |p| idx.closest(*p).distance);
+            let d = sfmeval::parallel::map_points_with_state(&c, &NoProgress, |hint, p| {
+                idx.closest_from(*p, hint).distance
+            });
             (t.elapsed().as_secs_f64(), summary(&d))
         }
         "completeness" => {

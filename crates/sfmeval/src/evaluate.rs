@@ -301,8 +301,8 @@ pub fn evaluate(
     let mut signed_distances = signed_wanted.then(|| vec![0.0f64; n]);
     for start in (0..n).step_by(BLOCK) {
         let end = (start + BLOCK).min(n);
-        let block = parallel::map_range_progress(start, end, progress, |k| {
-            gt.distance(in_gt(k), options.signed)
+        let block = parallel::map_range_with_state(start, end, progress, |hint, k| {
+            gt.distance_from(in_gt(k), options.signed, hint)
         });
         for (k, (d, s)) in (start..end).zip(block) {
             let i = slot_input[k] as usize;

@@ -97,8 +97,10 @@ where
     }
 }
 
-/// Maps `f` over `start..end`, keeping order, reporting progress per chunk.
-pub(crate) fn map_range_progress<R, F>(
+/// Maps `f` over `start..end`, keeping order, reporting progress per chunk; `f` also gets a
+/// state carried from one index to the next within a chunk (each chunk starts from
+/// `S::default()`), as in [`map_with_state`].
+pub(crate) fn map_range_with_state<R, S, F>(
     start: usize,
     end: usize,
     progress: &dyn Progress,
@@ -106,12 +108,14 @@ pub(crate) fn map_range_progress<R, F>(
 ) -> Vec<R>
 where
     R: Send,
-    F: Fn(usize) -> R + Sync + Send,
+    S: Default,
+    F: Fn(&mut S, usize) -> R + Sync + Send,
 {
     let starts: Vec<usize> = (start..end).step_by(CHUNK).collect();
     let chunk = |&s: &usize| {
         let e = (s + CHUNK).min(end);
-        let out: Vec<R> = (s..e).map(&f).collect();
+        let mut state = S::default();
+        let out: Vec<R> = (s..e).map(|k| f(&mut state, k)).collect();
         progress.advance((e - s) as u64);
         out
     };
@@ -144,11 +148,7 @@ where
 /// [`map_points`] where `f` also gets a state carried from one point to the next in the
 /// visiting order, as in [`map_with_state`]: neighbours in space follow each other, so the
 /// previous answer is a good start.
-pub(crate) fn map_points_with_state<R, S, F>(
-    points: &[Point3],
-    progress: &dyn Progress,
-    f: F,
-) -> Vec<R>
+pub fn map_points_with_state<R, S, F>(points: &[Point3], progress: &dyn Progress, f: F) -> Vec<R>
 where
     R: Send + Copy,
     S: Default,

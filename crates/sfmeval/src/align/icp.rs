@@ -198,7 +198,9 @@ pub(crate) fn correspondences(
     pts: &[Point3],
 ) -> Vec<(Point3, f64)> {
     let moved: Vec<Point3> = pts.iter().map(|p| t.apply(*p)).collect();
-    crate::parallel::map_points(&moved, &NoProgress, |p| gt.closest_point(*p))
+    crate::parallel::map_points_with_state(&moved, &NoProgress, |hint, p| {
+        gt.closest_point(*p, hint)
+    })
 }
 
 /// RMS distance of points to their centroid.

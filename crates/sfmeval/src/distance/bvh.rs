@@ -1,17 +1,25 @@
-//! A compact bounding-volume hierarchy over triangles for exact closest-point queries.
+//! A compact 4-wide bounding-volume hierarchy over triangles for exact closest-point queries.
 //!
 //! Why not parry's `TriMesh` BVH (used before): on the 1M-triangle bench mesh it needed about
 //! 340 MB of peak memory to build (one node of 112 bytes per triangle plus build buffers) and
-//! its f64 nodes do not fit the cache. Here a node is 32 bytes (`f32` bounds rounded outwards,
-//! so a box never shrinks), leaves hold up to [`LEAF_SIZE`] triangles, and the two children of
-//! a node sit side by side in one cache line. The leaf test is parry's exact f64
-//! point-triangle projection, so every distance is as exact as before; only the pruning uses
-//! the rounded boxes, and pruning with a box that contains the true one never drops the answer.
+//! its f64 nodes do not fit the cache. Here a node holds the boxes of its four children as
+//! `f32` lanes, structure of arrays (128 bytes, two cache lines), so one visit tests four boxes
+//! in a few vector instructions. The boxes are relative to the mesh's centre (so they stay
+//! tight for georeferenced coordinates, where absolute `f32` is coarser than a triangle) and
+//! rounded outwards, and the box distance is computed to be a lower bound (query rounded
+//! outwards too, a margin for the `f64` exact test, a relative guard on the `f32` squares):
+//! pruning with it never drops the answer. Leaves hold up to [`LEAF_SIZE`] triangles, tested
+//! with parry's exact f64 point-triangle projection.
 //!
 //! Each leaf also keeps a [`LeafBound`] block: a conservative `f32` lower bound on the distance
 //! to each of its triangles, four at a time. The exact test runs only for a triangle whose
-//! bound is below the best distance so far (near-surface queries on a smooth mesh: about 4
-//! exact tests instead of 24), and the answer stays the one testing every triangle gives.
+//! bound is not above the best distance so far (near-surface queries on a smooth mesh: about 4
+//! exact tests instead of 24).
+//!
+//! The answer is the triangle with the smallest exact squared distance and, among equal ones,
+//! the smallest input index: it does not depend on the tree's shape or the visiting order, so
+//! a query may start from a hint (the previous query's triangle), and the result equals a
+//! brute-force search over every triangle bit for bit.
 
 use parry3d_f64::math::Vector;
 use parry3d_f64::query::PointQueryWithLocation as _;
@@ -24,38 +32,116 @@ use crate::geometry::{Point3, TriangleMesh, sub};
 /// Most triangles in a leaf: one [`LeafBound`] block.
 pub(crate) const LEAF_SIZE: usize = LANES;
 
-/// Deepest tree the fixed traversal stack allows (median splits give ~log2(n / 4) + 1 ≤ 31).
-const MAX_DEPTH: usize = 64;
+/// Children of an inner node.
+const WIDTH: usize = 4;
 
-/// One node: `count > 0` is a leaf over `tris[index .. index + count]` (`index` a multiple of
-/// [`LEAF_SIZE`]: leaf `index / LEAF_SIZE`'s slots, its bound block `bounds[index / LEAF_SIZE]`);
-/// `count == 0` is an inner node whose children are `nodes[index]` and `nodes[index + 1]`.
-#[derive(Debug, Clone, Copy, Default)]
-#[repr(C, align(32))]
+/// A child code with this bit set is a leaf (the rest its index), else an inner node's index.
+const LEAF: u32 = 1 << 31;
+
+/// An unused lane's child code.
+const EMPTY: u32 = u32::MAX;
+
+/// The traversal stack: at most `WIDTH - 1` pending children a level; median splits of fewer
+/// than 2^32 triangles give at most 32 binary levels, 16 of this tree's.
+const STACK: usize = (WIDTH - 1) * 32 + 1;
+
+/// Query coordinates relative to the centre are clamped into ±`CLAMP` (every box lies inside
+/// ±`MAX_RELATIVE`, so the clamped point's distance to a box is not above the true one, and no
+/// `f32` square overflows).
+const CLAMP: f64 = (1u64 << 60) as f64;
+
+/// Largest relative coordinate the `f32` boxes are used for; a mesh reaching farther gets
+/// unbounded boxes (every leaf visited: correct, slow, and only for absurd inputs).
+const MAX_RELATIVE: f64 = (1u64 << 59) as f64;
+
+/// Relative guard on the `f32` box distances: the rounding of the differences, squares and
+/// sums stays well within 2⁻²⁰.
+const SHRINK: f32 = 1.0 - 1.0 / (1u32 << 20) as f32;
+
+/// Absolute guard against `f32` underflow of a tiny squared distance (a normal number: a
+/// subnormal operand would be slow on every node).
+const TINY: f32 = f32::MIN_POSITIVE;
+
+/// An inner node: the boxes of up to [`WIDTH`] children, per axis and lane, relative to the
+/// tree's centre (an unused lane: `+∞` to `−∞`, never visited), and each child's code and
+/// triangle count (a leaf's; 0 for an inner node).
+#[derive(Debug, Clone, Copy)]
+#[repr(C, align(64))]
 struct Node {
-    min: [f32; 3],
-    count: u32,
-    max: [f32; 3],
-    index: u32,
+    min: [[f32; WIDTH]; 3],
+    max: [[f32; WIDTH]; 3],
+    child: [u32; WIDTH],
+    count: [u8; WIDTH],
 }
 
+const EMPTY_NODE: Node = Node {
+    min: [[f32::INFINITY; WIDTH]; 3],
+    max: [[f32::NEG_INFINITY; WIDTH]; 3],
+    child: [EMPTY; WIDTH],
+    count: [0; WIDTH],
+};
+
 impl Node {
-    /// Squared distance from `p` to the node's box (0 inside).
+    /// Lower bounds on the squared distances from the query to the four boxes (`+∞` for an
+    /// unused lane). Computed in `f32` lanes; see [`Query`] for why each is a lower bound.
     #[inline]
-    fn distance2(&self, p: &Point3) -> f64 {
-        let mut d2 = 0.0;
-        for ((&min, &max), &pk) in self.min.iter().zip(&self.max).zip(p) {
-            let d = (f64::from(min) - pk).max(pk - f64::from(max)).max(0.0);
-            d2 += d * d;
+    fn lower_bounds2(&self, q: &Query) -> [f32; WIDTH] {
+        let mut d2 = [0.0f32; WIDTH];
+        for k in 0..3 {
+            for (l, acc) in d2.iter_mut().enumerate() {
+                // Branch-free forms (no NaN can occur: finite query, finite or infinite boxes).
+                let below = self.min[k][l] - q.hi[k];
+                let above = q.lo[k] - self.max[k][l];
+                let d = if below > above { below } else { above } - q.margin;
+                let d = if d > 0.0 { d } else { 0.0 };
+                *acc += d * d;
+            }
         }
-        d2
+        d2.map(|v| v * SHRINK - TINY)
     }
 
-    /// The lower corner and the size of the box, the frame of a leaf's bound block.
+    /// The frame of child `lane`'s leaf bound block: its box's lower corner and size.
     #[inline]
-    fn origin_extent(&self) -> (Point3, Point3) {
-        let origin = self.min.map(f64::from);
-        (origin, sub(self.max.map(f64::from), origin))
+    fn leaf_frame(&self, lane: usize, centre: Point3) -> (Point3, Point3) {
+        frame(
+            [0, 1, 2].map(|k| self.min[k][lane]),
+            [0, 1, 2].map(|k| self.max[k][lane]),
+            centre,
+        )
+    }
+}
+
+/// A leaf bound block's frame from its box (relative to `centre`): lower corner and size.
+#[inline]
+fn frame(min: [f32; 3], max: [f32; 3], centre: Point3) -> (Point3, Point3) {
+    let origin = [0, 1, 2].map(|k| centre[k] + f64::from(min[k]));
+    let extent = [0, 1, 2].map(|k| f64::from(max[k]) - f64::from(min[k]));
+    (origin, extent)
+}
+
+/// A query point as the box test sees it: relative to the centre, clamped, rounded down and
+/// up to `f32`, and the absolute margin that covers the `f64` exact test's rounding.
+///
+/// Why the result is a lower bound: the box distance of the rounded-outwards query to the
+/// rounded-outwards box, less the margin, is not above the true distance per axis; the `f32`
+/// subtraction, squares and sums round by at most 2⁻²⁴ each, which [`SHRINK`] covers.
+struct Query {
+    lo: [f32; 3],
+    hi: [f32; 3],
+    margin: f32,
+}
+
+impl Query {
+    fn new(p: Point3, centre: Point3) -> Self {
+        let local = [0, 1, 2].map(|k| (p[k] - centre[k]).clamp(-CLAMP, CLAMP));
+        let sum = |v: Point3| v[0].abs() + v[1].abs() + v[2].abs();
+        // As the leaf bound's global term (`leaf_bound::margin`): 2⁻⁴⁴ of the coordinates.
+        let margin = up((sum(p) + sum(centre)) / 17_592_186_044_416.0);
+        Query {
+            lo: local.map(down),
+            hi: local.map(up),
+            margin,
+        }
     }
 }
 
@@ -70,12 +156,32 @@ pub(crate) struct Closest {
     pub triangle: u32,
     /// That triangle's corners.
     pub corners: [Point3; 3],
+    /// Its slot in leaf order (a [`Hint`] for the next query).
+    slot: u32,
 }
 
-/// The hierarchy: nodes, the triangles in leaf order (vertex indices; [`LEAF_SIZE`] slots a
-/// leaf, the unused ones never read), their input indices and each leaf's bound block.
+impl Closest {
+    /// Whether this beats `other`: nearer, or as near with a smaller input index.
+    #[inline]
+    fn beats(&self, other: &Closest) -> bool {
+        self.distance2 < other.distance2
+            || (self.distance2 == other.distance2 && self.triangle < other.triangle)
+    }
+}
+
+/// Where a query starts: the triangle that answered the previous query, if any. Queries that
+/// follow each other in space (the reconstruction in k-d tree order, ICP in Morton order) prune
+/// from the first node on; the answer does not depend on it.
+#[derive(Debug, Clone, Copy, Default)]
+pub(crate) struct Hint(Option<u32>);
+
+/// The hierarchy: inner nodes, the triangles in leaf order (vertex indices; [`LEAF_SIZE`]
+/// slots a leaf, the unused ones never read), their input indices and each leaf's bound block.
 pub(crate) struct TriangleBvh {
     nodes: Vec<Node>,
+    centre: Point3,
+    /// The boxes are unbounded (a mesh beyond [`MAX_RELATIVE`]): no leaf bounds either.
+    unbounded: bool,
     vertices: Vec<Point3>,
     tris: Vec<[u32; 3]>,
     ids: Vec<u32>,
@@ -83,8 +189,9 @@ pub(crate) struct TriangleBvh {
 }
 
 impl TriangleBvh {
-    /// Builds the hierarchy by median splits of the triangle centroids along the longest axis.
-    /// The mesh must be valid (vertex indices in range, finite vertices); deterministic.
+    /// Builds the hierarchy by median splits of the triangle centroids along the longest axis,
+    /// two levels of them a node. The mesh must be valid (vertex indices in range, finite
+    /// vertices); deterministic.
     pub(crate) fn new(mesh: &TriangleMesh) -> Self {
         let centroids: Vec<Point3> = mesh
             .triangles
@@ -98,9 +205,25 @@ impl TriangleBvh {
                 ]
             })
             .collect();
+        let mut lo = [f64::INFINITY; 3];
+        let mut hi = [f64::NEG_INFINITY; 3];
+        for t in &mesh.triangles {
+            for v in mesh.corners(t) {
+                for k in 0..3 {
+                    lo[k] = lo[k].min(v[k]);
+                    hi[k] = hi[k].max(v[k]);
+                }
+            }
+        }
+        let centre = if mesh.triangles.is_empty() {
+            [0.0; 3]
+        } else {
+            [0, 1, 2].map(|k| lo[k] + (hi[k] - lo[k]) / 2.0)
+        };
+        let unbounded = (0..3).any(|k| !((hi[k] - lo[k]) / 2.0 < MAX_RELATIVE / 2.0));
+        let unbounded = unbounded && !mesh.triangles.is_empty();
         let mut order: Vec<u32> = (0..mesh.triangles.len() as u32).collect();
-        let mut nodes = Vec::with_capacity(2 * mesh.triangles.len() / LEAF_SIZE + 2);
-        nodes.push(Node::default());
+        let mut nodes = Vec::with_capacity(mesh.triangles.len() / (2 * LEAF_SIZE) + 2);
         let mut leaves = Vec::with_capacity(mesh.triangles.len() / (LEAF_SIZE - 1) + 1);
         let mut builder = Builder {
             mesh,
@@ -108,14 +231,16 @@ impl TriangleBvh {
             order: &mut order,
             nodes: &mut nodes,
             leaves: &mut leaves,
+            centre,
+            unbounded,
         };
         if !mesh.triangles.is_empty() {
-            builder.build(0, 0, mesh.triangles.len(), 0);
+            builder.root(mesh.triangles.len());
         }
         drop(centroids);
         let slots = leaves.len() * LEAF_SIZE;
         let mut tris = vec![[0u32; 3]; slots];
-        let mut ids = vec![0u32; slots];
+        let mut ids = vec![u32::MAX; slots];
         let mut bounds = Vec::with_capacity(leaves.len());
         for (leaf, &(start, end, origin, extent)) in leaves.iter().enumerate() {
             let slot = leaf * LEAF_SIZE;
@@ -125,10 +250,16 @@ impl TriangleBvh {
                 ids[slot + k] = i;
                 corners[k] = mesh.corners(&mesh.triangles[i as usize]);
             }
-            bounds.push(LeafBound::new(&corners[..end - start], origin, extent));
+            bounds.push(if unbounded {
+                LeafBound::default()
+            } else {
+                LeafBound::new(&corners[..end - start], origin, extent)
+            });
         }
         TriangleBvh {
             nodes,
+            centre,
+            unbounded,
             vertices: mesh.vertices.clone(),
             tris,
             ids,
@@ -136,116 +267,164 @@ impl TriangleBvh {
         }
     }
 
-    /// Number of nodes (for tests and the memory estimate).
+    /// Number of inner nodes (for tests and the memory estimate).
     #[cfg(test)]
     pub(crate) fn node_count(&self) -> usize {
         self.nodes.len()
     }
 
-    /// The corners of leaf-order triangle `k`.
-    fn corners(&self, k: usize) -> [Point3; 3] {
+    /// Exact closest point of leaf-order triangle `k` to `q`.
+    #[inline]
+    fn project(&self, k: usize, q: Vector) -> Closest {
+        #[cfg(test)]
+        tests::EXACT_TESTS.with(|n| n.set(n.get() + 1));
         let t = self.tris[k];
-        [
-            self.vertices[t[0] as usize],
-            self.vertices[t[1] as usize],
-            self.vertices[t[2] as usize],
-        ]
+        let [a, b, c] = t.map(|v| self.vertices[v as usize]);
+        let tri = Triangle::new(
+            Vector::new(a[0], a[1], a[2]),
+            Vector::new(b[0], b[1], b[2]),
+            Vector::new(c[0], c[1], c[2]),
+        );
+        let (proj, _) = tri.project_local_point_and_get_location(q, false);
+        let d = proj.point - q;
+        Closest {
+            distance2: d.dot(d),
+            point: [proj.point.x, proj.point.y, proj.point.z],
+            triangle: self.ids[k],
+            corners: [a, b, c],
+            slot: k as u32,
+        }
     }
 
     /// The exact closest surface point to `p`; `None` for an empty mesh or a non-finite `p`.
-    /// Of triangles at the same distance, the first in the traversal's order.
+    /// Of triangles at the same distance, the one with the smallest input index.
     pub(crate) fn closest(&self, p: Point3) -> Option<Closest> {
-        self.search::<true>(p)
+        self.search::<true>(p, None)
     }
 
-    /// The search; `BOUND` false tests every triangle of a visited leaf exactly (the reference
-    /// the bounds are checked against in the tests).
-    fn search<const BOUND: bool>(&self, p: Point3) -> Option<Closest> {
-        if self.tris.is_empty() || !p.iter().all(|v| v.is_finite()) {
+    /// [`Self::closest`], starting from `hint` (the same answer; faster when the hint's
+    /// triangle is near the answer), and leaving this answer in `hint`.
+    pub(crate) fn closest_from(&self, p: Point3, hint: &mut Hint) -> Option<Closest> {
+        let found = self.search::<true>(p, hint.0);
+        if let Some(c) = &found {
+            hint.0 = Some(c.slot);
+        }
+        found
+    }
+
+    /// The search from triangle slot `start` (if any); `BOUND` false tests every triangle of
+    /// a visited leaf exactly (the reference the bounds are checked against in the tests).
+    fn search<const BOUND: bool>(&self, p: Point3, start: Option<u32>) -> Option<Closest> {
+        if self.nodes.is_empty() || !p.iter().all(|v| v.is_finite()) {
             return None;
         }
         let q = Vector::new(p[0], p[1], p[2]);
-        let mut best = Closest {
-            distance2: f64::INFINITY,
-            point: p,
-            triangle: 0,
-            corners: [p; 3],
+        let mut best = match start {
+            // (an unused slot's id is `u32::MAX`)
+            Some(k) if self.ids.get(k as usize).is_some_and(|&id| id != u32::MAX) => {
+                self.project(k as usize, q)
+            }
+            _ => Closest {
+                distance2: f64::INFINITY,
+                point: p,
+                triangle: u32::MAX,
+                corners: [p; 3],
+                slot: u32::MAX,
+            },
         };
-        let mut stack = [(0u32, 0.0f64); MAX_DEPTH];
+        let query = Query::new(p, self.centre);
+        // Pending children: (node, lane, squared box distance).
+        let mut stack = [(0u32, 0u8, 0.0f32); STACK];
         let mut depth = 0;
-        let mut node = self.nodes[0];
+        let mut node = 0usize;
         loop {
-            if node.count > 0 {
-                let start = node.index as usize;
-                let bounds2 = if BOUND {
-                    let (origin, extent) = node.origin_extent();
-                    let local = sub(p, origin);
-                    let margin = leaf_bound::margin(local, origin, extent);
-                    let scale = leaf_bound::offset_scale(extent) as f32;
-                    self.bounds[start / LEAF_SIZE].lower_bounds2(
-                        local.map(|v| v as f32),
-                        scale,
-                        margin,
-                    )
-                } else {
-                    [0.0; LANES]
-                };
-                for (lane, &bound2) in bounds2.iter().enumerate().take(node.count as usize) {
-                    if f64::from(bound2) >= best.distance2 {
-                        continue;
+            // Expand `node`: its children nearer than the best, nearest first.
+            let n = &self.nodes[node];
+            let d2 = n.lower_bounds2(&query);
+            let mut near = [(0.0f32, 0u8); WIDTH];
+            let mut m = 0;
+            for (lane, &d) in d2.iter().enumerate() {
+                if n.child[lane] != EMPTY && f64::from(d) <= best.distance2 {
+                    // insertion by distance, ties by lane
+                    let mut j = m;
+                    while j > 0 && near[j - 1].0 > d {
+                        near[j] = near[j - 1];
+                        j -= 1;
                     }
-                    let k = start + lane;
-                    #[cfg(test)]
-                    tests::EXACT_TESTS.with(|n| n.set(n.get() + 1));
-                    let [a, b, c] = self.corners(k);
-                    let tri = Triangle::new(
-                        Vector::new(a[0], a[1], a[2]),
-                        Vector::new(b[0], b[1], b[2]),
-                        Vector::new(c[0], c[1], c[2]),
-                    );
-                    let (proj, _) = tri.project_local_point_and_get_location(q, false);
-                    let d = proj.point - q;
-                    let d2 = d.dot(d);
-                    if d2 < best.distance2 {
-                        best = Closest {
-                            distance2: d2,
-                            point: [proj.point.x, proj.point.y, proj.point.z],
-                            triangle: self.ids[k],
-                            corners: [a, b, c],
-                        };
-                    }
-                }
-            } else {
-                let (l, r) = (node.index as usize, node.index as usize + 1);
-                let (dl, dr) = (self.nodes[l].distance2(&p), self.nodes[r].distance2(&p));
-                let ((near, dn), (far, df)) = if dl <= dr {
-                    ((l, dl), (r, dr))
-                } else {
-                    ((r, dr), (l, dl))
-                };
-                if dn < best.distance2 {
-                    if df < best.distance2 && depth < MAX_DEPTH {
-                        stack[depth] = (far as u32, df);
-                        depth += 1;
-                    }
-                    node = self.nodes[near];
-                    continue;
+                    near[j] = (d, lane as u8);
+                    m += 1;
                 }
             }
-            // Next pending node still closer than the best so far.
+            // Farthest first onto the stack, so the nearest is taken next.
+            for &(d, lane) in near[..m].iter().rev() {
+                stack[depth] = (node as u32, lane, d);
+                depth += 1;
+            }
+            // Next pending child still not farther than the best: test leaves on the way.
             loop {
                 if depth == 0 {
-                    return Some(best);
+                    return (best.slot != u32::MAX).then_some(best);
                 }
                 depth -= 1;
-                let (i, d) = stack[depth];
-                if d < best.distance2 {
-                    node = self.nodes[i as usize];
+                let (parent, lane, d) = stack[depth];
+                if f64::from(d) > best.distance2 {
+                    continue;
+                }
+                let parent = &self.nodes[parent as usize];
+                let lane = lane as usize;
+                let child = parent.child[lane];
+                if child & LEAF == 0 {
+                    node = child as usize;
                     break;
                 }
+                self.test_leaf::<BOUND>(parent, lane, p, q, &mut best);
             }
         }
     }
+
+    /// Tests the triangles of `parent`'s leaf child `lane` that could beat `best`.
+    #[inline]
+    fn test_leaf<const BOUND: bool>(
+        &self,
+        parent: &Node,
+        lane: usize,
+        p: Point3,
+        q: Vector,
+        best: &mut Closest,
+    ) {
+        let leaf = (parent.child[lane] & !LEAF) as usize;
+        let count = usize::from(parent.count[lane]);
+        let start = leaf * LEAF_SIZE;
+        let bounds2 = if BOUND && !self.unbounded {
+            let (origin, extent) = parent.leaf_frame(lane, self.centre);
+            let local = sub(p, origin);
+            let margin = leaf_bound::margin(local, origin, extent);
+            let scale = leaf_bound::offset_scale(extent) as f32;
+            self.bounds[leaf].lower_bounds2(local.map(|v| v as f32), scale, margin)
+        } else {
+            [0.0; LANES]
+        };
+        for (t, &bound2) in bounds2.iter().enumerate().take(count) {
+            if f64::from(bound2) > best.distance2 {
+                continue;
+            }
+            let c = self.project(start + t, q);
+            if c.beats(best) {
+                *best = c;
+            }
+        }
+    }
+}
+
+/// Median halvings from `n` triangles down to leaves of at most [`LEAF_SIZE`].
+fn levels(n: usize) -> u32 {
+    let mut levels = 0;
+    let mut largest = n;
+    while largest > LEAF_SIZE {
+        largest = largest.div_ceil(2);
+        levels += 1;
+    }
+    levels
 }
 
 struct Builder<'a> {
@@ -253,22 +432,98 @@ struct Builder<'a> {
     centroids: &'a [Point3],
     order: &'a mut [u32],
     nodes: &'a mut Vec<Node>,
-    /// Per leaf, in slot order: its range of `order`, its node's lower corner and extent (as
-    /// the search computes them from the node).
+    /// Per leaf, in slot order: its range of `order`, and its box's lower corner and extent
+    /// (as the search computes them from the parent's lane, [`Node::leaf_frame`]).
     leaves: &'a mut Vec<(usize, usize, Point3, Point3)>,
+    centre: Point3,
+    unbounded: bool,
 }
 
 impl Builder<'_> {
-    /// Fills `nodes[slot]` with the subtree over `order[start..end]`.
-    fn build(&mut self, slot: usize, start: usize, end: usize, depth: usize) {
-        let n = end - start;
-        // Median splits halve the range: a depth of at most 31 for u32 triangle indices, so
-        // the traversal stack (MAX_DEPTH) always suffices.
-        debug_assert!(depth < MAX_DEPTH);
-        if n <= LEAF_SIZE {
-            self.nodes[slot] = self.leaf(start, end);
-            return;
+    /// Builds the tree over `order[..n]` (n > 0) with its root at node 0.
+    fn root(&mut self, n: usize) {
+        let (end, axis) = self.prepare(0, n);
+        if end <= LEAF_SIZE {
+            // One leaf: a root with one used lane.
+            let mut root = EMPTY_NODE;
+            self.nodes.push(EMPTY_NODE);
+            self.child(&mut root, 0, 0, end, axis);
+            self.nodes[0] = root;
+        } else {
+            self.node(0, end, axis);
         }
+    }
+
+    /// An inner node over `order[start..end]` (more than [`LEAF_SIZE`] triangles, prepared):
+    /// two levels of median splits give its two to four children. Returns its index.
+    fn node(&mut self, start: usize, end: usize, axis: usize) -> u32 {
+        let index = self.nodes.len();
+        self.nodes.push(EMPTY_NODE);
+        let mut node = EMPTY_NODE;
+        let mut lane = 0;
+        let mid = self.halve(start, end, axis);
+        // An odd number of halvings to the leaves: split once here, so that the nodes below
+        // (even numbers) all get four children rather than the lowest ones two.
+        let once = levels(end - start) % 2 == 1;
+        for (s, e) in [(start, mid), (mid, end)] {
+            let (e, axis) = self.prepare(s, e);
+            if once || e - s <= LEAF_SIZE {
+                self.child(&mut node, lane, s, e, axis);
+                lane += 1;
+            } else {
+                let m = self.halve(s, e, axis);
+                for (s, e) in [(s, m), (m, e)] {
+                    let (e, axis) = self.prepare(s, e);
+                    self.child(&mut node, lane, s, e, axis);
+                    lane += 1;
+                }
+            }
+        }
+        self.nodes[index] = node;
+        index as u32
+    }
+
+    /// Fills lane `lane` of `node` with the child over `order[start..end]` (prepared): a leaf
+    /// if it fits one, else an inner node.
+    fn child(&mut self, node: &mut Node, lane: usize, start: usize, end: usize, axis: usize) {
+        let (lo, hi, code, count) = if end - start <= LEAF_SIZE {
+            let mut lo = [f64::INFINITY; 3];
+            let mut hi = [f64::NEG_INFINITY; 3];
+            for &i in &self.order[start..end] {
+                for v in self.mesh.corners(&self.mesh.triangles[i as usize]) {
+                    for k in 0..3 {
+                        let r = v[k] - self.centre[k];
+                        lo[k] = lo[k].min(r);
+                        hi[k] = hi[k].max(r);
+                    }
+                }
+            }
+            let (lo, hi) = (lo.map(down), hi.map(up));
+            let leaf = self.leaves.len();
+            let (origin, extent) = frame(lo, hi, self.centre);
+            self.leaves.push((start, end, origin, extent));
+            (lo, hi, LEAF | leaf as u32, (end - start) as u8)
+        } else {
+            let c = self.node(start, end, axis);
+            let n = &self.nodes[c as usize];
+            let lo = [0, 1, 2].map(|k| n.min[k].iter().copied().fold(f32::INFINITY, f32::min));
+            let hi = [0, 1, 2].map(|k| n.max[k].iter().copied().fold(f32::NEG_INFINITY, f32::max));
+            (lo, hi, c, 0)
+        };
+        for k in 0..3 {
+            (node.min[k][lane], node.max[k][lane]) = if self.unbounded {
+                (f32::NEG_INFINITY, f32::INFINITY)
+            } else {
+                (lo[k], hi[k])
+            };
+        }
+        node.child[lane] = code;
+        node.count[lane] = count;
+    }
+
+    /// Drops stacked copies from `order[start..end]` when all its centroids coincide; returns
+    /// the range's new end and the longest axis of its centroids (the axis to split along).
+    fn prepare(&mut self, start: usize, end: usize) -> (usize, usize) {
         let mut lo = [f64::INFINITY; 3];
         let mut hi = [f64::NEG_INFINITY; 3];
         for &i in &self.order[start..end] {
@@ -278,40 +533,30 @@ impl Builder<'_> {
                 hi[k] = hi[k].max(c[k]);
             }
         }
-        if (0..3).all(|k| hi[k] == lo[k]) {
-            // Every centroid in one place: copies of one triangle (a glTF node graph that
-            // instances a mesh many times in the same place) would make every query visit
-            // them all, since the rounded boxes never prune an equally distant copy. Only the
-            // distinct ones are kept (the first of each by input order, so results do not
-            // change: a copy is never strictly closer).
-            let unique = self.drop_copies(start, end);
-            if unique < n {
-                self.build(slot, start, start + unique, depth);
-                return;
-            }
-        }
         let axis = (0..3)
             .max_by(|&a, &b| (hi[a] - lo[a]).total_cmp(&(hi[b] - lo[b])))
             .unwrap_or(0);
-        let mid = n / 2;
+        if end - start > LEAF_SIZE && (0..3).all(|k| hi[k] == lo[k]) {
+            // Every centroid in one place: copies of one triangle (a glTF node graph that
+            // instances a mesh many times in the same place) would make every query visit
+            // them all, since the boxes never prune an equally distant copy. Only the
+            // distinct ones are kept (the first of each by input order, so results do not
+            // change: a copy is never strictly closer, and the smaller index wins a tie).
+            return (start + self.drop_copies(start, end), axis);
+        }
+        (end, axis)
+    }
+
+    /// Median split of `order[start..end]` along `axis` (ties by input index); the middle.
+    fn halve(&mut self, start: usize, end: usize, axis: usize) -> usize {
+        let mid = (end - start) / 2;
         let centroids = self.centroids;
         self.order[start..end].select_nth_unstable_by(mid, |&a, &b| {
             centroids[a as usize][axis]
                 .total_cmp(&centroids[b as usize][axis])
                 .then(a.cmp(&b))
         });
-        let children = self.nodes.len();
-        self.nodes.push(Node::default());
-        self.nodes.push(Node::default());
-        self.build(children, start, start + mid, depth + 1);
-        self.build(children + 1, start + mid, end, depth + 1);
-        let (l, r) = (self.nodes[children], self.nodes[children + 1]);
-        self.nodes[slot] = Node {
-            min: [0, 1, 2].map(|k| l.min[k].min(r.min[k])),
-            count: 0,
-            max: [0, 1, 2].map(|k| l.max[k].max(r.max[k])),
-            index: children as u32,
-        };
+        start + mid
     }
 
     /// Moves the distinct triangles of `order[start..end]` (same corners in the same cyclic
@@ -362,30 +607,6 @@ impl Builder<'_> {
         // The copies left behind are never referenced by a leaf.
         unique
     }
-
-    /// A leaf over `order[start..end]` (at most [`LEAF_SIZE`] triangles), its box rounded
-    /// outwards to `f32`, recorded in `leaves`.
-    fn leaf(&mut self, start: usize, end: usize) -> Node {
-        let mut lo = [f64::INFINITY; 3];
-        let mut hi = [f64::NEG_INFINITY; 3];
-        for &i in &self.order[start..end] {
-            for v in self.mesh.corners(&self.mesh.triangles[i as usize]) {
-                for k in 0..3 {
-                    lo[k] = lo[k].min(v[k]);
-                    hi[k] = hi[k].max(v[k]);
-                }
-            }
-        }
-        let node = Node {
-            min: lo.map(down),
-            count: (end - start) as u32,
-            max: hi.map(up),
-            index: (self.leaves.len() * LEAF_SIZE) as u32,
-        };
-        let (origin, extent) = node.origin_extent();
-        self.leaves.push((start, end, origin, extent));
-        node
-    }
 }
 
 // Test data only: platform maths is fine here (reports use libm, see clippy.toml).
@@ -427,7 +648,7 @@ mod tests {
                 let t = 1.0 + spread * ((i % 7) as f64 / 3.0 - 1.0);
                 let p = [0, 1, 2].map(|k| offset[k] + scale * p[k] / r * t);
                 let before = exact_tests();
-                let reference = bvh.search::<false>(p).unwrap();
+                let reference = bvh.search::<false>(p, None).unwrap();
                 let middle = exact_tests();
                 let hit = bvh.closest(p).unwrap();
                 without += middle - before;
@@ -532,6 +753,29 @@ mod tests {
         assert_eq!(up(0.5), 0.5);
     }
 
+    /// Brute force over every triangle with the same exact test: the smallest squared
+    /// distance, ties to the smallest input index.
+    fn brute(mesh: &TriangleMesh, p: Point3) -> (f64, u32) {
+        mesh.triangles
+            .iter()
+            .enumerate()
+            .map(|(i, t)| (exact2(mesh, t, p), i as u32))
+            .fold((f64::INFINITY, u32::MAX), |a, b| if b < a { b } else { a })
+    }
+
+    /// parry's exact squared distance from `p` to triangle `t`.
+    fn exact2(mesh: &TriangleMesh, t: &[u32; 3], p: Point3) -> f64 {
+        let q = Vector::new(p[0], p[1], p[2]);
+        let [a, b, c] = mesh.corners(t);
+        let tri = Triangle::new(
+            Vector::new(a[0], a[1], a[2]),
+            Vector::new(b[0], b[1], b[2]),
+            Vector::new(c[0], c[1], c[2]),
+        );
+        let d = tri.project_local_point_and_get_location(q, false).0.point - q;
+        d.dot(d)
+    }
+
     #[test]
     fn same_answer_as_a_brute_force_search_and_as_parry() {
         let mesh = blob(40);
@@ -545,25 +789,12 @@ mod tests {
             TriMeshFlags::empty(),
         )
         .unwrap();
+        let mut hint = Hint::default();
         for p in queries(400) {
             let hit = bvh.closest(p).unwrap();
             let q = Vector::new(p[0], p[1], p[2]);
-            // brute force over every triangle with the same exact leaf test
-            let brute = mesh
-                .triangles
-                .iter()
-                .map(|t| {
-                    let [a, b, c] = mesh.corners(t);
-                    let tri = Triangle::new(
-                        Vector::new(a[0], a[1], a[2]),
-                        Vector::new(b[0], b[1], b[2]),
-                        Vector::new(c[0], c[1], c[2]),
-                    );
-                    let d = tri.project_local_point_and_get_location(q, false).0.point - q;
-                    d.dot(d)
-                })
-                .fold(f64::INFINITY, f64::min);
-            assert_eq!(hit.distance2, brute, "at {p:?}");
+            assert_eq!((hit.distance2, hit.triangle), brute(&mesh, p), "at {p:?}");
+            assert_eq!(bvh.closest_from(p, &mut hint), Some(hit));
             let (proj, _) = parry.project_local_point_and_get_location(q, false);
             let dp = (proj.point - q).length();
             assert!(
@@ -582,21 +813,96 @@ mod tests {
         }
     }
 
+    /// Exact ties (a query nearest to a vertex shared by six triangles, or on the surface at
+    /// distance 0) go to the smallest input index, whatever the tree, the leaf bounds or the
+    /// hint.
+    #[test]
+    fn ties_go_to_the_smallest_index_from_any_start() {
+        let mesh = blob(24);
+        let bvh = TriangleBvh::new(&mesh);
+        let mut ties = 0;
+        let mut hints = [Hint::default(), Hint::default()];
+        for (i, v) in mesh.vertices.iter().enumerate() {
+            for p in [
+                [v[0] * 1.3, v[1] * 1.3, v[2] * 1.3],
+                *v,
+                [v[0] * 0.7, v[1] * 0.7, v[2] * 0.7],
+            ] {
+                let want = brute(&mesh, p);
+                let hit = bvh.closest(p).unwrap();
+                assert_eq!((hit.distance2, hit.triangle), want, "vertex {i} at {p:?}");
+                assert_eq!(bvh.search::<false>(p, None), Some(hit));
+                // a hint from elsewhere: the previous query's answer, and a fixed far one
+                assert_eq!(bvh.closest_from(p, &mut hints[0]), Some(hit));
+                bvh.closest_from([-p[0], 0.5 - p[1], -p[2]], &mut hints[1]);
+                assert_eq!(bvh.closest_from(p, &mut hints[1]), Some(hit));
+                let equal = mesh
+                    .triangles
+                    .iter()
+                    .filter(|t| exact2(&mesh, t, p) == want.0)
+                    .count();
+                ties += usize::from(equal > 1);
+            }
+        }
+        assert!(ties > mesh.vertices.len(), "{ties} tied queries");
+    }
+
+    /// Georeferenced coordinates (a 20 m object 10^6 m from the origin), meshes beyond the
+    /// `f32` boxes' range, and microscopic ones: the brute-force answer, and at 10^6 the
+    /// boxes still prune (an absolute `f32` box there is 6 cm wide).
+    #[test]
+    fn far_huge_and_tiny_meshes() {
+        for (offset, scale, max_tests) in [
+            ([4e5, -1e6, 2.5e5], 10.0, Some(40)),
+            ([0.0; 3], 1e20, None),
+            ([1e21, 0.0, -3e20], 1e19, None),
+            ([1e-12, 0.0, 0.0], 1e-15, Some(40)),
+            // squared distances below f32's normal range: correct, not pruned
+            ([1e-20, 0.0, 0.0], 1e-22, None),
+        ] {
+            let mut mesh = blob(16);
+            for v in &mut mesh.vertices {
+                *v = [0, 1, 2].map(|k| offset[k] + scale * v[k]);
+            }
+            let bvh = TriangleBvh::new(&mesh);
+            let mut hint = Hint::default();
+            let before = exact_tests();
+            let m = 300;
+            for p in queries(m) {
+                let p = [0, 1, 2].map(|k| offset[k] + scale * p[k]);
+                let hit = bvh.closest(p).unwrap();
+                assert_eq!((hit.distance2, hit.triangle), brute(&mesh, p), "{p:?}");
+                assert_eq!(bvh.closest_from(p, &mut hint), Some(hit));
+            }
+            let per_query = (exact_tests() - before) / (2 * m);
+            if let Some(max) = max_tests {
+                assert!(
+                    per_query < max,
+                    "{offset:?}: {per_query} exact tests a query"
+                );
+            }
+        }
+    }
+
     #[test]
     fn compact_and_deterministic() {
         let mesh = blob(30);
         let a = TriangleBvh::new(&mesh);
         let b = TriangleBvh::new(&mesh);
         assert_eq!(a.ids, b.ids);
-        assert_eq!(std::mem::size_of::<Node>(), 32);
-        // a binary tree over ceil(n / 4)..n / 2 leaves
-        assert!(a.node_count() < mesh.triangles.len());
+        assert_eq!(std::mem::size_of::<Node>(), 128);
+        // a 4-wide tree over ceil(n / 4)..n / 2 leaves: two to four children a node
+        assert!(a.node_count() * 2 * LEAF_SIZE <= mesh.triangles.len());
         // every triangle in exactly one leaf slot
         let mut ids: Vec<u32> = a
             .nodes
             .iter()
-            .filter(|n| n.count > 0)
-            .flat_map(|n| &a.ids[n.index as usize..(n.index + n.count) as usize])
+            .flat_map(|n| (0..WIDTH).map(move |l| (n.child[l], n.count[l])))
+            .filter(|&(code, _)| code != EMPTY && code & LEAF != 0)
+            .flat_map(|(code, count)| {
+                let start = (code & !LEAF) as usize * LEAF_SIZE;
+                &a.ids[start..start + usize::from(count)]
+            })
             .copied()
             .collect();
         ids.sort_unstable();

@@ -1,7 +1,7 @@
 //! Exact point-to-triangle-mesh distance through a compact BVH ([`super::bvh`]) whose leaves
 //! run parry's exact f64 point-triangle projection.
 
-use super::bvh::TriangleBvh;
+use super::bvh::{Hint, TriangleBvh};
 use crate::error::Result;
 use crate::geometry::{Point3, TriangleMesh, cross, dot, norm, sub};
 
@@ -18,6 +18,29 @@ pub struct MeshHit {
     corners: [Point3; 3],
 }
 
+/// Where a query of [`MeshIndex::closest_from`] starts: the previous answer. One a thread,
+/// carried from query to query (a new one is a cold start).
+#[derive(Debug, Clone, Copy, Default)]
+pub struct MeshHint(Hint);
+
+/// The hit of a BVH answer (`None`: NaN distance).
+fn hit(p: Point3, found: Option<super::bvh::Closest>) -> MeshHit {
+    match found {
+        Some(c) => MeshHit {
+            distance: norm(sub(p, c.point)),
+            closest: c.point,
+            triangle: c.triangle,
+            corners: c.corners,
+        },
+        None => MeshHit {
+            distance: f64::NAN,
+            closest: p,
+            triangle: 0,
+            corners: [[0.0; 3]; 3],
+        },
+    }
+}
+
 /// A triangle mesh indexed for closest-point queries.
 pub struct MeshIndex {
     bvh: TriangleBvh,
@@ -32,22 +55,16 @@ impl MeshIndex {
         })
     }
 
-    /// The closest surface point to `p` (a non-finite `p` gets a NaN distance).
+    /// The closest surface point to `p` (a non-finite `p` gets a NaN distance). Of triangles
+    /// at the same distance, the one with the smallest index.
     pub fn closest(&self, p: Point3) -> MeshHit {
-        match self.bvh.closest(p) {
-            Some(c) => MeshHit {
-                distance: norm(sub(p, c.point)),
-                closest: c.point,
-                triangle: c.triangle,
-                corners: c.corners,
-            },
-            None => MeshHit {
-                distance: f64::NAN,
-                closest: p,
-                triangle: 0,
-                corners: [[0.0; 3]; 3],
-            },
-        }
+        hit(p, self.bvh.closest(p))
+    }
+
+    /// [`Self::closest`] (the same answer, bit for bit) starting from where the previous query
+    /// with this `hint` ended: faster when consecutive queries are near each other in space.
+    pub fn closest_from(&self, p: Point3, hint: &mut MeshHint) -> MeshHit {
+        hit(p, self.bvh.closest_from(p, &mut hint.0))
     }
 
     /// Distance signed by the normal of the closest triangle (positive on the side the

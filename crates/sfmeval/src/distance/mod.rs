@@ -9,7 +9,7 @@ pub(crate) mod neighbour_list;
 pub(crate) mod slot_tree;
 
 pub use cloud::CloudIndex;
-pub use mesh::{MeshHit, MeshIndex};
+pub use mesh::{MeshHint, MeshHit, MeshIndex};
 
 /// `f32` not above `v` (rounds towards −∞): the lower corner of a box that must contain `v`
 /// (the BVH's and the slot tree's `f32` boxes).
