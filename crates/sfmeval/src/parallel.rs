@@ -146,8 +146,8 @@ where
 }
 
 /// [`map_points`] where `f` also gets a state carried from one point to the next in the
-/// visiting order, as in [`map_with_state`]: neighbours in space follow each other, so the
-/// previous answer is a good start.
+/// visiting order (each chunk of it starts from `S::default()`): neighbours in space follow
+/// each other, so the previous answer is a good start.
 pub fn map_points_with_state<R, S, F>(points: &[Point3], progress: &dyn Progress, f: F) -> Vec<R>
 where
     R: Send + Copy,
