@@ -13,12 +13,15 @@ ROOT=$PWD
 OUT=$ROOT/target/web
 export PATH="$ROOT/.tools/bin:$PATH"
 TARGET_DIR=${CARGO_TARGET_DIR:-$ROOT/target}
+# the wasm is built as shipped: the manifest's release profile (scripts/test.sh overrides it for
+# its native build only)
+unset CARGO_PROFILE_RELEASE_LTO CARGO_PROFILE_RELEASE_CODEGEN_UNITS
 t0=$SECONDS
 
 wb_version=$(awk '/^name = "wasm-bindgen"$/ {getline; gsub(/version = |"/, ""); print; exit}' Cargo.lock)
 if [ "$(wasm-bindgen --version 2>/dev/null | awk '{print $2}')" != "$wb_version" ]; then
   echo "build-web: installing wasm-bindgen-cli $wb_version into .tools (takes a few minutes)"
-  cargo install --root "$ROOT/.tools" wasm-bindgen-cli --version "$wb_version"
+  cargo install --debug --root "$ROOT/.tools" wasm-bindgen-cli --version "$wb_version" # as setup-extra.sh
 fi
 for d in www crates/sfmeval-wasm/js; do
   [ -d "$d/node_modules" ] || (cd "$d" && npm ci --no-audit --no-fund --silent)
