@@ -18,18 +18,17 @@ TARGET_DIR=${CARGO_TARGET_DIR:-$ROOT/target}
 unset CARGO_PROFILE_RELEASE_LTO CARGO_PROFILE_RELEASE_CODEGEN_UNITS
 t0=$SECONDS
 
-wb_version=$(awk '/^name = "wasm-bindgen"$/ {getline; gsub(/version = |"/, ""); print; exit}' Cargo.lock)
-if [ "$(wasm-bindgen --version 2>/dev/null | awk '{print $2}')" != "$wb_version" ]; then
-  echo "build-web: installing wasm-bindgen-cli $wb_version into .tools (takes a few minutes)"
-  cargo install --debug --root "$ROOT/.tools" wasm-bindgen-cli --version "$wb_version" # as setup-extra.sh
-fi
+scripts/install-wasm-bindgen.sh # nothing to do after scripts/setup.sh
 for d in www crates/sfmeval-wasm/js; do
   [ -d "$d/node_modules" ] || (cd "$d" && npm ci --no-audit --no-fund --silent)
 done
 
 echo "build-web: cargo build (wasm32, release)"
-cargo build --release --locked --target wasm32-unknown-unknown -p sfmeval-wasm
-raw_wasm=$TARGET_DIR/wasm32-unknown-unknown/release/sfmeval_wasm.wasm
+# its own target dir (as the threaded build below): a native build beside it (scripts/test.sh
+# runs the tests while this builds) does not wait for the lock of target/release, where a
+# cross build keeps its build scripts and proc macros
+CARGO_TARGET_DIR=$TARGET_DIR/wasm cargo build --release --locked --target wasm32-unknown-unknown -p sfmeval-wasm
+raw_wasm=$TARGET_DIR/wasm/wasm32-unknown-unknown/release/sfmeval_wasm.wasm
 
 mkdir -p "$OUT"
 # wasm-bindgen, then wasm-opt -O3 (~20 s; skipped when wasm-bindgen's output did not change).

@@ -15,15 +15,7 @@ fi
 rustup target list --installed | grep -q wasm32-unknown-unknown || rustup target add wasm32-unknown-unknown
 # the standard library's source: the page's threaded wasm rebuilds std with atomics (-Z build-std)
 rustup component list --installed | grep -q '^rust-src' || rustup component add rust-src
-want=$(awk '/^name = "wasm-bindgen"$/ {getline; gsub(/version = |"/, ""); print; exit}' Cargo.lock)
-have=$(.tools/bin/wasm-bindgen --version 2>/dev/null | awk '{print $2}' || true)
-if [ "$have" != "$want" ]; then
-  echo "setup-extra: cargo install --debug wasm-bindgen-cli $want into .tools (about 3 minutes)"
-  # Not --locked: the CLI's lock file pins a webpki-roots the registry no longer has.
-  # --debug: an unoptimised build installs in 177 s instead of 376 s here, and its output is
-  # byte for byte the same; it runs 3.1 s instead of 0.9 s on the threaded page's module.
-  cargo install --quiet --debug --root .tools wasm-bindgen-cli --version "$want"
-fi
+scripts/install-wasm-bindgen.sh
 for d in www crates/sfmeval-wasm/js tests/browser; do
   [ -f "$d/package-lock.json" ] && [ ! -d "$d/node_modules" ] && (cd "$d" && npm ci --no-audit --no-fund --silent)
 done

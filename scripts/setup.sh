@@ -7,6 +7,12 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 t0=$SECONDS
 
+# wasm-bindgen-cli compiles (about 3 minutes of both cores) while apt, pip and npm download;
+# awaited before scripts/setup-extra.sh, which then finds it installed.
+wb_log=$(mktemp)
+scripts/install-wasm-bindgen.sh >"$wb_log" 2>&1 &
+wb_pid=$!
+
 # --- apt -------------------------------------------------------------------
 apt_pkgs=(libusb-1.0-0 libgl1 libegl1 libxrender1 libxi6 libxkbcommon0 libsm6 libxxf86vm1 libxfixes3)
 for f in requirements/apt-*.txt; do
@@ -47,5 +53,9 @@ fi
 for d in www crates/sfmeval-wasm/js tests/browser; do
   if [ -f "$d/package-lock.json" ]; then (cd "$d" && npm ci --no-audit --no-fund --silent); fi
 done
+if ! wait "$wb_pid"; then
+  cat "$wb_log"; echo "setup: installing wasm-bindgen-cli failed"; exit 1
+fi
+cat "$wb_log"
 [ -x scripts/setup-extra.sh ] && scripts/setup-extra.sh
 echo "setup: done in $((SECONDS - t0)) s"

@@ -50,6 +50,28 @@ t=$SECONDS
 # Every binary and example once (scripts/build-release.sh: the features `cargo test` resolves too,
 # and the one release build command of the Python tests, bench/compare.py and test-browser.sh).
 scripts/build-release.sh >"$log/build.log" 2>&1 || { failed=$((failed + 1)); failures+=("release build"); tail -40 "$log/build.log"; }
+# From here on, in the background: the page's wasm builds (scripts/build-web.sh, niced: they take
+# what the tests leave of the two cores), then the extra suites. Extra suites (browser, runner)
+# register themselves as scripts/test-*.sh printing "N passed, N failed" (and "skipped: WHAT: WHY"
+# per skipped test, if any); a suite that is not executable, ends without that line or runs nothing
+# has not tested anything. pytest keeps only 1.2-1.5 of the two cores busy (Blender, the SfM tools,
+# Slurm's scheduling and time limits wait on each other); the results are read after it.
+suites=()
+for s in scripts/test-*.sh; do
+  [ -e "$s" ] || continue
+  [ -x "$s" ] || { skip "$s" "not executable"; continue; }
+  suites+=("$s")
+done
+suite_start=$SECONDS
+(
+  nice -n 19 scripts/build-web.sh >"$log/build-web.log" 2>&1
+  echo "build-web (background, niced): exit $?, $((SECONDS - suite_start)) s" >"$log/build-web.sum"
+  for k in "${!suites[@]}"; do
+    "${suites[$k]}" >"$log/suite-$k.out" 2>&1
+    echo $? >"$log/suite-$k.rc"
+  done
+) &
+background=$!
 cargo test --workspace --release --locked >"$log/cargo-test.log" 2>&1
 rc=$?
 p=$(grep -Eo '^test result: .* ([0-9]+) passed' "$log/cargo-test.log" | grep -Eo '[0-9]+ passed' | awk '{s+=$1} END {print s+0}')
@@ -129,14 +151,13 @@ PY
   echo "pytest: $p passed, $f failed, $s skipped ($((SECONDS - t)) s)"
 fi
 
-# Extra suites (browser, runner) register themselves as scripts/test-*.sh printing "N passed, N failed"
-# (and "skipped: WHAT: WHY" per skipped test, if any). A suite that is not executable, ends
-# without that line or runs nothing has not tested anything.
-for s in scripts/test-*.sh; do
-  [ -e "$s" ] || continue
-  [ -x "$s" ] || { skip "$s" "not executable"; continue; }
-  t=$SECONDS
-  out=$("$s" 2>&1); rc=$?
+# The extra suites' results.
+wait "$background"
+cat "$log/build-web.sum" 2>/dev/null
+for k in "${!suites[@]}"; do
+  s=${suites[$k]}
+  rc=$(cat "$log/suite-$k.rc" 2>/dev/null || echo 1)
+  out=$(cat "$log/suite-$k.out" 2>/dev/null)
   echo "$out" | tail -30
   line=$(echo "$out" | grep -E '^[0-9]+ passed, [0-9]+ failed' | tail -1)
   p=$(echo "$line" | grep -Eo '^[0-9]+'); f=$(echo "$line" | grep -Eo '[0-9]+ failed' | grep -Eo '[0-9]+')
@@ -147,7 +168,7 @@ for s in scripts/test-*.sh; do
   elif [ "${f:-0}" -gt 0 ]; then
     failures+=("$s")
   fi
-  echo "$s: ${p:-0} passed, ${f:-0} failed ($((SECONDS - t)) s)"
+  echo "$s: ${p:-0} passed, ${f:-0} failed (the background's wasm builds and suites done $((SECONDS - suite_start)) s after they started)"
 done
 
 if [ "$skipped" -gt 0 ]; then
