@@ -171,7 +171,10 @@ try {
   });
   const dmax = (rep.accuracy.percentiles.p95).toPrecision(6);
   await page.fill('#max-distance', dmax);
-  await page.waitForTimeout(200);
+  // the live count follows the crop: wait for it to change (a fixed 200 ms wait failed once on
+  // a busy machine), and report what it shows if it never does
+  await page.waitForFunction((before) => document.getElementById('kept').textContent !== before, keptFull, { timeout: 15000 })
+    .catch(() => {});
   const keptLive = await page.textContent('#kept');
   check('crop-live-count-changes', keptLive !== keptFull, `${keptFull} → ${keptLive}`);
   const msAuto = await evaluateAndWait();
