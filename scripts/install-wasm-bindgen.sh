@@ -12,7 +12,8 @@ if [ "$have" != "$want" ]; then
   # Not --locked: the CLI's lock file pins a webpki-roots the registry no longer has.
   # --debug: an unoptimised build installs in 177 s instead of 376 s here, and its output is
   # byte for byte the same; it runs 3.1 s instead of 0.9 s on the threaded page's module.
-  # Its own target dir, so that a concurrent build of the workspace does not wait for its lock.
+  # Its own target dir, not a CARGO_TARGET_DIR from the environment, whose lock a build of the
+  # workspace beside it may hold.
   CARGO_TARGET_DIR="$PWD/.tools/target" cargo install --quiet --debug --root .tools \
     wasm-bindgen-cli --version "$want"
   rm -rf .tools/target

@@ -61,7 +61,8 @@ wbt() { # where, log, command...
 # (the wasm32 profile and target dir of scripts/build-web.sh, so that its dependencies are reused)
 wasm_target=${CARGO_TARGET_DIR:-$ROOT/target}/wasm
 wbt node "$log/wbt-node.log" env -u CARGO_PROFILE_RELEASE_LTO -u CARGO_PROFILE_RELEASE_CODEGEN_UNITS \
-  CARGO_TARGET_DIR="$wasm_target" CARGO_TARGET_WASM32_UNKNOWN_UNKNOWN_RUNNER=wasm-bindgen-test-runner cargo test --release --locked --target wasm32-unknown-unknown -p sfmeval-wasm --test web
+  CARGO_TARGET_DIR="$wasm_target" CARGO_TARGET_WASM32_UNKNOWN_UNKNOWN_RUNNER=wasm-bindgen-test-runner \
+  cargo test --release --locked --target wasm32-unknown-unknown -p sfmeval-wasm --test web
 test_wasm=$(ls -t "$wasm_target"/wasm32-unknown-unknown/release/deps/web-*.wasm 2>/dev/null | head -1)
 if [ -n "$test_wasm" ]; then
   wbt chromium "$log/wbt-chromium.log" env WASM_BINDGEN_USE_BROWSER=1 CHROMEDRIVER=/usr/bin/chromedriver \

@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
-# Runs every test of sfmeval: formatting, lints, docs, the wasm32 build of the core, the Rust unit
-# and integration tests, and the Python tests that compare sfmeval with independent tools (Open3D,
-# trimesh, scipy, pycolmap, Blender), and the benchmark in quick mode. Prints a final "N passed, N failed" line.
+# Runs every test of sfmeval: formatting, lints, docs, the Rust unit and integration tests, the
+# benchmarks in quick mode, the Python tests that compare sfmeval with independent tools (Open3D,
+# trimesh, scipy, pycolmap, Blender) and, in the background beside them, the page's wasm builds and
+# the extra suites (scripts/test-*.sh: browser and npm). Prints a final "N passed, N failed" line.
 # Needs scripts/setup.sh first.
 #
 # Skipped tests (a pytest skip, an ignored Rust test, a "skipped: ..." line of a suite, an anchor
