@@ -77,20 +77,14 @@ struct Query {
 /// that a point with no match keeps an empty list while it moves by less than half of one.
 const LIST_REACH: f64 = 1.5;
 
-/// Each source point's nearest target point strictly closer than the correspondence distance
-/// (`limit` = its square). `moved` and `queries` are in the visiting order (Morton), `position`
-/// maps a source index to its place there. A point matched before starts from its previous
-/// match (it moved a little: the nearest now is at most that far), the others from the radius;
-/// the nearest found is the exact one either way (through the point's neighbour list, which
-/// answers as the tree does), so the matches are those of an unbounded nearest-neighbour query
-/// filtered by the distance. Pairs and the error sum come in source order.
-fn matches(
-    moved: &[Point3],
-    position: &[u32],
-    target: &KdCloud,
-    limit: f64,
-    queries: &mut [Query],
-) -> Matches {
+/// Each moved point's nearest target point strictly closer than the correspondence distance
+/// (`limit` = its square). `moved` and `queries` are in the visiting order (Morton). A point
+/// matched before starts from its previous match (it moved a little: the nearest now is at most
+/// that far), the others from the radius; the nearest found is the exact one either way
+/// (through the point's neighbour list, which answers as the tree does), so the matches are
+/// those of an unbounded nearest-neighbour query filtered by the distance. Pairs and the error
+/// sum come in the visiting order, so that the fit then reads the moved points in memory order.
+fn matches(moved: &[Point3], target: &KdCloud, limit: f64, queries: &mut [Query]) -> Matches {
     let reach2 = limit * LIST_REACH * LIST_REACH;
     let found = parallel::map_mut(queries, |k, query| {
         let q = moved[k];
@@ -115,18 +109,17 @@ fn matches(
     });
     let mut pairs = Vec::new();
     let mut error2 = 0.0;
-    for (i, &k) in position.iter().enumerate() {
-        let (d2, slot) = found[k as usize];
+    for (k, &(d2, slot)) in found.iter().enumerate() {
         if slot != UNMATCHED {
             error2 += d2;
-            pairs.push((i as u32, slot));
+            pairs.push((k as u32, slot));
         }
     }
     let (fitness, inlier_rmse) = if pairs.is_empty() {
         (0.0, 0.0)
     } else {
         (
-            pairs.len() as f64 / position.len() as f64,
+            pairs.len() as f64 / moved.len() as f64,
             (error2 / pairs.len() as f64).sqrt(),
         )
     };
@@ -147,13 +140,10 @@ pub fn registration_icp(
     let limit = max_distance * max_distance;
     // The moves are small: one spatial visiting order serves every iteration, and the moved
     // points and their queries are kept in it (neighbours in space, neighbours in memory).
-    let order = morton_order(source);
-    let mut moved: Vec<Point3> = order.iter().map(|&i| source[i as usize]).collect();
-    let mut position = vec![0u32; order.len()];
-    for (k, &i) in order.iter().enumerate() {
-        position[i as usize] = k as u32;
-    }
-    drop(order);
+    let mut moved: Vec<Point3> = morton_order(source)
+        .iter()
+        .map(|&i| source[i as usize])
+        .collect();
     let mut queries = vec![
         Query {
             slot: UNMATCHED,
@@ -162,22 +152,16 @@ pub fn registration_icp(
         source.len()
     ];
     let mut transformation = IDENTITY;
-    let mut current = matches(&moved, &position, target, limit, &mut queries);
+    let mut current = matches(&moved, target, limit, &mut queries);
     let mut iterations = 0;
     while iterations < criteria.max_iterations {
-        let update = fit(
-            |i| moved[position[i] as usize],
-            |k| target.point(k),
-            &current.pairs,
-        );
+        let update = fit(|k| moved[k], |j| target.point(j), &current.pairs);
         transformation = matrix::mul(&update, &transformation);
-        for p in moved.iter_mut() {
-            *p = matrix::apply(&update, *p);
-        }
+        parallel::map_mut(&mut moved, |_, p| *p = matrix::apply(&update, *p));
         iterations += 1;
         let previous = std::mem::replace(
             &mut current,
-            matches(&moved, &position, target, limit, &mut queries),
+            matches(&moved, target, limit, &mut queries),
         );
         if (previous.fitness - current.fitness).abs() < criteria.relative_fitness
             && (previous.inlier_rmse - current.inlier_rmse).abs() < criteria.relative_rmse
