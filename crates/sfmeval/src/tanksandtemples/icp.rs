@@ -159,10 +159,8 @@ pub fn registration_icp(
         transformation = matrix::mul(&update, &transformation);
         parallel::map_mut(&mut moved, |_, p| *p = matrix::apply(&update, *p));
         iterations += 1;
-        let previous = std::mem::replace(
-            &mut current,
-            matches(&moved, target, limit, &mut queries),
-        );
+        let previous =
+            std::mem::replace(&mut current, matches(&moved, target, limit, &mut queries));
         if (previous.fitness - current.fitness).abs() < criteria.relative_fitness
             && (previous.inlier_rmse - current.inlier_rmse).abs() < criteria.relative_rmse
         {
