@@ -73,6 +73,57 @@ where
     }
 }
 
+/// Sets `out[k] = f(state, k)` for every `k`, in parallel chunks; each chunk's state starts as
+/// `S::default()` and goes from one index to the next in order, as in
+/// [`map_range_with_state`], but the results go straight into `out` (no second buffer).
+pub(crate) fn fill_with_state<R, S, F>(out: &mut [R], f: F)
+where
+    R: Send,
+    S: Default,
+    F: Fn(&mut S, usize) -> R + Sync + Send,
+{
+    let run = |(c, chunk): (usize, &mut [R])| {
+        let mut state = S::default();
+        for (j, r) in chunk.iter_mut().enumerate() {
+            *r = f(&mut state, c * CHUNK + j);
+        }
+    };
+    #[cfg(feature = "parallel")]
+    {
+        use rayon::prelude::*;
+        out.par_chunks_mut(CHUNK).enumerate().for_each(run);
+    }
+    #[cfg(not(feature = "parallel"))]
+    out.chunks_mut(CHUNK).enumerate().for_each(run);
+}
+
+/// `slice.sort_unstable()`, in parallel where threads are available (the same result: equal
+/// elements are indistinguishable).
+pub(crate) fn sort_unstable<T: Ord + Send>(slice: &mut [T]) {
+    #[cfg(feature = "parallel")]
+    {
+        use rayon::prelude::*;
+        slice.par_sort_unstable();
+    }
+    #[cfg(not(feature = "parallel"))]
+    slice.sort_unstable();
+}
+
+/// Runs `a` and `b`, in parallel where threads are available.
+#[cfg(feature = "parallel")]
+pub(crate) fn join<RA: Send, RB: Send>(
+    a: impl FnOnce() -> RA + Send,
+    b: impl FnOnce() -> RB + Send,
+) -> (RA, RB) {
+    rayon::join(a, b)
+}
+
+/// Runs `a` and `b`, in parallel where threads are available.
+#[cfg(not(feature = "parallel"))]
+pub(crate) fn join<RA, RB>(a: impl FnOnce() -> RA, b: impl FnOnce() -> RB) -> (RA, RB) {
+    (a(), b())
+}
+
 /// Maps `f` over `items` with each item's index and mutable access to it, keeping order (no
 /// progress).
 pub(crate) fn map_mut<T, R, F>(items: &mut [T], f: F) -> Vec<R>

@@ -28,6 +28,7 @@ use parry3d_f64::shape::Triangle;
 use super::leaf_bound::{self, LANES, LeafBound};
 use super::{down, up};
 use crate::geometry::{Point3, TriangleMesh, sub};
+use crate::parallel;
 
 /// Most triangles in a leaf: one [`LeafBound`] block.
 pub(crate) const LEAF_SIZE: usize = LANES;
@@ -193,18 +194,14 @@ impl TriangleBvh {
     /// two levels of them a node. The mesh must be valid (vertex indices in range, finite
     /// vertices); deterministic.
     pub(crate) fn new(mesh: &TriangleMesh) -> Self {
-        let centroids: Vec<Point3> = mesh
-            .triangles
-            .iter()
-            .map(|t| {
-                let [a, b, c] = mesh.corners(t);
-                [
-                    (a[0] + b[0] + c[0]) / 3.0,
-                    (a[1] + b[1] + c[1]) / 3.0,
-                    (a[2] + b[2] + c[2]) / 3.0,
-                ]
-            })
-            .collect();
+        let centroids: Vec<Point3> = parallel::map_range(mesh.triangles.len(), |i| {
+            let [a, b, c] = mesh.corners(&mesh.triangles[i]);
+            [
+                (a[0] + b[0] + c[0]) / 3.0,
+                (a[1] + b[1] + c[1]) / 3.0,
+                (a[2] + b[2] + c[2]) / 3.0,
+            ]
+        });
         let mut lo = [f64::INFINITY; 3];
         let mut hi = [f64::NEG_INFINITY; 3];
         for t in &mesh.triangles {
@@ -241,21 +238,24 @@ impl TriangleBvh {
         let slots = leaves.len() * LEAF_SIZE;
         let mut tris = vec![[0u32; 3]; slots];
         let mut ids = vec![u32::MAX; slots];
-        let mut bounds = Vec::with_capacity(leaves.len());
-        for (leaf, &(start, end, origin, extent)) in leaves.iter().enumerate() {
-            let slot = leaf * LEAF_SIZE;
+        for (leaf, &(start, end, _, _)) in leaves.iter().enumerate() {
+            for (k, &i) in order[start..end].iter().enumerate() {
+                tris[leaf * LEAF_SIZE + k] = mesh.triangles[i as usize];
+                ids[leaf * LEAF_SIZE + k] = i;
+            }
+        }
+        // The bound blocks, leaves in parallel.
+        let bounds = parallel::map_range(leaves.len(), |leaf| {
+            let (start, end, origin, extent) = leaves[leaf];
+            if unbounded {
+                return LeafBound::default();
+            }
             let mut corners = [[[0.0; 3]; 3]; LEAF_SIZE];
             for (k, &i) in order[start..end].iter().enumerate() {
-                tris[slot + k] = mesh.triangles[i as usize];
-                ids[slot + k] = i;
                 corners[k] = mesh.corners(&mesh.triangles[i as usize]);
             }
-            bounds.push(if unbounded {
-                LeafBound::default()
-            } else {
-                LeafBound::new(&corners[..end - start], origin, extent)
-            });
-        }
+            LeafBound::new(&corners[..end - start], origin, extent)
+        });
         TriangleBvh {
             nodes,
             centre,

@@ -68,18 +68,7 @@ fn split(keys: &mut [([f32; 3], u32)], levels: u32) {
         a.0[axis].total_cmp(&b.0[axis]).then(a.1.cmp(&b.1))
     });
     let (left, right) = keys.split_at_mut(mid);
-    join(|| split(left, levels - 1), || split(right, levels - 1));
-}
-
-#[cfg(feature = "parallel")]
-fn join(a: impl FnOnce() + Send, b: impl FnOnce() + Send) {
-    rayon::join(a, b);
-}
-
-#[cfg(not(feature = "parallel"))]
-fn join(a: impl FnOnce(), b: impl FnOnce()) {
-    a();
-    b();
+    crate::parallel::join(|| split(left, levels - 1), || split(right, levels - 1));
 }
 
 /// An axis-aligned box in `f32`, rounded outwards; empty (`min > max`) when no live point.
