@@ -6,6 +6,7 @@ pub(crate) mod kd_cloud;
 mod leaf_bound;
 mod mesh;
 pub(crate) mod neighbour_list;
+mod oriented;
 pub(crate) mod slot_tree;
 
 pub use cloud::CloudIndex;
