@@ -140,20 +140,21 @@ impl OrientedLanes {
         let axes32 = axes.map(|a| a.map(|c| c as f32));
         let axes64 = axes32.map(|a| a.map(f64::from));
         let corner64 = corner.map(f64::from);
+        // The corner in absolute coordinates: the rounding of this and of each `x − origin`
+        // below is far inside `slack`, as every corner lies in the lane's box.
+        let origin = [0, 1, 2].map(|k| centre[k] + corner64[k]);
         let sum = |v: Point3| v[0].abs() + v[1].abs() + v[2].abs();
+        let scale = 2.0 * (sum(centre) + sum(corner64)) + sum(extent);
         let mut lo = [f64::INFINITY; 3];
         let mut hi = [f64::NEG_INFINITY; 3];
-        let mut scale: f64 = 0.0;
         for x in triangles.iter().flatten() {
-            let local = sub(sub(*x, centre), corner64);
-            scale = scale.max(sum(*x) + sum(centre) + sum(corner64));
+            let local = sub(*x, origin);
             for k in 0..3 {
                 let t = dot(axes64[k], local);
                 lo[k] = lo[k].min(t);
                 hi[k] = hi[k].max(t);
             }
         }
-        // Far more than the f64 rounding of the lines above.
         let slack = scale / 1_099_511_627_776.0;
         if !(slack.is_finite() && lo.iter().chain(&hi).all(|v| v.is_finite())) {
             return;
@@ -173,15 +174,13 @@ impl OrientedLanes {
 /// when the triangles' normals cancel out (a closed or folded patch) or are not finite.
 fn axes(triangles: &[[Point3; 3]], extent: [f64; 3]) -> Option<[Point3; 3]> {
     let mut n = [0.0; 3];
+    let mut total = 0.0;
     for [a, b, c] in triangles {
         let m = cross(sub(*b, *a), sub(*c, *a));
         n = [n[0] + m[0], n[1] + m[1], n[2] + m[2]];
+        total += norm(m);
     }
     let length = norm(n);
-    let total: f64 = triangles
-        .iter()
-        .map(|[a, b, c]| norm(cross(sub(*b, *a), sub(*c, *a))))
-        .sum();
     // Normals that mostly cancel: no useful orientation.
     if !(length.is_finite() && length > 0.25 * total) {
         return None;
