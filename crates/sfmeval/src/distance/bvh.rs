@@ -3,8 +3,8 @@
 //! Why not parry's `TriMesh` BVH (used before): on the 1M-triangle bench mesh it needed about
 //! 340 MB of peak memory to build (one node of 112 bytes per triangle plus build buffers) and
 //! its f64 nodes do not fit the cache. Here a node holds the boxes of its four children as
-//! `f32` lanes, structure of arrays (128 bytes, two cache lines), so one visit tests four boxes
-//! in a few vector instructions. The boxes are relative to the mesh's centre (so they stay
+//! `f32` lanes, structure of arrays (128 bytes, two cache lines; with the oriented boxes below,
+//! 256 bytes), so one visit tests four boxes in a few vector instructions. The boxes are relative to the mesh's centre (so they stay
 //! tight for georeferenced coordinates, where absolute `f32` is coarser than a triangle) and
 //! rounded outwards, and the box distance is computed to be a lower bound (query rounded
 //! outwards too, a margin for the `f64` exact test, a relative guard on the `f32` squares):
@@ -34,7 +34,7 @@ use parry3d_f64::query::PointQueryWithLocation as _;
 use parry3d_f64::shape::Triangle;
 
 use super::leaf_bound::{self, LANES, LeafBound};
-use super::oriented::{self, OrientedLanes, OrientedQuery, UNCONSTRAINED};
+use super::oriented::{self, OrientedLanes, OrientedQuery};
 use super::{down, up};
 use crate::geometry::{Point3, TriangleMesh, sub};
 use crate::parallel;
@@ -82,6 +82,8 @@ struct Node {
     max: [[f32; WIDTH]; 3],
     child: [u32; WIDTH],
     count: [u8; WIDTH],
+    /// The children's oriented boxes (none above [`oriented::MAX_SLOTS`] triangles).
+    oriented: OrientedLanes,
 }
 
 const EMPTY_NODE: Node = Node {
@@ -89,6 +91,7 @@ const EMPTY_NODE: Node = Node {
     max: [[f32::NEG_INFINITY; WIDTH]; 3],
     child: [EMPTY; WIDTH],
     count: [0; WIDTH],
+    oriented: OrientedLanes::NONE,
 };
 
 impl Node {
@@ -196,8 +199,6 @@ pub(crate) struct TriangleBvh {
     tris: Vec<[u32; 3]>,
     ids: Vec<u32>,
     bounds: Vec<LeafBound>,
-    /// Per node, its children's oriented boxes (a second box bound, tight on thin patches).
-    oriented: Vec<OrientedLanes>,
 }
 
 impl TriangleBvh {
@@ -267,11 +268,9 @@ impl TriangleBvh {
             }
             LeafBound::new(&corners[..end - start], origin, extent)
         });
-        let oriented = if unbounded {
-            vec![UNCONSTRAINED; nodes.len()]
-        } else {
-            oriented_boxes(&nodes, &tris, &ids, mesh, centre)
-        };
+        if !unbounded {
+            oriented_boxes(&mut nodes, &tris, &ids, mesh, centre);
+        }
         TriangleBvh {
             nodes,
             centre,
@@ -280,7 +279,6 @@ impl TriangleBvh {
             tris,
             ids,
             bounds,
-            oriented,
         }
     }
 
@@ -362,7 +360,7 @@ impl TriangleBvh {
             let n = &self.nodes[node];
             let mut d2 = n.lower_bounds2(&query);
             if BOUND {
-                let o = self.oriented[node].lower_bounds2(&oriented_query, &n.min);
+                let o = n.oriented.lower_bounds2(&oriented_query, &n.min, &n.max);
                 for (d, o) in d2.iter_mut().zip(o) {
                     if o > *d {
                         *d = o;
@@ -449,12 +447,12 @@ impl TriangleBvh {
 /// Each node's children's oriented boxes, nodes in parallel: a child's triangles are a run of
 /// leaf slots (leaves are numbered depth first), found from the deepest nodes up.
 fn oriented_boxes(
-    nodes: &[Node],
+    nodes: &mut [Node],
     tris: &[[u32; 3]],
     ids: &[u32],
     mesh: &TriangleMesh,
     centre: Point3,
-) -> Vec<OrientedLanes> {
+) {
     // Per node and lane, the child's slot range (children come after their parent).
     let mut spans = vec![[(0usize, 0usize); WIDTH]; nodes.len()];
     for i in (0..nodes.len()).rev() {
@@ -475,9 +473,7 @@ fn oriented_boxes(
             };
         }
     }
-    parallel::map_range(nodes.len(), |i| {
-        let n = &nodes[i];
-        let mut lanes = UNCONSTRAINED;
+    parallel::map_mut(nodes, |i, n| {
         let mut corners = Vec::new();
         for (lane, &(start, end)) in spans[i].iter().enumerate() {
             if n.child[lane] == EMPTY || end - start > oriented::MAX_SLOTS {
@@ -489,12 +485,11 @@ fn oriented_boxes(
                     .filter(|&k| ids[k] != u32::MAX)
                     .map(|k| mesh.corners(&tris[k])),
             );
-            let corner = [0, 1, 2].map(|k| n.min[k][lane]);
-            let extent = [0, 1, 2].map(|k| f64::from(n.max[k][lane]) - f64::from(n.min[k][lane]));
-            lanes.set(lane, &corners, corner, extent, centre);
+            let min = [0, 1, 2].map(|k| n.min[k][lane]);
+            let max = [0, 1, 2].map(|k| n.max[k][lane]);
+            n.oriented.set(lane, &corners, min, max, centre);
         }
-        lanes
-    })
+    });
 }
 
 /// Median halvings from `n` triangles down to leaves of at most [`LEAF_SIZE`].
@@ -1012,7 +1007,7 @@ mod tests {
         let a = TriangleBvh::new(&mesh);
         let b = TriangleBvh::new(&mesh);
         assert_eq!(a.ids, b.ids);
-        assert_eq!(std::mem::size_of::<Node>(), 128);
+        assert_eq!(std::mem::size_of::<Node>(), 256);
         // a 4-wide tree over ceil(n / 4)..n / 2 leaves: two to four children a node
         assert!(a.node_count() * 2 * LEAF_SIZE <= mesh.triangles.len());
         // every triangle in exactly one leaf slot

@@ -8,22 +8,26 @@
 //! `t̂₂ = n̂ × t̂₁`) is only as thick as the patch's curvature, so its distance grows with the
 //! sideways offset as the true distance does.
 //!
-//! Per child lane: the three axes `aₖ` (rounded to `f32`) and, per axis, the interval
-//! `[loₖ, hiₖ]` that holds `aₖ·(x − c)` for every corner `x` of the child's triangles, where `c`
-//! is the child's axis-aligned box's lower corner (relative to the tree's centre, the same `f32`
-//! the query subtracts). The interval holds every point of the triangles too (`aₖ·x` is linear),
-//! computed in `f64` and rounded outwards with a slack for that arithmetic.
+//! Per child lane, stored in 16-bit integers (120 bytes a node, inside the node): the three
+//! axes `aₖ` in units of 2⁻¹⁵ (so each is exactly an `f32`), and per axis the interval
+//! `[loₖ, hiₖ]` that holds `aₖ·(x − c)` for every corner `x` of the child's triangles, in units
+//! of the child's box size / 32000 ([`unit`]; rounded outwards), where `c` is the child's
+//! axis-aligned box's lower corner (relative to the tree's centre, the same `f32` the query
+//! subtracts). The interval holds every point of the triangles too (`aₖ·x` is linear); it is
+//! computed in `f64` with a slack for that arithmetic.
 //!
 //! Why the bound is a lower bound: the query `v = q − c` is computed in `f32` from the query's
 //! rounded-down coordinates; per axis, `tₖ = aₖ·v` is within `spread + 2⁻²⁰ |v|₁` of the true
-//! value (`spread` the query's rounding, `|aₖⱼ| ≤ 1`), and `margin` (the exact test's rounding,
-//! as the axis-aligned test's) is added to that. So `gₖ = max(loₖ − tₖ, tₖ − hiₖ) − that ≤
-//! |aₖ·(q − x)|` for every point `x` of the child. The axes are orthonormal to within `f32`
-//! rounding, so `|q − x|² ≥ Σ gₖ² / σ²` with `σ² < 1 + 2⁻²¹`; [`SHRINK`] covers that and the
-//! rounding of the squares and sums. Non-finite lanes (unused, or a mesh too large for the
-//! boxes) come out as a bound of at most 0: the axis-aligned bound decides there.
+//! value (`spread` the query's rounding, `|aₖⱼ| ≤ 1`), the interval's ends are within
+//! `unit · 2⁻⁸` of the stored ones after the `f32` product, and `margin` (the exact test's
+//! rounding, as the axis-aligned test's) is added to that. So `gₖ = max(loₖ − tₖ, tₖ − hiₖ) −
+//! that ≤ |aₖ·(q − x)|` for every point `x` of the child. The rounded axes are orthonormal to
+//! within 2⁻¹⁵ a component, so `|q − x|² ≥ Σ gₖ² / σ²` with `σ² < 1 + 2⁻¹²·0.8`; [`SHRINK`]
+//! covers that and the rounding of the squares and sums. An unconstrained lane (zero axes and
+//! intervals) and non-finite lanes (unused, or a mesh too large for the boxes) come out as a
+//! bound of at most 0: the axis-aligned bound decides there.
 
-use super::{down, up};
+use super::up;
 use crate::geometry::{Point3, cross, dot, norm, sub};
 
 /// Children of a node (the BVH's width).
@@ -33,9 +37,9 @@ pub(crate) const WIDTH: usize = 4;
 /// thin, and the boxes would cost build time for nothing.
 pub(crate) const MAX_SLOTS: usize = 1024;
 
-/// Relative guard on the final squares and sums: the axes' departure from orthonormality (at
-/// most 2⁻²¹) and the `f32` rounding of the gaps, squares and sums.
-const SHRINK: f32 = 1.0 - 1.0 / (1u32 << 18) as f32;
+/// Relative guard on the final squares and sums: the axes' departure from orthonormality
+/// (`σ² − 1` below 2⁻¹²·0.8) and the `f32` rounding of the gaps, squares and sums.
+const SHRINK: f32 = 1.0 - 1.0 / (1u32 << 11) as f32;
 
 /// Absolute guard against `f32` underflow of a tiny square.
 const TINY: f32 = f32::MIN_POSITIVE;
@@ -44,27 +48,40 @@ const TINY: f32 = f32::MIN_POSITIVE;
 /// (each within a few units of 2⁻²⁴).
 const REL: f32 = 1.0 / (1u32 << 20) as f32;
 
-/// The oriented boxes of a node's children, structure of arrays (240 bytes).
-#[derive(Debug, Clone, Copy)]
-#[repr(C, align(64))]
-pub(crate) struct OrientedLanes {
-    /// `axis[k][j][l]`: component `j` of lane `l`'s axis `k`.
-    axis: [[[f32; WIDTH]; 3]; 3],
-    /// Per axis and lane, the interval of `aₖ·(x − c)` over the child's triangles.
-    lo: [[f32; WIDTH]; 3],
-    hi: [[f32; WIDTH]; 3],
+/// An axis component's unit: 2⁻¹⁵.
+const AXIS_UNIT: f64 = 1.0 / 32768.0;
+
+/// Interval units in a box of size sum 1 (the intervals lie within ±that size, so within
+/// ±32001 units even after the outward rounding: an `i16`).
+const PER_SIZE: f32 = 1.0 / 32000.0;
+
+/// The interval unit of a child lane whose box runs from `min` to `max` (relative `f32`): the
+/// build and the query compute it the same way, bit for bit.
+#[inline]
+fn unit(min: [f32; 3], max: [f32; 3]) -> f32 {
+    ((max[0] - min[0]) + (max[1] - min[1]) + (max[2] - min[2])) * PER_SIZE
 }
 
-/// Every lane unconstrained: the world axes and infinite intervals (a bound of at most 0).
-pub(crate) const UNCONSTRAINED: OrientedLanes = OrientedLanes {
-    axis: [
-        [[1.0; WIDTH], [0.0; WIDTH], [0.0; WIDTH]],
-        [[0.0; WIDTH], [1.0; WIDTH], [0.0; WIDTH]],
-        [[0.0; WIDTH], [0.0; WIDTH], [1.0; WIDTH]],
-    ],
-    lo: [[f32::NEG_INFINITY; WIDTH]; 3],
-    hi: [[f32::INFINITY; WIDTH]; 3],
-};
+/// The oriented boxes of a node's children, structure of arrays (120 bytes).
+#[derive(Debug, Clone, Copy, Default)]
+#[repr(C)]
+pub(crate) struct OrientedLanes {
+    /// `axis[k][j][l]`: component `j` of lane `l`'s axis `k`, in units of 2⁻¹⁵.
+    axis: [[[i16; WIDTH]; 3]; 3],
+    /// Per axis and lane, the interval of `aₖ·(x − c)` over the child's triangles, in units of
+    /// the lane's [`unit`].
+    lo: [[i16; WIDTH]; 3],
+    hi: [[i16; WIDTH]; 3],
+}
+
+impl OrientedLanes {
+    /// Every lane unconstrained (zero axes and intervals: a bound of at most 0).
+    pub(crate) const NONE: OrientedLanes = OrientedLanes {
+        axis: [[[0; WIDTH]; 3]; 3],
+        lo: [[0; WIDTH]; 3],
+        hi: [[0; WIDTH]; 3],
+    };
+}
 
 /// A query as the oriented test sees it: its rounded-down coordinates relative to the tree's
 /// centre, and the absolute error allowance independent of the lane.
@@ -91,29 +108,41 @@ impl OrientedQuery {
 
 impl OrientedLanes {
     /// Lower bounds on the squared distances from the query to the four children's triangles;
-    /// `corner` is the node's axis-aligned lower corners (`Node::min`).
+    /// `min` and `max` are the node's axis-aligned boxes (`Node::min`, `Node::max`).
     #[inline]
     pub(crate) fn lower_bounds2(
         &self,
         q: &OrientedQuery,
-        corner: &[[f32; WIDTH]; 3],
+        min: &[[f32; WIDTH]; 3],
+        max: &[[f32; WIDTH]; 3],
     ) -> [f32; WIDTH] {
         let mut v = [[0.0f32; WIDTH]; 3];
         let mut l1 = [0.0f32; WIDTH];
         for j in 0..3 {
             for l in 0..WIDTH {
-                v[j][l] = q.lo[j] - corner[j][l];
+                v[j][l] = q.lo[j] - min[j][l];
                 l1[l] += v[j][l].abs();
             }
         }
-        let margin = l1.map(|s| q.margin + s * REL);
+        let scale: [f32; WIDTH] = std::array::from_fn(|l| {
+            unit(
+                [min[0][l], min[1][l], min[2][l]],
+                [max[0][l], max[1][l], max[2][l]],
+            )
+        });
+        let margin: [f32; WIDTH] =
+            std::array::from_fn(|l| q.margin + l1[l] * REL + scale[l] * (1.0 / 256.0));
+        let axis_unit = AXIS_UNIT as f32;
         let mut d2 = [0.0f32; WIDTH];
         for k in 0..3 {
             let a = &self.axis[k];
             for l in 0..WIDTH {
-                let t = a[0][l] * v[0][l] + a[1][l] * v[1][l] + a[2][l] * v[2][l];
-                let below = self.lo[k][l] - t;
-                let above = t - self.hi[k][l];
+                let t = (f32::from(a[0][l]) * v[0][l]
+                    + f32::from(a[1][l]) * v[1][l]
+                    + f32::from(a[2][l]) * v[2][l])
+                    * axis_unit;
+                let below = f32::from(self.lo[k][l]) * scale[l] - t;
+                let above = t - f32::from(self.hi[k][l]) * scale[l];
                 // NaN (an infinite lane) and negative gaps count as 0.
                 let g = if below > above { below } else { above } - margin[l];
                 let g = if g > 0.0 { g } else { 0.0 };
@@ -124,22 +153,29 @@ impl OrientedLanes {
     }
 
     /// Sets lane `lane` to the oriented box of `triangles` (their corners, absolute), for a
-    /// child whose axis-aligned box's lower corner is `corner` (relative to `centre`) and
-    /// extent `extent`. A degenerate patch (no net normal, non-finite) stays unconstrained.
+    /// child whose axis-aligned box runs from `min` to `max` (relative to `centre`). A degenerate
+    /// patch (no net normal, a box of size 0, non-finite) stays unconstrained.
     pub(crate) fn set(
         &mut self,
         lane: usize,
         triangles: &[[Point3; 3]],
-        corner: [f32; 3],
-        extent: [f64; 3],
+        min: [f32; 3],
+        max: [f32; 3],
         centre: Point3,
     ) {
+        let unit = f64::from(unit(min, max));
+        let extent = [0, 1, 2].map(|k| f64::from(max[k]) - f64::from(min[k]));
+        if !(unit.is_finite() && unit > 0.0) {
+            return;
+        }
         let Some(axes) = axes(triangles, extent) else {
             return;
         };
-        let axes32 = axes.map(|a| a.map(|c| c as f32));
-        let axes64 = axes32.map(|a| a.map(f64::from));
-        let corner64 = corner.map(f64::from);
+        // Components in units of 2⁻¹⁵ (1 itself rounds down to 32767: |aₖⱼ| ≤ 1 either way).
+        let axes16 =
+            axes.map(|a| a.map(|c| (c / AXIS_UNIT).round().clamp(-32767.0, 32767.0) as i16));
+        let axes64 = axes16.map(|a| a.map(|c| f64::from(c) * AXIS_UNIT));
+        let corner64 = min.map(f64::from);
         // The corner in absolute coordinates: the rounding of this and of each `x − origin`
         // below is far inside `slack`, as every corner lies in the lane's box.
         let origin = [0, 1, 2].map(|k| centre[k] + corner64[k]);
@@ -156,15 +192,19 @@ impl OrientedLanes {
             }
         }
         let slack = scale / 1_099_511_627_776.0;
-        if !(slack.is_finite() && lo.iter().chain(&hi).all(|v| v.is_finite())) {
+        let lo = lo.map(|v| ((v - slack) / unit).floor());
+        let hi = hi.map(|v| ((v + slack) / unit).ceil());
+        // (the division's rounding is far below the slack; an interval outside ±32767 units,
+        // impossible for points in the box, leaves the lane unconstrained)
+        if !lo.iter().chain(&hi).all(|v| v.abs() <= 32767.0) {
             return;
         }
         for k in 0..3 {
-            for (j, &a) in axes32[k].iter().enumerate() {
+            for (j, &a) in axes16[k].iter().enumerate() {
                 self.axis[k][j][lane] = a;
             }
-            self.lo[k][lane] = down(lo[k] - slack);
-            self.hi[k][lane] = up(hi[k] + slack);
+            self.lo[k][lane] = lo[k] as i16;
+            self.hi[k][lane] = hi[k] as i16;
         }
     }
 }
@@ -205,6 +245,7 @@ fn axes(triangles: &[[Point3; 3]], extent: [f64; 3]) -> Option<[Point3; 3]> {
 #[allow(clippy::disallowed_methods)]
 mod tests {
     use super::*;
+    use crate::distance::down;
 
     /// Exact squared distance from `p` to triangle `abc` (Ericson's region walk, f64).
     fn exact2(p: Point3, [a, b, c]: [Point3; 3]) -> f64 {
@@ -290,8 +331,9 @@ mod tests {
         ] {
             let centre = [offset[0] * 0.999, offset[1], offset[2] + 1.0];
             for _ in 0..200 {
-                let mut lanes_of = UNCONSTRAINED;
+                let mut lanes_of = OrientedLanes::NONE;
                 let mut corners = [[0.0f32; WIDTH]; 3];
+                let mut far_corners = [[0.0f32; WIDTH]; 3];
                 let mut tris = Vec::new();
                 for lane in 0..WIDTH {
                     let at = [0, 1, 2].map(|k| offset[k] + (next() - 0.5) * 4.0 * size);
@@ -304,12 +346,12 @@ mod tests {
                             hi[k] = hi[k].max(x[k] - centre[k]);
                         }
                     }
-                    let c = lo.map(down);
-                    for (axis, &v) in corners.iter_mut().zip(&c) {
-                        axis[lane] = v;
+                    let (c, f) = (lo.map(down), hi.map(up));
+                    for k in 0..3 {
+                        corners[k][lane] = c[k];
+                        far_corners[k][lane] = f[k];
                     }
-                    let extent = [0, 1, 2].map(|k| hi[k] - lo[k]);
-                    lanes_of.set(lane, &t, c, extent, centre);
+                    lanes_of.set(lane, &t, c, f, centre);
                     tris.push(t);
                 }
                 for _ in 0..20 {
@@ -318,7 +360,7 @@ mod tests {
                     let p = [0, 1, 2].map(|k| base[k] + (next() - 0.5) * reach * size * 8.0);
                     let rel = [0, 1, 2].map(|k| p[k] - centre[k]);
                     let q = OrientedQuery::new(rel.map(down), rel.map(up), 0.0);
-                    let bounds = lanes_of.lower_bounds2(&q, &corners);
+                    let bounds = lanes_of.lower_bounds2(&q, &corners, &far_corners);
                     for lane in 0..WIDTH {
                         let exact = tris[lane]
                             .iter()
