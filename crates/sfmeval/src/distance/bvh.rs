@@ -34,6 +34,7 @@ use parry3d_f64::query::PointQueryWithLocation as _;
 use parry3d_f64::shape::Triangle;
 
 use super::leaf_bound::{self, LANES, LeafBound};
+use super::median_split;
 use super::oriented::{self, OrientedLanes, OrientedQuery};
 use super::{down, up};
 use crate::geometry::{Point3, TriangleMesh, sub};
@@ -75,7 +76,7 @@ const TINY: f32 = f32::MIN_POSITIVE;
 /// An inner node: the boxes of up to [`WIDTH`] children, per axis and lane, relative to the
 /// tree's centre (an unused lane: `+∞` to `−∞`, never visited), and each child's code and
 /// triangle count (a leaf's; 0 for an inner node).
-#[derive(Debug, Clone, Copy)]
+#[derive(Debug, Clone, Copy, PartialEq)]
 #[repr(C, align(64))]
 struct Node {
     min: [[f32; WIDTH]; 3],
@@ -203,9 +204,15 @@ pub(crate) struct TriangleBvh {
 
 impl TriangleBvh {
     /// Builds the hierarchy by median splits of the triangle centroids along the longest axis,
-    /// two levels of them a node. The mesh must be valid (vertex indices in range, finite
-    /// vertices); deterministic.
+    /// two levels of them a node (the splits made ahead on disjoint ranges in parallel:
+    /// [`median_split`]). The mesh must be valid (vertex indices in range, finite vertices);
+    /// deterministic.
     pub(crate) fn new(mesh: &TriangleMesh) -> Self {
+        Self::build(mesh, true)
+    }
+
+    /// [`Self::new`]; `split_ahead` false takes the serial path (the tests' reference).
+    fn build(mesh: &TriangleMesh, split_ahead: bool) -> Self {
         let centroids: Vec<Point3> = parallel::map_range(mesh.triangles.len(), |i| {
             let [a, b, c] = mesh.corners(&mesh.triangles[i]);
             [
@@ -231,7 +238,12 @@ impl TriangleBvh {
         };
         let unbounded = (0..3).any(|k| !((hi[k] - lo[k]) / 2.0 < MAX_RELATIVE / 2.0));
         let unbounded = unbounded && !mesh.triangles.is_empty();
+        // The median splits ahead, in parallel; the serial path where copies are dropped.
         let mut order: Vec<u32> = (0..mesh.triangles.len() as u32).collect();
+        let partitioned = split_ahead && median_split::split_all(&mut order, &centroids, LEAF_SIZE);
+        if !partitioned {
+            order = (0..mesh.triangles.len() as u32).collect();
+        }
         let mut nodes = Vec::with_capacity(mesh.triangles.len() / (2 * LEAF_SIZE) + 2);
         let mut leaves = Vec::with_capacity(mesh.triangles.len() / (LEAF_SIZE - 1) + 1);
         let mut builder = Builder {
@@ -242,6 +254,7 @@ impl TriangleBvh {
             leaves: &mut leaves,
             centre,
             unbounded,
+            partitioned,
         };
         if !mesh.triangles.is_empty() {
             builder.root(mesh.triangles.len());
@@ -513,6 +526,8 @@ struct Builder<'a> {
     leaves: &'a mut Vec<(usize, usize, Point3, Point3)>,
     centre: Point3,
     unbounded: bool,
+    /// The order is split already ([`median_split::split_all`]): only the nodes are placed.
+    partitioned: bool,
 }
 
 impl Builder<'_> {
@@ -600,19 +615,11 @@ impl Builder<'_> {
     /// Drops stacked copies from `order[start..end]` when all its centroids coincide; returns
     /// the range's new end and the longest axis of its centroids (the axis to split along).
     fn prepare(&mut self, start: usize, end: usize) -> (usize, usize) {
-        let mut lo = [f64::INFINITY; 3];
-        let mut hi = [f64::NEG_INFINITY; 3];
-        for &i in &self.order[start..end] {
-            let c = self.centroids[i as usize];
-            for k in 0..3 {
-                lo[k] = lo[k].min(c[k]);
-                hi[k] = hi[k].max(c[k]);
-            }
+        if self.partitioned {
+            return (end, 0);
         }
-        let axis = (0..3)
-            .max_by(|&a, &b| (hi[a] - lo[a]).total_cmp(&(hi[b] - lo[b])))
-            .unwrap_or(0);
-        if end - start > LEAF_SIZE && (0..3).all(|k| hi[k] == lo[k]) {
+        let (axis, same) = median_split::centroid_axis(&self.order[start..end], self.centroids);
+        if end - start > LEAF_SIZE && same {
             // Every centroid in one place: copies of one triangle (a glTF node graph that
             // instances a mesh many times in the same place) would make every query visit
             // them all, since the boxes never prune an equally distant copy. Only the
@@ -625,14 +632,10 @@ impl Builder<'_> {
 
     /// Median split of `order[start..end]` along `axis` (ties by input index); the middle.
     fn halve(&mut self, start: usize, end: usize, axis: usize) -> usize {
-        let mid = (end - start) / 2;
-        let centroids = self.centroids;
-        self.order[start..end].select_nth_unstable_by(mid, |&a, &b| {
-            centroids[a as usize][axis]
-                .total_cmp(&centroids[b as usize][axis])
-                .then(a.cmp(&b))
-        });
-        start + mid
+        if self.partitioned {
+            return start + (end - start) / 2;
+        }
+        start + median_split::median_split(&mut self.order[start..end], self.centroids, axis)
     }
 
     /// Moves the distinct triangles of `order[start..end]` (same corners in the same cyclic
@@ -998,6 +1001,22 @@ mod tests {
                     "{offset:?}: {per_query} exact tests a query"
                 );
             }
+        }
+    }
+
+    /// The splits made ahead in parallel give the serial build's tree, bit for bit; and a
+    /// mesh with stacked copies takes the serial path.
+    #[test]
+    fn splits_ahead_give_the_serial_tree() {
+        let mut stacked = blob(20);
+        let t = stacked.triangles[3];
+        stacked.triangles.extend(std::iter::repeat_n(t, 50));
+        for mesh in [blob(150), blob(7), stacked] {
+            let a = TriangleBvh::new(&mesh);
+            let b = TriangleBvh::build(&mesh, false);
+            assert!(a.nodes == b.nodes, "{} triangles", mesh.triangles.len());
+            assert_eq!((a.tris, a.ids), (b.tris, b.ids));
+            assert!(a.bounds == b.bounds);
         }
     }
 

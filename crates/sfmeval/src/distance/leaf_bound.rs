@@ -37,7 +37,7 @@ const TINY: f32 = f32::MIN_POSITIVE;
 const MIN_SINE: f64 = 1e-9;
 
 /// The bound's data for up to [`LANES`] triangles, structure of arrays (128 bytes).
-#[derive(Debug, Clone, Copy, Default)]
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
 #[repr(C, align(64))]
 pub(crate) struct LeafBound {
     /// Unit normal, per axis, in units of 1 / [`UNIT`].

@@ -4,6 +4,7 @@ mod bvh;
 mod cloud;
 pub(crate) mod kd_cloud;
 mod leaf_bound;
+mod median_split;
 mod mesh;
 pub(crate) mod neighbour_list;
 mod oriented;

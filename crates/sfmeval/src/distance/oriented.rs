@@ -63,7 +63,7 @@ fn unit(min: [f32; 3], max: [f32; 3]) -> f32 {
 }
 
 /// The oriented boxes of a node's children, structure of arrays (120 bytes).
-#[derive(Debug, Clone, Copy, Default)]
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
 #[repr(C)]
 pub(crate) struct OrientedLanes {
     /// `axis[k][j][l]`: component `j` of lane `l`'s axis `k`, in units of 2⁻¹⁵.

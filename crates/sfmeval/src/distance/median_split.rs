@@ -1,0 +1,75 @@
+//! The BVH's median splits of the triangle order: the longest axis of a range's centroids, the
+//! split of a range at its median along it, and all of the build's splits done ahead, in
+//! parallel over disjoint ranges.
+//!
+//! The build ([`super::bvh`]) splits a range at its median, then each half again, two levels
+//! of splits a node. Every split reads and permutes only its own range of the order, so the
+//! halves of a split can be split on different threads and the order comes out the same, bit
+//! for bit, as one thread's (`select_nth_unstable_by` is deterministic for the same slice).
+//! The build then reads the finished order and only places the nodes. One case is left to the
+//! build's own serial path: a range of more than a leaf whose centroids all coincide (stacked
+//! copies of a triangle, which the build drops).
+
+use crate::geometry::Point3;
+use crate::parallel;
+
+/// Ranges at least this long split their halves on two threads.
+const PARALLEL_MIN: usize = 16_384;
+
+/// The longest axis of the centroids of `order` (the axis to split along; the last of equally
+/// long ones), and whether they all coincide.
+pub(crate) fn centroid_axis(order: &[u32], centroids: &[Point3]) -> (usize, bool) {
+    let mut lo = [f64::INFINITY; 3];
+    let mut hi = [f64::NEG_INFINITY; 3];
+    for &i in order {
+        let c = centroids[i as usize];
+        for k in 0..3 {
+            lo[k] = lo[k].min(c[k]);
+            hi[k] = hi[k].max(c[k]);
+        }
+    }
+    let axis = (0..3)
+        .max_by(|&a, &b| (hi[a] - lo[a]).total_cmp(&(hi[b] - lo[b])))
+        .unwrap_or(0);
+    (axis, (0..3).all(|k| hi[k] == lo[k]))
+}
+
+/// Splits `order` at its median along `axis` (ties by triangle index); returns the middle.
+pub(crate) fn median_split(order: &mut [u32], centroids: &[Point3], axis: usize) -> usize {
+    let mid = order.len() / 2;
+    order.select_nth_unstable_by(mid, |&a, &b| {
+        centroids[a as usize][axis]
+            .total_cmp(&centroids[b as usize][axis])
+            .then(a.cmp(&b))
+    });
+    mid
+}
+
+/// Every split the build of a tree over `order` makes, with leaves of `leaf_size` triangles:
+/// the build groups two levels of splits into a node, but each range of more than a leaf is
+/// split once, at its median along its own longest axis, whatever the grouping. Returns `false`
+/// (the order then partly split) when a range of more than a leaf has coinciding centroids: the
+/// build must then start over from its own order on its serial path.
+pub(crate) fn split_all(order: &mut [u32], centroids: &[Point3], leaf_size: usize) -> bool {
+    if order.len() <= leaf_size {
+        return true;
+    }
+    let (axis, same) = centroid_axis(order, centroids);
+    if same {
+        return false;
+    }
+    let mid = median_split(order, centroids, axis);
+    let (left, right) = order.split_at_mut(mid);
+    let (a, b) = if left.len() + right.len() >= PARALLEL_MIN {
+        parallel::join(
+            || split_all(left, centroids, leaf_size),
+            || split_all(right, centroids, leaf_size),
+        )
+    } else {
+        (
+            split_all(left, centroids, leaf_size),
+            split_all(right, centroids, leaf_size),
+        )
+    };
+    a && b
+}
