@@ -4,9 +4,9 @@
 //! 340 MB of peak memory to build (one node of 112 bytes per triangle plus build buffers) and
 //! its f64 nodes do not fit the cache. Here a node holds the boxes of its four children as
 //! `f32` lanes, structure of arrays (128 bytes, two cache lines; with the oriented boxes below,
-//! 256 bytes), so one visit tests four boxes in a few vector instructions. The boxes are relative to the mesh's centre (so they stay
-//! tight for georeferenced coordinates, where absolute `f32` is coarser than a triangle) and
-//! rounded outwards, and the box distance is computed to be a lower bound (query rounded
+//! 256 bytes), so one visit tests four boxes in a few vector instructions. The boxes are
+//! relative to the mesh's centre (so they stay tight for georeferenced coordinates, where
+//! absolute `f32` is coarser than a triangle) and rounded outwards, and the box distance is computed to be a lower bound (query rounded
 //! outwards too, a margin for the `f64` exact test, a relative guard on the `f32` squares):
 //! pruning with it never drops the answer. Leaves hold up to [`LEAF_SIZE`] triangles, tested
 //! with parry's exact f64 point-triangle projection.
@@ -717,18 +717,13 @@ mod tests {
     #[test]
     fn oriented_boxes_keep_the_answer_and_prune_nodes() {
         for offset in [[0.0; 3], [4e5, -1e6, 2.5e5]] {
-            let mut mesh = blob(150);
-            for v in &mut mesh.vertices {
-                *v = [0, 1, 2].map(|k| offset[k] + v[k]);
-            }
+            let mesh = placed(blob(150), offset, 1.0);
             let bvh = TriangleBvh::new(&mesh);
             let (mut with, mut without) = (0, 0);
             let mut hint = Hint::default();
-            for (i, p) in queries(3000).into_iter().enumerate() {
-                let r = (p[0] * p[0] + p[1] * p[1] + p[2] * p[2]).sqrt().max(1e-9);
-                // a spacing of about 0.02, noise up to 0.1 either side
-                let t = 1.0 + 0.1 * ((i % 11) as f64 / 5.0 - 1.0);
-                let p = [0, 1, 2].map(|k| offset[k] + p[k] / r * t);
+            // a spacing of about 0.02, noise up to 0.1 either side
+            for p in near_surface(3000, 0.1, 11) {
+                let p = [0, 1, 2].map(|k| offset[k] + p[k]);
                 let before = node_visits();
                 let reference = bvh.search::<false>(p, None).unwrap();
                 let middle = node_visits();
@@ -756,17 +751,11 @@ mod tests {
             ([0.0; 3], 1.0, 3.0),
             ([4e5, -1e6, 2.5e5], 1e-2, 0.05),
         ] {
-            let mut mesh = blob(60);
-            for v in &mut mesh.vertices {
-                *v = [0, 1, 2].map(|k| offset[k] + scale * v[k]);
-            }
+            let mesh = placed(blob(60), offset, scale);
             let bvh = TriangleBvh::new(&mesh);
             let (mut with, mut without) = (0, 0);
-            for (i, p) in queries(2000).into_iter().enumerate() {
-                // near the surface: a surface point pushed along its radius
-                let r = (p[0] * p[0] + p[1] * p[1] + p[2] * p[2]).sqrt().max(1e-9);
-                let t = 1.0 + spread * ((i % 7) as f64 / 3.0 - 1.0);
-                let p = [0, 1, 2].map(|k| offset[k] + scale * p[k] / r * t);
+            for p in near_surface(2000, spread, 7) {
+                let p = [0, 1, 2].map(|k| offset[k] + scale * p[k]);
                 let before = exact_tests();
                 let reference = bvh.search::<false>(p, None).unwrap();
                 let middle = exact_tests();
@@ -815,6 +804,29 @@ mod tests {
             vertices,
             triangles,
         }
+    }
+
+    /// `mesh` scaled by `scale` about the origin, then moved by `offset`.
+    fn placed(mut mesh: TriangleMesh, offset: Point3, scale: f64) -> TriangleMesh {
+        for v in &mut mesh.vertices {
+            *v = [0, 1, 2].map(|k| offset[k] + scale * v[k]);
+        }
+        mesh
+    }
+
+    /// [`queries`] pushed along their radius to 1 ± `spread` (a unit sphere's surface points
+    /// with noise), the noise cycling through `period` (odd) steps from −spread to +spread.
+    fn near_surface(m: usize, spread: f64, period: usize) -> Vec<Point3> {
+        let half = ((period - 1) / 2) as f64;
+        queries(m)
+            .into_iter()
+            .enumerate()
+            .map(|(i, p)| {
+                let r = (p[0] * p[0] + p[1] * p[1] + p[2] * p[2]).sqrt().max(1e-9);
+                let t = 1.0 + spread * ((i % period) as f64 / half - 1.0);
+                p.map(|v| v / r * t)
+            })
+            .collect()
     }
 
     fn queries(m: usize) -> Vec<Point3> {
@@ -980,10 +992,7 @@ mod tests {
             // squared distances below f32's normal range: correct, not pruned
             ([1e-20, 0.0, 0.0], 1e-22, None),
         ] {
-            let mut mesh = blob(16);
-            for v in &mut mesh.vertices {
-                *v = [0, 1, 2].map(|k| offset[k] + scale * v[k]);
-            }
+            let mesh = placed(blob(16), offset, scale);
             let bvh = TriangleBvh::new(&mesh);
             let mut hint = Hint::default();
             let before = exact_tests();

@@ -148,11 +148,12 @@ pub(crate) fn margin(p_local: Point3, origin: Point3, extent: Point3) -> f32 {
 // Test data only: platform maths is fine here (reports use libm, see clippy.toml).
 #[cfg(test)]
 #[allow(clippy::disallowed_methods)]
-mod tests {
+pub(super) mod tests {
     use super::*;
 
-    /// Exact squared point-triangle distance (Ericson's region walk), f64.
-    fn exact2(p: Point3, [a, b, c]: [Point3; 3]) -> f64 {
+    /// Exact squared point-triangle distance (Ericson's region walk), f64; the oriented boxes'
+    /// tests use it too.
+    pub(crate) fn exact2(p: Point3, [a, b, c]: [Point3; 3]) -> f64 {
         let n = cross(sub(b, a), sub(c, a));
         let inside = |u: Point3, v: Point3| dot(cross(sub(v, u), sub(p, u)), n) >= 0.0;
         let seg2 = |u: Point3, v: Point3| {

@@ -74,15 +74,6 @@ pub(crate) struct OrientedLanes {
     hi: [[i16; WIDTH]; 3],
 }
 
-impl OrientedLanes {
-    /// Every lane unconstrained (zero axes and intervals: a bound of at most 0).
-    pub(crate) const NONE: OrientedLanes = OrientedLanes {
-        axis: [[[0; WIDTH]; 3]; 3],
-        lo: [[0; WIDTH]; 3],
-        hi: [[0; WIDTH]; 3],
-    };
-}
-
 /// A query as the oriented test sees it: its rounded-down coordinates relative to the tree's
 /// centre, and the absolute error allowance independent of the lane.
 #[derive(Debug, Clone, Copy)]
@@ -107,6 +98,13 @@ impl OrientedQuery {
 }
 
 impl OrientedLanes {
+    /// Every lane unconstrained (zero axes and intervals: a bound of at most 0).
+    pub(crate) const NONE: OrientedLanes = OrientedLanes {
+        axis: [[[0; WIDTH]; 3]; 3],
+        lo: [[0; WIDTH]; 3],
+        hi: [[0; WIDTH]; 3],
+    };
+
     /// Lower bounds on the squared distances from the query to the four children's triangles;
     /// `min` and `max` are the node's axis-aligned boxes (`Node::min`, `Node::max`).
     #[inline]
@@ -246,43 +244,7 @@ fn axes(triangles: &[[Point3; 3]], extent: [f64; 3]) -> Option<[Point3; 3]> {
 mod tests {
     use super::*;
     use crate::distance::down;
-
-    /// Exact squared distance from `p` to triangle `abc` (Ericson's region walk, f64).
-    fn exact2(p: Point3, [a, b, c]: [Point3; 3]) -> f64 {
-        let ab = sub(b, a);
-        let ac = sub(c, a);
-        let ap = sub(p, a);
-        let (d1, d2) = (dot(ab, ap), dot(ac, ap));
-        let at = |u: f64, w: f64| [0, 1, 2].map(|k| a[k] + u * ab[k] + w * ac[k]);
-        let closest = if d1 <= 0.0 && d2 <= 0.0 {
-            a
-        } else {
-            let bp = sub(p, b);
-            let (d3, d4) = (dot(ab, bp), dot(ac, bp));
-            let cp = sub(p, c);
-            let (d5, d6) = (dot(ab, cp), dot(ac, cp));
-            let vc = d1 * d4 - d3 * d2;
-            let vb = d5 * d2 - d1 * d6;
-            let va = d3 * d6 - d5 * d4;
-            if d3 >= 0.0 && d4 <= d3 {
-                b
-            } else if vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0 {
-                at(d1 / (d1 - d3), 0.0)
-            } else if d6 >= 0.0 && d5 <= d6 {
-                c
-            } else if vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0 {
-                at(0.0, d2 / (d2 - d6))
-            } else if va <= 0.0 && (d4 - d3) >= 0.0 && (d5 - d6) >= 0.0 {
-                let w = (d4 - d3) / ((d4 - d3) + (d5 - d6));
-                [0, 1, 2].map(|k| b[k] + w * (c[k] - b[k]))
-            } else {
-                let denom = 1.0 / (va + vb + vc);
-                at(vb * denom, vc * denom)
-            }
-        };
-        let d = sub(p, closest);
-        dot(d, d)
-    }
+    use crate::distance::leaf_bound::tests::exact2;
 
     fn rng(seed: u64) -> impl FnMut() -> f64 {
         let mut s = seed;
