@@ -73,6 +73,30 @@ where
     }
 }
 
+/// `f` over `0..n` cut into one contiguous range per thread (a single range without threads),
+/// the results in range order: for reductions whose partial results are large (histograms,
+/// counters), where a range per work unit would multiply them.
+pub(crate) fn map_ranges<R, F>(n: usize, f: F) -> Vec<R>
+where
+    R: Send,
+    F: Fn(std::ops::Range<usize>) -> R + Sync + Send,
+{
+    #[cfg(feature = "parallel")]
+    let parts = rayon::current_num_threads().min(n.div_ceil(1 << 15)).max(1);
+    #[cfg(not(feature = "parallel"))]
+    let parts = 1;
+    let range = |j: usize| j * n / parts..(j + 1) * n / parts;
+    #[cfg(feature = "parallel")]
+    {
+        use rayon::prelude::*;
+        (0..parts).into_par_iter().map(|j| f(range(j))).collect()
+    }
+    #[cfg(not(feature = "parallel"))]
+    {
+        (0..parts).map(|j| f(range(j))).collect()
+    }
+}
+
 /// Sets `out[k] = f(state, k)` for every `k`, in parallel chunks; each chunk's state starts as
 /// `S::default()` and goes from one index to the next in order, as in
 /// [`map_range_with_state`], but the results go straight into `out` (no second buffer).
@@ -148,6 +172,10 @@ where
     }
 }
 
+/// Indices per work unit of [`map_range_with_state`]: closest-point queries in tree order take
+/// from 1 to 50 µs, and a unit of far points at the end would keep one thread working alone.
+const STATE_CHUNK: usize = 1024;
+
 /// Maps `f` over `start..end`, keeping order, reporting progress per chunk; `f` also gets a
 /// state carried from one index to the next within a chunk (each chunk starts from
 /// `S::default()`), as in [`map_with_state`].
@@ -162,9 +190,9 @@ where
     S: Default,
     F: Fn(&mut S, usize) -> R + Sync + Send,
 {
-    let starts: Vec<usize> = (start..end).step_by(CHUNK).collect();
+    let starts: Vec<usize> = (start..end).step_by(STATE_CHUNK).collect();
     let chunk = |&s: &usize| {
-        let e = (s + CHUNK).min(end);
+        let e = (s + STATE_CHUNK).min(end);
         let mut state = S::default();
         let out: Vec<R> = (s..e).map(|k| f(&mut state, k)).collect();
         progress.advance((e - s) as u64);
@@ -189,7 +217,7 @@ where
 /// in input order, like [`map`]. Worth it for closest-point queries on large inputs.
 pub fn map_points<R, F>(points: &[Point3], progress: &dyn Progress, f: F) -> Vec<R>
 where
-    R: Send + Copy,
+    R: Send + Sync + Copy,
     F: Fn(&Point3) -> R + Sync + Send,
 {
     let order = morton_order(points);
@@ -201,7 +229,7 @@ where
 /// each other, so the previous answer is a good start.
 pub fn map_points_with_state<R, S, F>(points: &[Point3], progress: &dyn Progress, f: F) -> Vec<R>
 where
-    R: Send + Copy,
+    R: Send + Sync + Copy,
     S: Default,
     F: Fn(&mut S, &Point3) -> R + Sync + Send,
 {
@@ -214,7 +242,7 @@ where
 /// the results by index, like [`map`]: [`map_points`] with an order computed once and reused.
 pub(crate) fn map_in_order<R, F>(order: &[u32], progress: &dyn Progress, f: F) -> Vec<R>
 where
-    R: Send + Copy,
+    R: Send + Sync + Copy,
     F: Fn(usize) -> R + Sync + Send,
 {
     let visited = map(order, progress, |&i| f(i as usize));
@@ -222,12 +250,12 @@ where
 }
 
 /// `visited[k]` is the result for index `order[k]`: the results by index.
-fn by_index<R: Copy>(order: &[u32], visited: Vec<R>) -> Vec<R> {
+fn by_index<R: Copy + Send + Sync>(order: &[u32], visited: Vec<R>) -> Vec<R> {
     let mut position = vec![0u32; order.len()];
     for (k, &i) in order.iter().enumerate() {
         position[i as usize] = k as u32;
     }
-    position.into_iter().map(|k| visited[k as usize]).collect()
+    map_range(order.len(), |i| visited[position[i] as usize])
 }
 
 #[cfg(test)]

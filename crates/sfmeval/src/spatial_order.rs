@@ -25,21 +25,19 @@ pub(crate) fn morton_order(points: &[Point3]) -> Vec<u32> {
     } else {
         0.0
     };
-    let mut keyed: Vec<(u64, u32)> = points
-        .iter()
-        .enumerate()
-        .map(|(i, p)| {
-            let code = if p.iter().all(|v| v.is_finite()) {
-                // In [0, 2^21 - 1] by construction; `as` saturates anything rounding outside.
-                let cell = |k: usize| ((p[k] - lo[k]) * scale) as u64;
-                spread(cell(0)) | (spread(cell(1)) << 1) | (spread(cell(2)) << 2)
-            } else {
-                u64::MAX
-            };
-            (code, i as u32)
-        })
-        .collect();
-    keyed.sort_unstable();
+    let mut keyed: Vec<(u64, u32)> = crate::parallel::map_range(points.len(), |i| {
+        let p = &points[i];
+        let code = if p.iter().all(|v| v.is_finite()) {
+            // In [0, 2^21 - 1] by construction; `as` saturates anything rounding outside.
+            let cell = |k: usize| ((p[k] - lo[k]) * scale) as u64;
+            spread(cell(0)) | (spread(cell(1)) << 1) | (spread(cell(2)) << 2)
+        } else {
+            u64::MAX
+        };
+        (code, i as u32)
+    });
+    // The keys are distinct (the index breaks ties): any sort gives this order.
+    crate::parallel::sort_unstable(&mut keyed);
     keyed.into_iter().map(|(_, i)| i).collect()
 }
 

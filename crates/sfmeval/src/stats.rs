@@ -4,6 +4,8 @@
 
 use serde::{Deserialize, Serialize};
 
+use crate::parallel;
+
 /// Percentiles reported in every statistics block.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, Default)]
 pub struct Percentiles {
@@ -104,9 +106,10 @@ impl Statistics {
 
     /// [`Statistics::of`] on the values `values[i]` with `keep(i)`, in that order, without a copy
     /// of them: the sums run in input order as in [`Statistics::of`], and the order statistics
-    /// are selected exactly by `select_rank` (a few counting passes), so the results are the
-    /// same bits as sorting a copy would give.
-    pub fn of_kept(values: &[f64], keep: impl Fn(usize) -> bool, bins: usize) -> Statistics {
+    /// are selected exactly by [`select_ranks`] (a few counting passes), so the results are the
+    /// same bits as sorting a copy would give. The count, extremes, counting passes and
+    /// histogram run on one range of the values per thread (exact, so thread-independent).
+    pub fn of_kept(values: &[f64], keep: impl Fn(usize) -> bool + Sync, bins: usize) -> Statistics {
         let kept = || {
             values
                 .iter()
@@ -114,19 +117,27 @@ impl Statistics {
                 .filter(|(i, _)| keep(*i))
                 .map(|(_, &v)| v)
         };
-        let Some(first) = kept().next() else {
+        let parts = parallel::map_ranges(values.len(), |range| {
+            let mut count = 0usize;
+            let mut extremes: Option<(f64, f64)> = None;
+            for i in range.filter(|&i| keep(i)) {
+                let v = values[i];
+                count += 1;
+                extremes = Some(extremes.map_or((v, v), |(lo, hi)| widen(lo, hi, v, v)));
+            }
+            (count, extremes)
+        });
+        let n: usize = parts.iter().map(|p| p.0).sum();
+        let Some((min, max)) = parts
+            .iter()
+            .filter_map(|p| p.1)
+            .reduce(|(lo, hi), (a, b)| widen(lo, hi, a, b))
+        else {
             return Statistics::default();
         };
-        let n = kept().count();
         // Scale-safe: values whose squares (or sums) could overflow are divided by the largest
         // magnitude first and the results multiplied back; ordinary values are divided by 1
         // (bit-identical to the plain sums).
-        let (min, max) = kept().fold((first, first), |(lo, hi), v| {
-            (
-                if v.total_cmp(&lo).is_lt() { v } else { lo },
-                if v.total_cmp(&hi).is_gt() { v } else { hi },
-            )
-        });
         let largest = min.abs().max(max.abs());
         let k = if largest.is_finite() && largest > 1e100 {
             largest
@@ -147,12 +158,23 @@ impl Statistics {
             dev += (v - mean_k) * (v - mean_k);
         }
         let mean = mean_k * k;
-        let mut at = |r: usize| select_rank(kept, r);
-        let p50 = percentile_by(n, 50.0, &mut at);
-        let (p1, p99) = (
-            percentile_by(n, 1.0, &mut at),
-            percentile_by(n, 99.0, &mut at),
-        );
+        // Every rank the percentiles interpolate between, selected together.
+        const QS: [f64; 5] = [1.0, 50.0, 90.0, 95.0, 99.0];
+        let ranks: Vec<usize> = QS
+            .iter()
+            .flat_map(|&q| {
+                let (lo, hi, _) = percentile_ranks(n, q);
+                [lo, hi]
+            })
+            .collect();
+        let picked = select_ranks(values, &keep, &ranks);
+        let mut at = |r: usize| {
+            ranks
+                .iter()
+                .position(|&x| x == r)
+                .map_or(f64::NAN, |j| picked[j])
+        };
+        let [p1, p50, p90, p95, p99] = QS.map(|q| percentile_by(n, q, &mut at));
         let (lo, hi) = histogram_range(min, max, p1, p99);
         Statistics {
             count: n as u64,
@@ -162,15 +184,18 @@ impl Statistics {
             std: (dev / nf).sqrt() * k,
             median: p50,
             rms: (sum_sq / nf).sqrt() * k,
-            percentiles: Percentiles {
-                p50,
-                p90: percentile_by(n, 90.0, &mut at),
-                p95: percentile_by(n, 95.0, &mut at),
-                p99,
-            },
-            histogram: histogram_of(kept(), lo, hi, bins),
+            percentiles: Percentiles { p50, p90, p95, p99 },
+            histogram: histogram_of(values, &keep, lo, hi, bins),
         }
     }
+}
+
+/// `(lo, hi)` widened to hold `a` and `b` (`a <= b`), in `total_cmp` order.
+fn widen(lo: f64, hi: f64, a: f64, b: f64) -> (f64, f64) {
+    (
+        if a.total_cmp(&lo).is_lt() { a } else { lo },
+        if b.total_cmp(&hi).is_gt() { b } else { hi },
+    )
 }
 
 /// `v`'s position in the total order of `f64` as an unsigned integer (monotone).
@@ -179,53 +204,164 @@ fn order_key(v: f64) -> u64 {
     if b >> 63 == 1 { !b } else { b | 1 << 63 }
 }
 
+/// The value whose [`order_key`] is `key`.
+fn from_order_key(key: u64) -> f64 {
+    f64::from_bits(if key >> 63 == 1 {
+        key & !(1 << 63)
+    } else {
+        !key
+    })
+}
+
 /// Candidates collected and sorted at most, per rank: a bucket larger than this is split by
 /// the next 16 bits of the key in one more counting pass.
 const SELECT_LIMIT: u64 = 1 << 16;
 
-/// The value of rank `r` (0-based, in `total_cmp` order) among the values `values()` yields:
-/// counting passes over the top bits of [`order_key`], 16 bits a pass, narrow the rank to
-/// one bucket of at most [`SELECT_LIMIT`] values, which are sorted. Exact; memory is the
-/// 65 536 counters and the one bucket.
-pub(crate) fn select_rank<I: Iterator<Item = f64>>(values: impl Fn() -> I, r: usize) -> f64 {
-    let mut r = r as u64;
-    let mut prefix = 0u64;
-    let mut fixed = 0u32; // top bits of the key fixed so far
-    loop {
-        let matches = |key: u64| fixed == 0 || key >> (64 - fixed) == prefix >> (64 - fixed);
-        let shift = 64 - fixed - 16;
-        let mut counts = vec![0u64; 1 << 16];
-        for v in values() {
-            let key = order_key(v);
-            if matches(key) {
-                counts[((key >> shift) & 0xffff) as usize] += 1;
+/// Whether `key`'s top `fixed` bits are `prefix`'s.
+fn has_prefix(key: u64, prefix: u64, fixed: u32) -> bool {
+    fixed == 0 || key >> (64 - fixed) == prefix >> (64 - fixed)
+}
+
+/// A rank being narrowed: its rank among the values whose key starts with `prefix`'s top
+/// `fixed` bits.
+#[derive(Clone, Copy)]
+struct Narrowing {
+    rank: u64,
+    prefix: u64,
+    fixed: u32,
+    /// Its position in the caller's list.
+    slot: usize,
+}
+
+/// The values of ranks `ranks` (0-based, in `total_cmp` order) among the `values[i]` with
+/// `keep(i)`, in the order of `ranks`. Counting passes over the keys' ([`order_key`]) top bits,
+/// 16 bits a pass and one pass for all ranks, narrow each rank to one bucket; a bucket of at
+/// most [`SELECT_LIMIT`] values is collected and sorted (one pass for all such buckets), a
+/// bucket whose key is complete is that key's value. Exact; memory is 65 536 counters a
+/// distinct bucket and thread, and the collected buckets. Each rank must be below the number of
+/// kept values.
+pub(crate) fn select_ranks(
+    values: &[f64],
+    keep: &(impl Fn(usize) -> bool + Sync),
+    ranks: &[usize],
+) -> Vec<f64> {
+    let mut out = vec![f64::NAN; ranks.len()];
+    let mut open: Vec<Narrowing> = ranks
+        .iter()
+        .enumerate()
+        .map(|(slot, &r)| Narrowing {
+            rank: r as u64,
+            prefix: 0,
+            fixed: 0,
+            slot,
+        })
+        .collect();
+    let mut small: Vec<Narrowing> = Vec::new();
+    let group_of = |list: &[Narrowing]| {
+        let mut g: Vec<(u64, u32)> = list.iter().map(|x| (x.prefix, x.fixed)).collect();
+        g.sort_unstable();
+        g.dedup();
+        g
+    };
+    while !open.is_empty() {
+        let groups = group_of(&open);
+        let parts = parallel::map_ranges(values.len(), |range| {
+            let mut counts = vec![0u64; groups.len() << 16];
+            for i in range.filter(|&i| keep(i)) {
+                let key = order_key(values[i]);
+                for (g, &(prefix, fixed)) in groups.iter().enumerate() {
+                    if has_prefix(key, prefix, fixed) {
+                        counts[g << 16 | ((key >> (48 - fixed)) & 0xffff) as usize] += 1;
+                    }
+                }
+            }
+            counts
+        });
+        let mut counts = vec![0u64; groups.len() << 16];
+        for part in &parts {
+            for (c, p) in counts.iter_mut().zip(part) {
+                *c += p;
             }
         }
-        let mut bucket = counts.len() - 1;
-        for (b, &c) in counts.iter().enumerate() {
-            if r < c {
-                bucket = b;
-                break;
+        drop(parts);
+        let mut still = Vec::new();
+        for mut x in open {
+            let Ok(g) = groups.binary_search(&(x.prefix, x.fixed)) else {
+                continue;
+            };
+            let group = &counts[g << 16..(g + 1) << 16];
+            let mut bucket = group.len() - 1;
+            for (b, &c) in group.iter().enumerate() {
+                if x.rank < c {
+                    bucket = b;
+                    break;
+                }
+                x.rank -= c;
             }
-            r -= c;
+            let shift = 48 - x.fixed;
+            x.prefix |= (bucket as u64) << shift;
+            x.fixed += 16;
+            let count = group[bucket];
+            if x.fixed == 64 {
+                // Every value of the bucket has this key: the rank's value, or none at all.
+                out[x.slot] = if count > 0 {
+                    from_order_key(x.prefix)
+                } else {
+                    f64::NAN
+                };
+            } else if count <= SELECT_LIMIT {
+                small.push(x);
+            } else {
+                still.push(x);
+            }
         }
-        prefix |= (bucket as u64) << shift;
-        fixed += 16;
-        if counts[bucket] <= SELECT_LIMIT || fixed == 64 {
-            let mut candidates: Vec<f64> = values()
-                .filter(|&v| {
-                    let key = order_key(v);
-                    fixed == 64 || key >> (64 - fixed) == prefix >> (64 - fixed)
-                })
-                .collect();
-            candidates.sort_unstable_by(f64::total_cmp);
-            return candidates
-                .get(r as usize)
-                .or(candidates.last())
-                .copied()
-                .unwrap_or(f64::NAN);
+        open = still;
+    }
+    if small.is_empty() {
+        return out;
+    }
+    let groups = group_of(&small);
+    let parts = parallel::map_ranges(values.len(), |range| {
+        let mut found = vec![Vec::new(); groups.len()];
+        for i in range.filter(|&i| keep(i)) {
+            let key = order_key(values[i]);
+            for (g, &(prefix, fixed)) in groups.iter().enumerate() {
+                if has_prefix(key, prefix, fixed) {
+                    found[g].push(values[i]);
+                }
+            }
+        }
+        found
+    });
+    let mut found: Vec<Vec<f64>> = vec![Vec::new(); groups.len()];
+    for part in parts {
+        for (f, p) in found.iter_mut().zip(part) {
+            f.extend(p);
         }
     }
+    for f in &mut found {
+        f.sort_unstable_by(f64::total_cmp);
+    }
+    for x in small {
+        let Ok(g) = groups.binary_search(&(x.prefix, x.fixed)) else {
+            continue;
+        };
+        let f = &found[g];
+        out[x.slot] = f
+            .get(x.rank as usize)
+            .or(f.last())
+            .copied()
+            .unwrap_or(f64::NAN);
+    }
+    out
+}
+
+/// The two ranks (0-based) the linear-interpolated percentile `q` in [0, 100] of `n > 0` values
+/// lies between, and the fraction of the way from the first (numpy's default).
+fn percentile_ranks(n: usize, q: f64) -> (usize, usize, f64) {
+    let pos = (q / 100.0).clamp(0.0, 1.0) * n.saturating_sub(1) as f64;
+    let lo = pos.floor() as usize;
+    (lo, (lo + 1).min(n.saturating_sub(1)), pos - lo as f64)
 }
 
 /// Linear-interpolated percentile `q` in [0, 100] of `n` values, `at(r)` giving the value of
@@ -235,10 +371,7 @@ fn percentile_by(n: usize, q: f64, at: &mut impl FnMut(usize) -> f64) -> f64 {
         0 => 0.0,
         1 => at(0),
         n => {
-            let pos = (q / 100.0).clamp(0.0, 1.0) * (n - 1) as f64;
-            let lo = pos.floor() as usize;
-            let hi = (lo + 1).min(n - 1);
-            let frac = pos - lo as f64;
+            let (lo, hi, frac) = percentile_ranks(n, q);
             let (a, b) = (at(lo), at(hi));
             let v = a + (b - a) * frac;
             if v.is_finite() {
@@ -276,12 +409,18 @@ fn histogram_range(min: f64, max: f64, p1: f64, p99: f64) -> (f64, f64) {
 /// `underflow` / `overflow`.
 #[cfg(test)]
 pub(crate) fn histogram(values: &[f64], lo: f64, hi: f64, bins: usize) -> Histogram {
-    histogram_of(values.iter().copied(), lo, hi, bins)
+    histogram_of(values, &|_| true, lo, hi, bins)
 }
 
-/// Histogram of the values an iterator yields into `bins` equal bins over `[lo, hi]`; values
-/// outside are counted in `underflow` / `overflow`.
-fn histogram_of(values: impl Iterator<Item = f64>, lo: f64, hi: f64, bins: usize) -> Histogram {
+/// Histogram of the values `values[i]` with `keep(i)` into `bins` equal bins over `[lo, hi]`;
+/// values outside are counted in `underflow` / `overflow`. Counted on one range per thread.
+fn histogram_of(
+    values: &[f64],
+    keep: &(impl Fn(usize) -> bool + Sync),
+    lo: f64,
+    hi: f64,
+    bins: usize,
+) -> Histogram {
     let bins = bins.max(1);
     let width = if hi > lo {
         let w = (hi - lo) / bins as f64;
@@ -308,21 +447,33 @@ fn histogram_of(values: impl Iterator<Item = f64>, lo: f64, hi: f64, bins: usize
             }
         })
         .collect();
+    let parts = parallel::map_ranges(values.len(), |range| {
+        let mut counts = vec![0u64; bins];
+        let (mut underflow, mut overflow) = (0u64, 0u64);
+        for v in range.filter(|&i| keep(i)).map(|i| values[i]) {
+            if v < lo {
+                underflow += 1;
+            } else if v > hi {
+                overflow += 1;
+            } else {
+                let mut x = (v - lo) / width;
+                if !x.is_finite() {
+                    x = v / width - lo / width;
+                }
+                let b = (x.floor().max(0.0) as usize).min(bins - 1);
+                counts[b] += 1;
+            }
+        }
+        (counts, underflow, overflow)
+    });
     let mut counts = vec![0u64; bins];
     let (mut underflow, mut overflow) = (0u64, 0u64);
-    for v in values {
-        if v < lo {
-            underflow += 1;
-        } else if v > hi {
-            overflow += 1;
-        } else {
-            let mut x = (v - lo) / width;
-            if !x.is_finite() {
-                x = v / width - lo / width;
-            }
-            let b = (x.floor().max(0.0) as usize).min(bins - 1);
-            counts[b] += 1;
+    for (c, u, o) in parts {
+        for (a, b) in counts.iter_mut().zip(c) {
+            *a += b;
         }
+        underflow += u;
+        overflow += o;
     }
     Histogram {
         edges,
@@ -388,9 +539,10 @@ mod tests {
             let copy: Vec<f64> = (0..v.len()).filter(|&i| keep(i)).map(|i| v[i]).collect();
             let mut sorted = copy.clone();
             sorted.sort_unstable_by(f64::total_cmp);
-            for r in [0, 1, copy.len() / 2, copy.len() - 2, copy.len() - 1] {
-                let got = select_rank(|| copy.iter().copied(), r);
-                assert_eq!(got.to_bits(), sorted[r].to_bits(), "rank {r}");
+            let ranks = [0, 1, copy.len() / 2, copy.len() - 2, copy.len() - 1];
+            let got = select_ranks(&copy, &|_| true, &ranks);
+            for (r, g) in ranks.into_iter().zip(got) {
+                assert_eq!(g.to_bits(), sorted[r].to_bits(), "rank {r}");
             }
             let got = Statistics::of_kept(&v, keep, bins);
             assert_eq!(
@@ -416,6 +568,35 @@ mod tests {
                 percentile_sorted(&sorted, 99.0),
             );
             assert_eq!(got.histogram, histogram(&sorted, lo, hi, bins));
+        }
+    }
+
+    /// More equal values than [`SELECT_LIMIT`] (a perfect reconstruction's zeros, a quantised
+    /// cloud): the selection fixes all 64 bits of the key and reads the value from it.
+    #[test]
+    fn select_ranks_through_runs_of_equal_values() {
+        let mut v: Vec<f64> = Vec::new();
+        for i in 0..400_000u64 {
+            v.push(match i % 4 {
+                0 | 1 => 0.0,
+                2 => 0.125,
+                _ => (i as f64).sqrt() * 1e-3,
+            });
+        }
+        v[5] = -0.0;
+        let mut sorted = v.clone();
+        sorted.sort_unstable_by(f64::total_cmp);
+        let ranks: Vec<usize> = [
+            0, 1, 2, 100_000, 199_999, 200_000, 250_000, 299_999, 399_999,
+        ]
+        .into_iter()
+        .collect();
+        let got = select_ranks(&v, &|_| true, &ranks);
+        for (&r, g) in ranks.iter().zip(got) {
+            assert_eq!(g.to_bits(), sorted[r].to_bits(), "rank {r}");
+        }
+        for x in [0.0, -0.0, 0.125, -3.5, f64::MAX, f64::MIN_POSITIVE] {
+            assert_eq!(from_order_key(order_key(x)).to_bits(), f64::to_bits(x));
         }
     }
 
