@@ -251,6 +251,21 @@ impl Evaluation {
     }
 }
 
+/// The distance from each of `samples` to the nearest live point of `tree`, `point(k)` giving
+/// slot `k` in the samples' frame; NaN where the search finds none (a sample not finite).
+fn nearest_kept(
+    tree: &SlotTree,
+    samples: &[Point3],
+    point: impl Fn(usize) -> Point3 + Sync,
+    live: impl Fn(usize) -> bool + Sync,
+    progress: &dyn Progress,
+) -> Vec<f64> {
+    parallel::map_points(samples, progress, |&p| {
+        tree.nearest(p, &point, &live)
+            .map_or(f64::NAN, |(d2, _)| d2.sqrt())
+    })
+}
+
 /// Slots per block of accuracy queries: results are scattered into input order a block at a
 /// time, so the queries hold no per-point buffer beyond the outputs.
 const BLOCK: usize = 1 << 20;
@@ -366,10 +381,16 @@ pub fn evaluate(
         let tree = SlotTree::new(n, in_gt, is_live);
         progress.finish();
         progress.start(Stage::Completeness, completeness_points.len() as u64);
-        let d = parallel::map_points(&completeness_points, progress, |&p| {
-            tree.nearest(p, in_gt, is_live)
-                .map_or(f64::NAN, |(d2, _)| d2.sqrt())
-        });
+        // A plain read of the storage where no transform applies: the leaf scans inline it
+        // (0.8-0.9x the time of the searches through `in_gt`, one thread, 1M samples).
+        let samples = &completeness_points;
+        let d = match (&recon, identity) {
+            (Positions::F32(v), true) => {
+                nearest_kept(&tree, samples, |k| v[k].map(f64::from), is_live, progress)
+            }
+            (Positions::F64(v), true) => nearest_kept(&tree, samples, |k| v[k], is_live, progress),
+            _ => nearest_kept(&tree, samples, in_gt, is_live, progress),
+        };
         progress.finish();
         d
     };
