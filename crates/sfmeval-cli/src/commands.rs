@@ -393,6 +393,25 @@ fn read_recon(input: &InputArgs) -> Result<ReconInput> {
         .with_context(|| format!("reconstruction '{}'", input.recon.display()))
 }
 
+/// The ground truth (as [`dataset_paths`] finds it) and the reconstruction, read at the same
+/// time: two files, two parsers (the ground truth's error first when both fail).
+fn read_inputs(
+    input: &InputArgs,
+    depth: Option<&Path>,
+    with_depth: bool,
+) -> Result<(Dataset, ReconInput)> {
+    let paths = dataset_paths(input, depth, with_depth)?;
+    let limits = ReadLimits::triangles(input.max_triangles);
+    std::thread::scope(|s| {
+        let recon = s.spawn(|| read_recon(input));
+        let dataset = sfmeval_fs::read_dataset(&paths, &limits);
+        let recon = recon
+            .join()
+            .unwrap_or_else(|panic| std::panic::resume_unwind(panic));
+        Ok((dataset?, recon?))
+    })
+}
+
 fn eval(args: &EvalArgs) -> Result<()> {
     let eval = EvalOptions {
         tau: args.tau.clone(),
@@ -411,11 +430,7 @@ fn eval(args: &EvalArgs) -> Result<()> {
         pose: PoseOptions::default(),
     };
     let bars = Bars::new(args.quiet);
-    let mut dataset = sfmeval_fs::read_dataset(
-        &dataset_paths(&args.input, args.depth.as_deref(), true)?,
-        &ReadLimits::triangles(args.input.max_triangles),
-    )?;
-    let recon = read_recon(&args.input)?;
+    let (mut dataset, recon) = read_inputs(&args.input, args.depth.as_deref(), true)?;
     let evaluation = pipeline::run_owned(&mut dataset, recon, &request, &bars)
         .map_err(|e| run_error(e, &args.input))?;
     if let Some(path) = &args.samples_csv {
@@ -454,11 +469,7 @@ fn align_cmd(input: &InputArgs, out: Option<&Path>, seed: u64) -> Result<()> {
         pose: PoseOptions::default(),
     };
     let bars = Bars::new(false);
-    let mut dataset = sfmeval_fs::read_dataset(
-        &dataset_paths(input, None, false)?,
-        &ReadLimits::triangles(input.max_triangles),
-    )?;
-    let recon = read_recon(input)?;
+    let (mut dataset, recon) = read_inputs(input, None, false)?;
     let evaluation =
         pipeline::run(&mut dataset, &recon, &request, &bars).map_err(|e| run_error(e, input))?;
     let a = &evaluation.report.alignment;
