@@ -276,7 +276,7 @@ const BLOCK: usize = 1 << 20;
 /// Memory, `n` points: the points as read (12 bytes a point in `f32`, 24 in `f64`), their input
 /// indices in tree order (4), the distances (8; 8 more signed), the status (1), the live mask
 /// (1/8) and the tree boxes (about 2), plus 16 bytes a point while the tree order is computed
-/// and 8 while the statistics sort the kept distances.
+/// (the statistics select their percentiles without a copy).
 pub fn evaluate(
     gt: &PreparedGroundTruth,
     mut recon: Positions,

@@ -106,7 +106,7 @@ impl Statistics {
 
     /// [`Statistics::of`] on the values `values[i]` with `keep(i)`, in that order, without a copy
     /// of them: the sums run in input order as in [`Statistics::of`], and the order statistics
-    /// are selected exactly by [`select_ranks`] (a few counting passes), so the results are the
+    /// are selected exactly by `select_ranks` (a few counting passes), so the results are the
     /// same bits as sorting a copy would give. The count, extremes, counting passes and
     /// histogram run on one range of the values per thread (exact, so thread-independent).
     pub fn of_kept(values: &[f64], keep: impl Fn(usize) -> bool + Sync, bins: usize) -> Statistics {
