@@ -430,11 +430,6 @@ pub fn evaluate(
         .collect();
 
     let bins = options.histogram_bins;
-    let finite_completeness: Vec<f64> = completeness_distances
-        .iter()
-        .copied()
-        .filter(|d| d.is_finite())
-        .collect();
     let accuracy_stats = Statistics::of_kept(&distances, is_kept, bins);
     let signed_stats = signed_distances
         .as_ref()
@@ -504,7 +499,11 @@ pub fn evaluate(
             .into(),
             samples: completeness_points.len() as u64,
             seed: gt.sample_seed,
-            stats: Statistics::of_owned(finite_completeness, bins),
+            stats: Statistics::of_kept(
+                &completeness_distances,
+                |i| completeness_distances[i].is_finite(),
+                bins,
+            ),
         },
         thresholds,
         cameras: None,
