@@ -13,11 +13,14 @@ const WORDS_PER_SAMPLE: u128 = 6;
 
 /// Draws `n` points uniformly by area on the mesh surface.
 pub fn sample_surface(mesh: &TriangleMesh, n: usize, seed: u64) -> Result<Vec<Point3>> {
-    let mut cumulative = Vec::with_capacity(mesh.triangles.len());
+    // The areas in parallel, their running sum in order (the same bits as one loop).
+    let mut cumulative = parallel::map_range(mesh.triangles.len(), |i| {
+        triangle_area(mesh.corners(&mesh.triangles[i]))
+    });
     let mut total = 0.0f64;
-    for t in &mesh.triangles {
-        total += triangle_area(mesh.corners(t));
-        cumulative.push(total);
+    for c in &mut cumulative {
+        total += *c;
+        *c = total;
     }
     if !(total > 0.0) || !total.is_finite() {
         return Err(Error::Geometry(
@@ -42,13 +45,9 @@ pub fn sample_surface(mesh: &TriangleMesh, n: usize, seed: u64) -> Result<Vec<Po
     });
     // Sorted by (target, index) as plain integers: a target is finite and ≥ 0, where the
     // order of the bits is the order of the numbers.
-    let mut keyed: Vec<(u64, u32)> = draws
-        .iter()
-        .enumerate()
-        .map(|(k, d)| (d[0].to_bits(), k as u32))
-        .collect();
+    let mut keyed: Vec<(u64, u32)> = parallel::map_range(n, |k| (draws[k][0].to_bits(), k as u32));
     parallel::sort_unstable(&mut keyed);
-    let by_target: Vec<u32> = keyed.iter().map(|&(_, k)| k).collect();
+    let by_target: Vec<u32> = parallel::map_range(n, |j| keyed[j].1);
     drop(keyed);
     let last = cumulative.len() - 1;
     let mut sorted = vec![[0.0f64; 3]; n];
@@ -69,11 +68,13 @@ pub fn sample_surface(mesh: &TriangleMesh, n: usize, seed: u64) -> Result<Vec<Po
         ]
     });
     drop(draws);
-    let mut out = vec![[0.0; 3]; n];
-    for (&k, p) in by_target.iter().zip(sorted) {
-        out[k as usize] = p;
+    // Back to sample order: each sample's place in target order, then a parallel gather.
+    let mut place = vec![0u32; n];
+    for (j, &k) in by_target.iter().enumerate() {
+        place[k as usize] = j as u32;
     }
-    Ok(out)
+    drop(by_target);
+    Ok(parallel::map_range(n, |k| sorted[place[k] as usize]))
 }
 
 #[cfg(test)]
