@@ -39,7 +39,7 @@ where
         use rayon::prelude::*;
         // Small inputs (ICP's coarse phase) still get split over every thread.
         let chunk = (items.len() / (4 * rayon::current_num_threads())).clamp(256, CHUNK);
-        let chunks: Vec<Vec<R>> = items.par_chunks(chunk).map(run).collect();
+        let chunks: Vec<Vec<R>> = items.par_chunks(chunk).with_max_len(1).map(run).collect();
         let mut out = Vec::with_capacity(items.len());
         for c in chunks {
             out.extend(c);
@@ -201,7 +201,7 @@ where
     #[cfg(feature = "parallel")]
     let chunks: Vec<Vec<R>> = {
         use rayon::prelude::*;
-        starts.par_iter().map(chunk).collect()
+        starts.par_iter().with_max_len(1).map(chunk).collect()
     };
     #[cfg(not(feature = "parallel"))]
     let chunks: Vec<Vec<R>> = starts.iter().map(chunk).collect();
