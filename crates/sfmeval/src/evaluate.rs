@@ -343,20 +343,31 @@ pub fn evaluate(
     }
 
     let crop = &options.crop;
-    let mut status = vec![PointStatus::Kept; n];
-    let mut live = vec![0u64; n.div_ceil(64)];
-    for (k, &i) in slot_input.iter().enumerate() {
-        let i = i as usize;
-        let s = if !crop.in_volume(in_gt(k)) {
+    // Each slot's status and the live mask (tree order) in parallel, then the statuses into
+    // input order.
+    let slot_status = parallel::map_range(n, |k| {
+        if !crop.in_volume(in_gt(k)) {
             PointStatus::OutsideVolume
-        } else if crop.max_distance.is_some_and(|m| distances[i] > m) {
+        } else if crop
+            .max_distance
+            .is_some_and(|m| distances[slot_input[k] as usize] > m)
+        {
             PointStatus::TooFar
         } else {
-            live[k / 64] |= 1 << (k % 64);
             PointStatus::Kept
-        };
-        status[i] = s;
+        }
+    });
+    let live: Vec<u64> = parallel::map_range(n.div_ceil(64), |w| {
+        let slots = &slot_status[w * 64..((w + 1) * 64).min(n)];
+        (slots.iter().enumerate())
+            .filter(|(_, s)| **s == PointStatus::Kept)
+            .fold(0u64, |bits, (b, _)| bits | 1 << b)
+    });
+    let mut status = vec![PointStatus::Kept; n];
+    for (&i, &s) in slot_input.iter().zip(&slot_status) {
+        status[i as usize] = s;
     }
+    drop(slot_status);
     let is_live = |k: usize| live[k / 64] >> (k % 64) & 1 == 1;
     let count = |s: PointStatus| status.iter().filter(|&&x| x == s).count() as u64;
     let (kept_n, outside, too_far) = (
