@@ -110,20 +110,6 @@ impl Positions {
             Positions::F32(v) => v.retain(|_| (keep(i), i += 1).0),
         }
     }
-
-    /// Reorders the points so that new slot `k` holds old point `order[k]` (`order` is a
-    /// permutation of `0..len`). `f32` points are gathered into new storage in parallel: their
-    /// 12 bytes a point stay below the 16 a point [`kd_order`](crate::distance::slot_tree)
-    /// held just before, so the peak does not move. `f64` points are reordered in place (one bit
-    /// a point of extra memory), as their copy would raise it.
-    pub(crate) fn permute(&mut self, order: &[u32]) {
-        match self {
-            Positions::F64(v) => permute_in_place(v, order),
-            Positions::F32(v) => {
-                *v = crate::parallel::map_range(order.len(), |k| v[order[k] as usize])
-            }
-        }
-    }
 }
 
 /// Reorders `v` in place so that new slot `k` holds old item `order[k]`, following the
@@ -414,27 +400,4 @@ fn norm_scaled(a: Point3, d: f64) -> f64 {
 #[inline]
 pub(crate) fn triangle_area(c: [Point3; 3]) -> f64 {
     0.5 * norm(cross(sub(c[1], c[0]), sub(c[2], c[0])))
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    /// Both storages reorder as a plain gather does: new slot `k` holds old point `order[k]`
-    /// (a permutation of long cycles over many parallel work units).
-    #[test]
-    fn permute_gathers_by_order() {
-        let n = 50_000u32;
-        let order: Vec<u32> = (0..n).map(|k| (k * 7919 + 13) % n).collect();
-        let points: Vec<Point3> = (0..n).map(|i| [i as f64, -(i as f64), 0.5]).collect();
-        let want: Vec<Point3> = order.iter().map(|&i| points[i as usize]).collect();
-        let mut p64 = Positions::F64(points.clone());
-        p64.permute(&order);
-        let mut p32 = Positions::F32(points.iter().map(|p| p.map(|v| v as f32)).collect());
-        p32.permute(&order);
-        for (k, w) in want.iter().enumerate() {
-            assert_eq!(p64.get(k), *w, "f64 slot {k}");
-            assert_eq!(p32.get(k), *w, "f32 slot {k}");
-        }
-    }
 }

@@ -3,7 +3,7 @@
 
 use crate::geometry::Point3;
 use crate::progress::Progress;
-use crate::spatial_order::morton_order;
+use crate::spatial_order::morton_keys;
 
 /// Items per progress tick and per parallel work unit.
 const CHUNK: usize = 8192;
@@ -210,6 +210,13 @@ where
         out.extend(c);
     }
     out
+}
+
+/// The Morton order of `points` (`spatial_order::morton_order`), sorted in parallel.
+fn morton_order(points: &[Point3]) -> Vec<u32> {
+    let mut keyed = morton_keys(points);
+    sort_unstable(&mut keyed);
+    map_range(keyed.len(), |k| keyed[k].1)
 }
 
 /// Maps `f` over 3D points visited in Morton order (a Z-curve: neighbours in space are

@@ -11,6 +11,14 @@ const BITS: u32 = 21;
 /// Indices of `points` sorted by their Morton code on the points' bounding box (ties by index;
 /// non-finite points last). A permutation of `0..points.len()`, deterministic.
 pub(crate) fn morton_order(points: &[Point3]) -> Vec<u32> {
+    let mut keyed = morton_keys(points);
+    keyed.sort_unstable();
+    keyed.into_iter().map(|(_, i)| i).collect()
+}
+
+/// `(Morton code, index)` of each of `points`, in input order: sorted (by any sort: the keys are
+/// distinct), the indices are [`morton_order`].
+pub(crate) fn morton_keys(points: &[Point3]) -> Vec<(u64, u32)> {
     let mut lo = [f64::INFINITY; 3];
     let mut hi = [f64::NEG_INFINITY; 3];
     for p in points.iter().filter(|p| p.iter().all(|v| v.is_finite())) {
@@ -25,20 +33,20 @@ pub(crate) fn morton_order(points: &[Point3]) -> Vec<u32> {
     } else {
         0.0
     };
-    let mut keyed: Vec<(u64, u32)> = crate::parallel::map_range(points.len(), |i| {
-        let p = &points[i];
-        let code = if p.iter().all(|v| v.is_finite()) {
-            // In [0, 2^21 - 1] by construction; `as` saturates anything rounding outside.
-            let cell = |k: usize| ((p[k] - lo[k]) * scale) as u64;
-            spread(cell(0)) | (spread(cell(1)) << 1) | (spread(cell(2)) << 2)
-        } else {
-            u64::MAX
-        };
-        (code, i as u32)
-    });
-    // The keys are distinct (the index breaks ties): any sort gives this order.
-    crate::parallel::sort_unstable(&mut keyed);
-    keyed.into_iter().map(|(_, i)| i).collect()
+    points
+        .iter()
+        .enumerate()
+        .map(|(i, p)| {
+            let code = if p.iter().all(|v| v.is_finite()) {
+                // In [0, 2^21 - 1] by construction; `as` saturates anything rounding outside.
+                let cell = |k: usize| ((p[k] - lo[k]) * scale) as u64;
+                spread(cell(0)) | (spread(cell(1)) << 1) | (spread(cell(2)) << 2)
+            } else {
+                u64::MAX
+            };
+            (code, i as u32)
+        })
+        .collect()
 }
 
 /// Spreads the low 21 bits of `x` so that bit i moves to bit 3i.
