@@ -31,10 +31,14 @@ class _RansacCriteria:
 
 
 def _ransac_on_correspondence(source, target, corres, distance, estimation, ransac_n, criteria):
-    """0.9's positional order (criteria after ransac_n) onto the current signature."""
+    """0.9's positional order (criteria after ransac_n) onto the current signature. 0.9 drew
+    all `max_iteration` samples (`max_validation` only capped the validations); the current
+    criteria stop early once a sample reaches `confidence`, 0.999 by default, which is not the
+    toolbox's algorithm: confidence 1.0 never stops early (log(1 - 1) makes the estimate NaN or
+    infinite), so every sample is drawn as in 0.9."""
     return _reg.registration_ransac_based_on_correspondence(
         source, target, corres, distance, estimation, ransac_n, [],
-        _reg.RANSACConvergenceCriteria(criteria.max_iteration))
+        _reg.RANSACConvergenceCriteria(criteria.max_iteration, 1.0))
 
 
 _shim = types.SimpleNamespace(**{k: getattr(_reg, k) for k in dir(_reg) if not k.startswith("_")})
