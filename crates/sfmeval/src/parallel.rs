@@ -212,8 +212,10 @@ where
     out
 }
 
-/// The Morton order of `points` (`spatial_order::morton_order`), sorted in parallel.
-fn morton_order(points: &[Point3]) -> Vec<u32> {
+/// Indices of `points` in Morton order (`spatial_order::morton_keys`, sorted in parallel): ties
+/// by index, non-finite points last. A permutation of `0..points.len()`, the same for any
+/// thread count.
+pub(crate) fn morton_order(points: &[Point3]) -> Vec<u32> {
     let mut keyed = morton_keys(points);
     sort_unstable(&mut keyed);
     map_range(keyed.len(), |k| keyed[k].1)
@@ -270,12 +272,11 @@ mod tests {
     use super::*;
     use crate::progress::NoProgress;
 
-    #[test]
-    fn map_points_returns_results_in_input_order() {
-        // Scrambled points across several chunks, with a NaN among them.
-        let pts: Vec<Point3> = (0..3 * CHUNK as u64 + 17)
+    /// Scrambled points across several chunks, with a NaN among them and repeated points.
+    fn scrambled_points() -> Vec<Point3> {
+        (0..3 * CHUNK as u64 + 17)
             .map(|i| {
-                let h = i.wrapping_mul(0x9e37_79b9_7f4a_7c15);
+                let h = (i % 20_000).wrapping_mul(0x9e37_79b9_7f4a_7c15);
                 let f = |s: u32| ((h >> s) & 0xffff) as f64 / 65535.0;
                 if i == 1234 {
                     [f64::NAN, 0.0, 0.0]
@@ -283,7 +284,26 @@ mod tests {
                     [f(0), f(16), f(32)]
                 }
             })
-            .collect();
+            .collect()
+    }
+
+    #[test]
+    fn morton_order_is_the_sorted_keys_indices() {
+        let pts = scrambled_points();
+        let mut keyed = morton_keys(&pts);
+        keyed.sort_by_key(|&(code, i)| (code, i));
+        let want: Vec<u32> = keyed.iter().map(|&(_, i)| i).collect();
+        let got = morton_order(&pts);
+        assert_eq!(got, want);
+        // Repeated points: the later index follows the earlier one; the NaN is last.
+        let at = |i: u32| got.iter().position(|&k| k == i);
+        assert!(at(20_000) > at(0));
+        assert_eq!(got.last(), Some(&1234));
+    }
+
+    #[test]
+    fn map_points_returns_results_in_input_order() {
+        let pts = scrambled_points();
         let got = map_points(&pts, &NoProgress, |p| (p[0], p[1] + p[2]));
         let want: Vec<(f64, f64)> = pts.iter().map(|p| (p[0], p[1] + p[2])).collect();
         assert_eq!(got.len(), want.len());

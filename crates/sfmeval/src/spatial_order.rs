@@ -8,16 +8,10 @@ use crate::geometry::Point3;
 /// Bits per axis of the Morton code (3 × 21 = 63 bits).
 const BITS: u32 = 21;
 
-/// Indices of `points` sorted by their Morton code on the points' bounding box (ties by index;
-/// non-finite points last). A permutation of `0..points.len()`, deterministic.
-pub(crate) fn morton_order(points: &[Point3]) -> Vec<u32> {
-    let mut keyed = morton_keys(points);
-    keyed.sort_unstable();
-    keyed.into_iter().map(|(_, i)| i).collect()
-}
-
-/// `(Morton code, index)` of each of `points`, in input order: sorted (by any sort: the keys are
-/// distinct), the indices are [`morton_order`].
+/// `(Morton code, index)` of each of `points`, in input order, the code taken on the points'
+/// bounding box (non-finite points get `u64::MAX`). The keys are distinct, so sorting them by
+/// any sort gives one order: the Morton order (ties by index, non-finite points last), which
+/// `parallel::morton_order` computes.
 pub(crate) fn morton_keys(points: &[Point3]) -> Vec<(u64, u32)> {
     let mut lo = [f64::INFINITY; 3];
     let mut hi = [f64::NEG_INFINITY; 3];
@@ -70,6 +64,13 @@ mod tests {
             assert_eq!(spread(1 << i), 1 << (3 * i), "bit {i}");
         }
         assert_eq!(spread(0x1f_ffff), 0x1249_2492_4924_9249);
+    }
+
+    /// The indices of the sorted keys.
+    fn morton_order(points: &[Point3]) -> Vec<u32> {
+        let mut keyed = morton_keys(points);
+        keyed.sort_unstable();
+        keyed.into_iter().map(|(_, i)| i).collect()
     }
 
     #[test]

@@ -19,8 +19,7 @@ use crate::align::umeyama;
 use crate::distance::kd_cloud::{KdCloud, NO_POINT, distance2};
 use crate::distance::neighbour_list::NeighbourList;
 use crate::geometry::Point3;
-use crate::parallel;
-use crate::spatial_order::morton_order;
+use crate::parallel::{self, morton_order};
 
 /// When ICP stops.
 #[derive(Debug, Clone, Copy, PartialEq)]
