@@ -71,7 +71,17 @@ pub struct LogArgs {
 
 /// Runs `sfmeval tnt`.
 pub fn tnt_cmd(args: &TntArgs) -> Result<()> {
-    let scene = Scene::read(&Disk, path_str(&args.scene)?, args.scene_name.as_deref())?;
+    // The scene (its ground truth is the larger file) and the reconstruction are read at the
+    // same time; the scene's error comes first when both fail.
+    let (scene, recon) = std::thread::scope(|s| {
+        let recon = s.spawn(|| sfmeval_fs::read_reconstruction(&args.recon, &name_of(&args.recon)));
+        let scene = path_str(&args.scene)
+            .and_then(|dir| Ok(Scene::read(&Disk, dir, args.scene_name.as_deref())?));
+        let recon = recon
+            .join()
+            .unwrap_or_else(|panic| std::panic::resume_unwind(panic));
+        anyhow::Ok((scene?, recon?))
+    })?;
     let registration = match (&args.transform, &args.trajectory) {
         (Some(t), _) => Registration::Given(
             tnt::matrix::parse(&read(t)?, "transform")
@@ -90,7 +100,6 @@ pub fn tnt_cmd(args: &TntArgs) -> Result<()> {
             bail!("give --trajectory FILE.log (or --transform FILE to skip the registration)")
         }
     };
-    let recon = sfmeval_fs::read_reconstruction(&args.recon, &name_of(&args.recon))?;
     let request = TntRequest {
         tau: args.tau,
         registration,
@@ -118,14 +127,23 @@ pub fn tnt_cmd(args: &TntArgs) -> Result<()> {
     let json = serde_json::to_string_pretty(&report)? + "\n";
     write_atomic(&out.join("report.json"), json.as_bytes())?;
     let name = &scene.name;
-    write_atomic(
-        &out.join(format!("{name}.precision.ply")),
-        &evaluation.precision_ply(),
-    )?;
-    write_atomic(
-        &out.join(format!("{name}.recall.ply")),
-        &evaluation.recall_ply(),
-    )?;
+    // The two coloured clouds are encoded and written side by side.
+    std::thread::scope(|s| {
+        let recall = s.spawn(|| {
+            write_atomic(
+                &out.join(format!("{name}.recall.ply")),
+                &evaluation.recall_ply(),
+            )
+        });
+        let precision = write_atomic(
+            &out.join(format!("{name}.precision.ply")),
+            &evaluation.precision_ply(),
+        );
+        let recall = recall
+            .join()
+            .unwrap_or_else(|panic| std::panic::resume_unwind(panic));
+        precision.and(recall)
+    })?;
     for (suffix, text) in evaluation.toolbox_texts() {
         write_atomic(&out.join(format!("{name}{suffix}")), text.as_bytes())?;
     }

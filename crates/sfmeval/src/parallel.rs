@@ -133,6 +133,21 @@ pub(crate) fn sort_unstable<T: Ord + Send>(slice: &mut [T]) {
     slice.sort_unstable();
 }
 
+/// `slice.sort_unstable_by_key(key)` for keys that are all distinct (so that the order is
+/// the same whatever the sort), in parallel where threads are available.
+pub(crate) fn sort_unstable_by_key<T: Send, K: Ord>(
+    slice: &mut [T],
+    key: impl Fn(&T) -> K + Sync + Send,
+) {
+    #[cfg(feature = "parallel")]
+    {
+        use rayon::prelude::*;
+        slice.par_sort_unstable_by_key(key);
+    }
+    #[cfg(not(feature = "parallel"))]
+    slice.sort_unstable_by_key(key);
+}
+
 /// Runs `a` and `b`, in parallel where threads are available.
 #[cfg(feature = "parallel")]
 pub(crate) fn join<RA: Send, RB: Send>(
