@@ -187,6 +187,46 @@ where
     }
 }
 
+/// [`map_mut`] where `f` also gets a state carried from one item to the next within a work
+/// unit of [`STATE_CHUNK`] items (each starts from `S::default()`), as in [`map_with_state`].
+pub(crate) fn map_mut_with_state<T, R, S, F>(items: &mut [T], f: F) -> Vec<R>
+where
+    T: Send,
+    R: Send,
+    S: Default,
+    F: Fn(&mut S, usize, &mut T) -> R + Sync + Send,
+{
+    let unit = |(c, unit): (usize, &mut [T])| -> Vec<R> {
+        let mut state = S::default();
+        let first = c * STATE_CHUNK;
+        unit.iter_mut()
+            .enumerate()
+            .map(|(j, t)| f(&mut state, first + j, t))
+            .collect()
+    };
+    #[cfg(feature = "parallel")]
+    let units: Vec<Vec<R>> = {
+        use rayon::prelude::*;
+        items
+            .par_chunks_mut(STATE_CHUNK)
+            .enumerate()
+            .with_max_len(1)
+            .map(unit)
+            .collect()
+    };
+    #[cfg(not(feature = "parallel"))]
+    let units: Vec<Vec<R>> = items
+        .chunks_mut(STATE_CHUNK)
+        .enumerate()
+        .map(unit)
+        .collect();
+    let mut out = Vec::with_capacity(items.len());
+    for u in units {
+        out.extend(u);
+    }
+    out
+}
+
 /// Indices per work unit of [`map_range_with_state`]: closest-point queries in tree order take
 /// from 1 to 50 µs, and a unit of far points at the end would keep one thread working alone.
 const STATE_CHUNK: usize = 1024;

@@ -39,7 +39,18 @@ pub(crate) struct NeighbourList {
     slots: [u32; LIST_LEN],
 }
 
+impl Default for NeighbourList {
+    fn default() -> NeighbourList {
+        NeighbourList::NONE
+    }
+}
+
 impl NeighbourList {
+    /// Whether the list holds `LIST_LEN` points.
+    pub(crate) fn is_full(&self) -> bool {
+        self.len as usize == LIST_LEN
+    }
+
     /// No list yet: the first query walks the tree.
     pub(crate) const NONE: NeighbourList = NeighbourList {
         centre: [0.0; 3],
@@ -51,17 +62,23 @@ impl NeighbourList {
     /// Exactly `cloud.nearest_below(q, bound)`: the nearest point strictly closer to `q` than
     /// `bound.0` (squared), with its slot, or `bound` when there is none. Reads the list when it
     /// decides the answer, else makes it again at `q` from the points closer than `reach2`
-    /// (squared; at least `bound.0` serves, more keeps the list useful for longer).
+    /// (squared; at least `bound.0` serves, more keeps the list useful for longer). A list is
+    /// made by a walk of the tree that starts with the radius of a full list's points around
+    /// `q`: this list's old points, or `hint`'s (a list of the same cloud, e.g. the previous
+    /// query's in the visiting order) when this one is not full. The points found are the same
+    /// (only nodes with no nearer point are skipped); the walk opens fewer nodes.
     pub(crate) fn nearest_below(
         &mut self,
         cloud: &KdCloud,
         q: Point3,
         bound: (f64, usize),
         reach2: f64,
+        hint: Option<&NeighbourList>,
     ) -> (f64, usize) {
         if !q.iter().all(|v| v.is_finite()) {
             return bound;
         }
+        let mut radius2 = reach2.max(bound.0);
         if self.radius2 >= 0.0 {
             let coverage2 = self.coverage2(q);
             let listed = self.slots[..self.len as usize]
@@ -71,8 +88,23 @@ impl NeighbourList {
                 return found;
             }
         }
+        // A full list's points are LIST_LEN points within their farthest distance from `q`: the
+        // new list's radius is no larger, and the walk can start there. The point's own list
+        // if it is full, else a neighbouring query's.
+        let full = if self.is_full() {
+            Some(&self.slots)
+        } else {
+            hint.filter(|h| h.is_full()).map(|h| &h.slots)
+        };
+        if let Some(slots) = full {
+            let farthest = slots
+                .iter()
+                .map(|&slot| distance2(cloud.point(slot as usize), q))
+                .fold(0.0, f64::max);
+            radius2 = radius2.min(farthest * (1.0 + 4.0 * f64::EPSILON) + f64::MIN_POSITIVE);
+        }
         let mut nearest = [(0.0, 0u32); LIST_LEN];
-        let (len, radius2) = cloud.nearest_k_below(q, reach2.max(bound.0), &mut nearest);
+        let (len, radius2) = cloud.nearest_k_below(q, radius2, &mut nearest);
         *self = NeighbourList {
             centre: q,
             radius2,
@@ -201,7 +233,10 @@ mod tests {
                             }
                         }
                     };
-                    let got = lists[i].nearest_below(&tree, q, bound, reach2);
+                    // Every other query starts its walk from the list before it (any full
+                    // list bounds the radius, near or not).
+                    let hint = (i % 2 == 1).then(|| lists[i - 1]);
+                    let got = lists[i].nearest_below(&tree, q, bound, reach2, hint.as_ref());
                     let want = tree.nearest_below(q, bound);
                     assert_eq!(got.0.to_bits(), want.0.to_bits(), "{q:?} {bound:?}");
                     assert_eq!(got.1, want.1, "{q:?} {bound:?}");
@@ -212,7 +247,7 @@ mod tests {
         }
         let mut list = NeighbourList::NONE;
         assert_eq!(
-            list.nearest_below(&tree, [f64::NAN, 0.0, 0.0], (1.0, 3), 1.0),
+            list.nearest_below(&tree, [f64::NAN, 0.0, 0.0], (1.0, 3), 1.0, None),
             (1.0, 3)
         );
     }

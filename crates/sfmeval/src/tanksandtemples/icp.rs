@@ -85,7 +85,9 @@ const LIST_REACH: f64 = 1.5;
 /// sum come in the visiting order, so that the fit then reads the moved points in memory order.
 fn matches(moved: &[Point3], target: &KdCloud, limit: f64, queries: &mut [Query]) -> Matches {
     let reach2 = limit * LIST_REACH * LIST_REACH;
-    let found = parallel::map_mut(queries, |k, query| {
+    // The state: the last full list made or read in this work unit, a neighbour's in the
+    // visiting order.
+    let found = parallel::map_mut_with_state(queries, |hint: &mut NeighbourList, k, query| {
         let q = moved[k];
         let bound = match query.slot {
             UNMATCHED => (limit, NO_POINT),
@@ -98,7 +100,12 @@ fn matches(moved: &[Point3], target: &KdCloud, limit: f64, queries: &mut [Query]
                 }
             }
         };
-        let (d2, slot) = query.list.nearest_below(target, q, bound, reach2);
+        let (d2, slot) = query
+            .list
+            .nearest_below(target, q, bound, reach2, Some(hint));
+        if query.list.is_full() {
+            *hint = query.list;
+        }
         query.slot = if slot == NO_POINT {
             UNMATCHED
         } else {
