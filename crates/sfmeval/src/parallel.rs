@@ -189,41 +189,38 @@ where
 
 /// [`map_mut`] where `f` also gets a state carried from one item to the next within a work
 /// unit of [`STATE_CHUNK`] items (each starts from `S::default()`), as in [`map_with_state`].
+/// The results go straight into one buffer (no per-unit vectors to copy).
 pub(crate) fn map_mut_with_state<T, R, S, F>(items: &mut [T], f: F) -> Vec<R>
 where
     T: Send,
-    R: Send,
+    R: Send + Clone + Default,
     S: Default,
     F: Fn(&mut S, usize, &mut T) -> R + Sync + Send,
 {
-    let unit = |(c, unit): (usize, &mut [T])| -> Vec<R> {
+    let mut out = vec![R::default(); items.len()];
+    let unit = |(c, (unit, out)): (usize, (&mut [T], &mut [R]))| {
         let mut state = S::default();
         let first = c * STATE_CHUNK;
-        unit.iter_mut()
-            .enumerate()
-            .map(|(j, t)| f(&mut state, first + j, t))
-            .collect()
+        for (j, (t, r)) in unit.iter_mut().zip(out.iter_mut()).enumerate() {
+            *r = f(&mut state, first + j, t);
+        }
     };
     #[cfg(feature = "parallel")]
-    let units: Vec<Vec<R>> = {
+    {
         use rayon::prelude::*;
         items
             .par_chunks_mut(STATE_CHUNK)
+            .zip(out.par_chunks_mut(STATE_CHUNK))
             .enumerate()
             .with_max_len(1)
-            .map(unit)
-            .collect()
-    };
-    #[cfg(not(feature = "parallel"))]
-    let units: Vec<Vec<R>> = items
-        .chunks_mut(STATE_CHUNK)
-        .enumerate()
-        .map(unit)
-        .collect();
-    let mut out = Vec::with_capacity(items.len());
-    for u in units {
-        out.extend(u);
+            .for_each(unit);
     }
+    #[cfg(not(feature = "parallel"))]
+    items
+        .chunks_mut(STATE_CHUNK)
+        .zip(out.chunks_mut(STATE_CHUNK))
+        .enumerate()
+        .for_each(unit);
     out
 }
 
