@@ -20,6 +20,7 @@ use sfmeval::pose::PoseOptions;
 use sfmeval::transform::Similarity;
 use sfmeval_fs::{Disk, name_of, path_str, read, read_input_files, write_atomic};
 
+use crate::concurrent::side_by_side;
 use crate::progress::Bars;
 use crate::summary;
 use crate::tanksandtemples::{LogArgs, TntArgs, log_cmd, tnt_cmd};
@@ -402,14 +403,11 @@ fn read_inputs(
 ) -> Result<(Dataset, ReconInput)> {
     let paths = dataset_paths(input, depth, with_depth)?;
     let limits = ReadLimits::triangles(input.max_triangles);
-    std::thread::scope(|s| {
-        let recon = s.spawn(|| read_recon(input));
-        let dataset = sfmeval_fs::read_dataset(&paths, &limits);
-        let recon = recon
-            .join()
-            .unwrap_or_else(|panic| std::panic::resume_unwind(panic));
-        Ok((dataset?, recon?))
-    })
+    let (recon, dataset) = side_by_side(
+        || read_recon(input),
+        || sfmeval_fs::read_dataset(&paths, &limits),
+    );
+    Ok((dataset?, recon?))
 }
 
 fn eval(args: &EvalArgs) -> Result<()> {

@@ -1,6 +1,7 @@
 //! `sfmeval`: evaluate SfM reconstructions against ground truth from the command line.
 
 mod commands;
+mod concurrent;
 mod progress;
 mod summary;
 mod tanksandtemples;

@@ -10,6 +10,7 @@ use sfmeval::tanksandtemples::{
 };
 use sfmeval_fs::{Disk, image_names, name_of, path_str, read, read_input_files, write_atomic};
 
+use crate::concurrent::side_by_side;
 use crate::progress::Bars;
 
 /// `sfmeval tnt`'s flags.
@@ -73,15 +74,17 @@ pub struct LogArgs {
 pub fn tnt_cmd(args: &TntArgs) -> Result<()> {
     // The scene (its ground truth is the larger file) and the reconstruction are read at the
     // same time; the scene's error comes first when both fail.
-    let (scene, recon) = std::thread::scope(|s| {
-        let recon = s.spawn(|| sfmeval_fs::read_reconstruction(&args.recon, &name_of(&args.recon)));
-        let scene = path_str(&args.scene)
-            .and_then(|dir| Ok(Scene::read(&Disk, dir, args.scene_name.as_deref())?));
-        let recon = recon
-            .join()
-            .unwrap_or_else(|panic| std::panic::resume_unwind(panic));
-        anyhow::Ok((scene?, recon?))
-    })?;
+    let (recon, scene) = side_by_side(
+        || sfmeval_fs::read_reconstruction(&args.recon, &name_of(&args.recon)),
+        || -> Result<Scene> {
+            Ok(Scene::read(
+                &Disk,
+                path_str(&args.scene)?,
+                args.scene_name.as_deref(),
+            )?)
+        },
+    );
+    let (scene, recon) = (scene?, recon?);
     let registration = match (&args.transform, &args.trajectory) {
         (Some(t), _) => Registration::Given(
             tnt::matrix::parse(&read(t)?, "transform")
@@ -128,22 +131,21 @@ pub fn tnt_cmd(args: &TntArgs) -> Result<()> {
     write_atomic(&out.join("report.json"), json.as_bytes())?;
     let name = &scene.name;
     // The two coloured clouds are encoded and written side by side.
-    std::thread::scope(|s| {
-        let recall = s.spawn(|| {
+    let (recall, precision) = side_by_side(
+        || {
             write_atomic(
                 &out.join(format!("{name}.recall.ply")),
                 &evaluation.recall_ply(),
             )
-        });
-        let precision = write_atomic(
-            &out.join(format!("{name}.precision.ply")),
-            &evaluation.precision_ply(),
-        );
-        let recall = recall
-            .join()
-            .unwrap_or_else(|panic| std::panic::resume_unwind(panic));
-        precision.and(recall)
-    })?;
+        },
+        || {
+            write_atomic(
+                &out.join(format!("{name}.precision.ply")),
+                &evaluation.precision_ply(),
+            )
+        },
+    );
+    precision.and(recall)?;
     for (suffix, text) in evaluation.toolbox_texts() {
         write_atomic(&out.join(format!("{name}{suffix}")), text.as_bytes())?;
     }
