@@ -57,6 +57,8 @@ fn spread(x: u64) -> u64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+    // The order the keys give, as the callers get it.
+    use crate::parallel::morton_order;
 
     #[test]
     fn spread_moves_bit_i_to_3i() {
@@ -64,13 +66,6 @@ mod tests {
             assert_eq!(spread(1 << i), 1 << (3 * i), "bit {i}");
         }
         assert_eq!(spread(0x1f_ffff), 0x1249_2492_4924_9249);
-    }
-
-    /// The indices of the sorted keys.
-    fn morton_order(points: &[Point3]) -> Vec<u32> {
-        let mut keyed = morton_keys(points);
-        keyed.sort_unstable();
-        keyed.into_iter().map(|(_, i)| i).collect()
     }
 
     #[test]

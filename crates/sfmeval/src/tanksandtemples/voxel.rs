@@ -90,10 +90,9 @@ fn mean(sum: [f64; 3], n: u32) -> Point3 {
 fn sorted_means(points: &[Point3], key: impl Fn(&Point3) -> u64 + Sync + Send) -> Vec<Point3> {
     let mut keyed = parallel::map_range(points.len(), |i| (key(&points[i]), i as u32));
     parallel::sort_unstable(&mut keyed);
-    let mut starts: Vec<usize> = (1..keyed.len())
-        .filter(|&k| keyed[k].0 != keyed[k - 1].0)
+    let starts: Vec<usize> = (0..keyed.len())
+        .filter(|&k| k == 0 || keyed[k].0 != keyed[k - 1].0)
         .collect();
-    starts.insert(0, 0);
     let mut voxels = parallel::map_range(starts.len(), |v| {
         let end = starts.get(v + 1).copied().unwrap_or(keyed.len());
         let run = &keyed[starts[v]..end];
