@@ -52,7 +52,7 @@ pub(crate) struct LeafBound {
 
 /// The length one unit of a stored offset stands for, in a leaf of extent `extent`: offsets of
 /// points inside the leaf's box lie within ±(sum of the extents).
-#[inline]
+#[inline(always)]
 pub(crate) fn offset_scale(extent: Point3) -> f64 {
     let sum = extent[0].abs() + extent[1].abs() + extent[2].abs();
     if sum > 0.0 { sum / UNIT } else { 1.0 }
@@ -100,7 +100,7 @@ impl LeafBound {
     /// Lower bounds on the squared distances from `p` (relative to the block's origin) to the
     /// block's triangles; `scale` the leaf's [`offset_scale`], `margin` from [`margin`]. A lane
     /// whose arithmetic overflows gets 0.
-    #[inline]
+    #[inline(always)]
     pub(crate) fn lower_bounds2(&self, p: [f32; 3], scale: f32, margin: f32) -> [f32; LANES] {
         // Everything in units of 1 / UNIT until the end.
         let dot3 = |v: &[[i16; LANES]; 3], l: usize| {
@@ -128,7 +128,7 @@ impl LeafBound {
 /// `x` rounded to an integer, half away from zero, within `0.5 + ulp(x)` of `x` (`f64::round`
 /// is a library call on baseline x86-64: 7 % of the instructions of a BVH build); `x` within
 /// ±2⁶². The extra ulp is far inside [`margin`]'s slack.
-#[inline]
+#[inline(always)]
 fn nearest(x: f64) -> f64 {
     (x + 0.5f64.copysign(x)) as i64 as f64
 }
@@ -137,7 +137,7 @@ fn nearest(x: f64) -> f64 {
 /// leaf of extent `extent`: `2⁻¹³` (1 / 8192) of the local coordinates' size covers the
 /// rounded directions (`ε (d + D)` with `d ≤ |p_local| + D`), the rounded offsets (`D / 65534`) and the
 /// `f32` arithmetic; `2⁻⁴⁴` of the global coordinates' size covers the f64 exact test.
-#[inline]
+#[inline(always)]
 pub(crate) fn margin(p_local: Point3, origin: Point3, extent: Point3) -> f32 {
     let sum = |v: Point3| v[0].abs() + v[1].abs() + v[2].abs();
     let local = sum(p_local) + sum(extent);

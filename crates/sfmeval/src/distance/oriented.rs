@@ -57,7 +57,7 @@ const PER_SIZE: f32 = 1.0 / 32000.0;
 
 /// The interval unit of a child lane whose box runs from `min` to `max` (relative `f32`): the
 /// build and the query compute it the same way, bit for bit.
-#[inline]
+#[inline(always)]
 fn unit(min: [f32; 3], max: [f32; 3]) -> f32 {
     ((max[0] - min[0]) + (max[1] - min[1]) + (max[2] - min[2])) * PER_SIZE
 }
@@ -107,7 +107,7 @@ impl OrientedLanes {
 
     /// Lower bounds on the squared distances from the query to the four children's triangles;
     /// `min` and `max` are the node's axis-aligned boxes (`Node::min`, `Node::max`).
-    #[inline]
+    #[inline(always)]
     pub(crate) fn lower_bounds2(
         &self,
         q: &OrientedQuery,
