@@ -13,6 +13,7 @@ import json
 import math
 import os
 import shutil
+import signal
 import subprocess
 import sys
 
@@ -350,6 +351,10 @@ def test_cancel_ends_the_runner_and_its_tools(tiny, bins, tmp_path):
     time.sleep(0.2)
     assert not os.path.exists("/proc/%d" % sleeper) or \
         open("/proc/%d/stat" % sleeper).read().split(") ")[1].startswith("Z"), "sleep survived"
+    # The runner is signalled before its tool, so it never sees the tool die and records
+    # nothing for the cancelled run (it did, under load, when the tool's group went first).
+    assert rc == -signal.SIGTERM, rc
+    assert not list((tmp_path / "runs").rglob("run.json"))
 
 
 def test_binaries_are_found_in_preferences_path_or_target_release(bins, tmp_path, monkeypatch):

@@ -108,9 +108,11 @@ class Job:
         """SIGTERM to the runner's group and its tools' groups, SIGKILL after `grace` seconds."""
         if self.proc.poll() is not None:
             return
-        groups = _descendant_groups(self.proc.pid) | {self.proc.pid}
+        groups = _descendant_groups(self.proc.pid) - {self.proc.pid}
         for sig in (signal.SIGTERM, signal.SIGKILL):
-            for g in groups:
+            # The runner's own group first: signalled after a tool, it could see the tool die
+            # and record the run as failed (run.json) before its own signal arrived.
+            for g in [self.proc.pid, *sorted(groups)]:
                 try:
                     os.killpg(g, sig)
                 except (ProcessLookupError, PermissionError):
