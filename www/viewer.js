@@ -38,11 +38,23 @@ export class Viewer {
     this.raycaster = new THREE.Raycaster();
     new ResizeObserver(() => this.resize()).observe(container);
     this.resize();
-    const loop = () => {
-      this.renderer.render(this.scene, this.camera);
-      requestAnimationFrame(loop);
-    };
-    requestAnimationFrame(loop);
+    // Drawn on demand, in the next animation frame after a change, never in a loop: an idle
+    // page that redraws every frame keeps a core busy (the GPU, or the CPU under a software
+    // renderer) and takes it from the evaluation's workers. Changes come from the controls'
+    // events and from every method of this class (wrapped below).
+    this.renderQueued = false;
+    this.orbit.addEventListener('change', () => this.requestRender());
+    this.gizmo.addEventListener('change', () => this.requestRender());
+    for (const name of Object.getOwnPropertyNames(Viewer.prototype)) {
+      const f = this[name];
+      if (name === 'constructor' || name === 'requestRender' || typeof f !== 'function') continue;
+      this[name] = (...args) => {
+        const out = f.apply(this, args);
+        this.requestRender();
+        return out;
+      };
+    }
+    this.requestRender();
     this.renderer.domElement.addEventListener('pointerdown', (e) => { this.down = [e.clientX, e.clientY]; });
     this.renderer.domElement.addEventListener('pointerup', (e) => {
       if (!this.down || !this.onPick) return;
@@ -352,7 +364,19 @@ export class Viewer {
     else this.onPick({ kind: 'gt', point: [h.point.x + c[0], h.point.y + c[1], h.point.z + c[2]] });
   }
 
+  /** Draws the scene in the next animation frame (once, however many changes come first). */
+  requestRender() {
+    if (this.renderQueued) return;
+    this.renderQueued = true;
+    requestAnimationFrame(() => {
+      this.renderQueued = false;
+      this.renderer.render(this.scene, this.camera);
+    });
+  }
+
   screenshot() {
+    // drawn now: a change made just before must be in the picture
+    this.renderer.render(this.scene, this.camera);
     return this.renderer.domElement.toDataURL('image/png');
   }
 }

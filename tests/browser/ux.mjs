@@ -160,6 +160,22 @@ try {
     await runButtonChecks(page, tag);
     await loadDemo(page);
     await evaluateAndWait(page);
+    // the 3D view draws on demand: idle, no frame at all (a redraw every frame kept a core busy
+    // under a software renderer and slowed the evaluation's workers); a change draws once
+    const frames = await page.evaluate(async () => {
+      const v = window.sfmevalViewer;
+      const draw = v.renderer.render.bind(v.renderer);
+      let n = 0;
+      v.renderer.render = (...a) => { n += 1; return draw(...a); };
+      await new Promise((r) => setTimeout(r, 1500));
+      const idle = n;
+      v.setPointSize(4);
+      await new Promise((r) => setTimeout(r, 500));
+      const changed = n - idle;
+      v.renderer.render = draw;
+      return { idle, changed };
+    });
+    check(`${tag} viewer-idle-draws-nothing-a-change-draws-once`, frames.idle === 0 && frames.changed === 1, JSON.stringify(frames));
     // colour bar: 0 left of the gradient, "≥ clip" right of it, nothing else
     const cb = await page.evaluate(() => {
       const r = (id) => document.getElementById(id).getBoundingClientRect();
