@@ -128,7 +128,7 @@ impl LeafBound {
 /// `x` rounded to an integer, half away from zero, within `0.5 + ulp(x)` of `x` (`f64::round`
 /// is a library call on baseline x86-64: 7 % of the instructions of a BVH build); `x` within
 /// ±2⁶². The extra ulp is far inside [`margin`]'s slack.
-#[inline(always)]
+#[inline]
 fn nearest(x: f64) -> f64 {
     (x + 0.5f64.copysign(x)) as i64 as f64
 }
