@@ -12,7 +12,7 @@ use std::sync::atomic::{AtomicU64, Ordering};
 use js_sys::{Float32Array, Float64Array, Function, Object, Uint8Array, Uint32Array};
 use serde::Serialize as _;
 use sfmeval::align::{AlignMode, AlignRequest, PointPair, parse_point_pairs};
-use sfmeval::colormap::distance_color;
+use sfmeval::colormap::distance_colors;
 use sfmeval::crop::Crop;
 use sfmeval::dataset::Dataset;
 use sfmeval::evaluate::EvalOptions;
@@ -92,8 +92,7 @@ fn files_of(files: &Object) -> Result<BTreeMap<String, Vec<u8>>, JsError> {
 }
 
 fn points_f64(points: &[[f64; 3]]) -> Float64Array {
-    let flat: Vec<f64> = points.iter().flatten().copied().collect();
-    Float64Array::from(flat.as_slice())
+    Float64Array::from(points.as_flattened())
 }
 
 /// The same as 32-bit floats (WebGL buffers).
@@ -572,13 +571,7 @@ impl Evaluation {
     /// Heat-map colours (`r0, g0, b0, ...`, viridis) of every point, saturating at `clip`
     /// (the colours of the coloured PLY).
     pub fn colors(&self, clip: f64) -> Uint8Array {
-        let flat: Vec<u8> = self
-            .inner
-            .distances
-            .iter()
-            .flat_map(|&d| distance_color(d, clip))
-            .collect();
-        Uint8Array::from(flat.as_slice())
+        Uint8Array::from(distance_colors(&self.inner.distances, clip).as_flattened())
     }
 
     /// The kept points coloured by error as binary PLY, as `sfmeval eval --colored`.

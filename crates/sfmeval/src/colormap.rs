@@ -32,6 +32,13 @@ pub fn distance_color(d: f64, clip: f64) -> [u8; 3] {
     }
 }
 
+/// [`distance_color`] of every distance, in order (in parallel with the `parallel` feature).
+pub fn distance_colors(distances: &[f64], clip: f64) -> Vec<[u8; 3]> {
+    crate::parallel::map(distances, &crate::progress::NoProgress, |&d| {
+        distance_color(d, clip)
+    })
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -41,6 +48,9 @@ mod tests {
         assert_eq!(viridis(0.0), [68, 1, 84]);
         assert_eq!(viridis(1.0), [253, 231, 37]);
         assert_eq!(viridis(2.0), viridis(1.0));
+        let d: Vec<f64> = (0..20_000).map(|i| f64::from(i) * 1e-4).collect();
+        let one_by_one: Vec<[u8; 3]> = d.iter().map(|&x| distance_color(x, 1.5)).collect();
+        assert_eq!(distance_colors(&d, 1.5), one_by_one);
         let luma = |c: [u8; 3]| {
             0.2126 * f64::from(c[0]) + 0.7152 * f64::from(c[1]) + 0.0722 * f64::from(c[2])
         };

@@ -230,21 +230,26 @@ impl Evaluation {
     /// 24 bytes a point; exports use [`Evaluation::for_each_point_in_gt`]).
     pub fn points_in_gt(&self) -> Vec<Point3> {
         let t = self.gt_from_recon;
-        let mut out = vec![[0.0; 3]; self.recon.len()];
+        let slot_of = self.slot_of_input();
+        parallel::map_range(slot_of.len(), |i| {
+            t.apply(self.recon.get(slot_of[i] as usize))
+        })
+    }
+
+    /// The inverse of `slot_input`: the slot of every input point.
+    fn slot_of_input(&self) -> Vec<u32> {
+        let mut slot_of = vec![0u32; self.slot_input.len()];
         for (k, &i) in self.slot_input.iter().enumerate() {
-            out[i as usize] = t.apply(self.recon.get(k));
+            slot_of[i as usize] = k as u32;
         }
-        out
+        slot_of
     }
 
     /// Calls `f(index, point in the ground-truth frame)` for every reconstructed point in input
     /// order (4 bytes a point of extra memory).
     pub fn for_each_point_in_gt(&self, mut f: impl FnMut(usize, Point3)) {
         let t = self.gt_from_recon;
-        let mut slot_of = vec![0u32; self.slot_input.len()];
-        for (k, &i) in self.slot_input.iter().enumerate() {
-            slot_of[i as usize] = k as u32;
-        }
+        let slot_of = self.slot_of_input();
         for (i, &k) in slot_of.iter().enumerate() {
             f(i, t.apply(self.recon.get(k as usize)));
         }
