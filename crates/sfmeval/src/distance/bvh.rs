@@ -404,7 +404,7 @@ impl TriangleBvh {
             tests::NODE_VISITS.with(|v| v.set(v.get() + 1));
             let n = &self.nodes[node];
             let mut d2 = n.lower_bounds2(&query);
-            if BOUND {
+            if BOUND && d2.iter().any(|&d| f64::from(d) <= best.distance2) {
                 let o = n.oriented.lower_bounds2(&oriented_query, &n.min, &n.max);
                 for (d, o) in d2.iter_mut().zip(o) {
                     if o > *d {
