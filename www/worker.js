@@ -214,6 +214,9 @@ const handlers = {
     const completeness = e.completenessDistances();
     const clip = e.defaultClip();
     const colors = e.colors(clip);
+    // sorted here (in the core's threads), not on the page's UI thread: 10M points took seconds
+    const sortedKept = e.sortedKeptDistances();
+    const sortedComp = e.sortedCompletenessDistances();
     const sampleLabels = e.sampleLabels() ?? null;
     const samplePoints = sampleLabels ? e.completenessPointsF32() : null;
     const extra = sampleLabels ? [sampleLabels.buffer, samplePoints.buffer] : [];
@@ -221,10 +224,11 @@ const handlers = {
     const cameras = cameraData(recon, JSON.parse(reportJson));
     return {
       reply: {
-        reportJson, pointsInGt, distances, status, completeness, colors, clip,
+        reportJson, pointsInGt, distances, status, completeness, colors, clip, sortedKept, sortedComp,
         gtFromRecon: Array.from(e.gtFromRecon()), ms, sampleLabels, samplePoints, cameras,
       },
-      transfer: [pointsInGt.buffer, distances.buffer, status.buffer, completeness.buffer, colors.buffer, ...extra],
+      transfer: [pointsInGt.buffer, distances.buffer, status.buffer, completeness.buffer, colors.buffer,
+        sortedKept.buffer, sortedComp.buffer, ...extra],
     };
   },
   /**
@@ -254,10 +258,8 @@ const handlers = {
           images_registered: r.images, points: r.pointCount,
         });
         const row = JSON.parse(e.runRow(run));
-        const status = e.status();
-        const dist = e.distances();
-        const kept = Float64Array.from(dist.filter((_, i) => status[i] === 0)).sort();
-        const comp = Float64Array.from(e.completenessDistances()).sort();
+        const kept = e.sortedKeptDistances();
+        const comp = e.sortedCompletenessDistances();
         const pointsInGt = e.pointsInGtF32();
         const clip = e.defaultClip();
         const colors = e.colors(clip);

@@ -53,6 +53,18 @@ check('npm-progress', progressCalls > 0);
 const n = r.report.inputs.reconstruction.points;
 check('npm-arrays', r.distances().length === n && r.status().length === n && r.colors().length === 3 * n && r.pointsInGt().length === 3 * n);
 check('npm-colored-ply', Buffer.from(r.coloredPly().slice(0, 4)).toString() === 'ply\n');
+// the sorted distances (sorted in the core) are a plain sort of the kept and the completeness
+// distances, and count the report's precision and recall at every τ
+{
+  const st = r.status(), d = r.distances();
+  const kept = Float64Array.from(d.filter((_, i) => st[i] === 0)).sort();
+  const comp = Float64Array.from(r.completenessDistances()).sort();
+  const sk = r.sortedKeptDistances(), sc = r.sortedCompletenessDistances();
+  const below = (xs, t) => xs.filter((x) => x < t).length;
+  const atTau = r.report.thresholds.every((t) => below(sk, t.tau) / sk.length === t.precision && below(sc, t.tau) / sc.length === t.recall);
+  check('npm-sorted-distances', sk.length === kept.length && sk.every((x, i) => Object.is(x, kept[i]))
+    && sc.length === comp.length && sc.every((x, i) => Object.is(x, comp[i])) && atTau, JSON.stringify({ kept: sk.length, comp: sc.length, atTau }));
+}
 check('npm-csv', r.csv().startsWith('index,x,y,z,distance,signed_distance,status\n'));
 // the runner's table through the package: a run's row from run.json + this evaluation, a failed
 // run's row, and the tables' text

@@ -99,6 +99,10 @@ export interface EvaluationResult {
   status(): Uint8Array;
   /** Distances of the completeness samples to the kept points. */
   completenessDistances(): Float64Array;
+  /** The kept points' distances, ascending (NaN last): precision at any τ by a binary search. */
+  sortedKeptDistances(): Float64Array;
+  /** The completeness distances, ascending (NaN last). */
+  sortedCompletenessDistances(): Float64Array;
   /** The completeness samples themselves, `x0, y0, z0, ...` as 32-bit floats (WebGL). */
   completenessPointsF32(): Float32Array;
   /** Per completeness sample: 0 covered, 1 missed, 2 unseen (with depth maps only). */

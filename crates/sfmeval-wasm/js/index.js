@@ -161,6 +161,8 @@ function wrap(e) {
     signedDistances: () => e.signedDistances(),
     status: () => e.status(),
     completenessDistances: () => e.completenessDistances(),
+    sortedKeptDistances: () => e.sortedKeptDistances(),
+    sortedCompletenessDistances: () => e.sortedCompletenessDistances(),
     completenessPointsF32: () => e.completenessPointsF32(),
     sampleLabels: () => e.sampleLabels(),
     trackErrors: () => e.trackErrors(),

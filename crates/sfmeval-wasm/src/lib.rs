@@ -568,6 +568,19 @@ impl Evaluation {
         Float64Array::from(self.inner.completeness_distances.as_slice())
     }
 
+    /// The kept points' distances, ascending (NaN last), sorted in the core: what the page's
+    /// precision curve and τ slider read.
+    #[wasm_bindgen(js_name = sortedKeptDistances)]
+    pub fn sorted_kept_distances(&self) -> Float64Array {
+        Float64Array::from(self.inner.sorted_kept_distances().as_slice())
+    }
+
+    /// The completeness distances, ascending (NaN last).
+    #[wasm_bindgen(js_name = sortedCompletenessDistances)]
+    pub fn sorted_completeness_distances(&self) -> Float64Array {
+        Float64Array::from(self.inner.sorted_completeness_distances().as_slice())
+    }
+
     /// Heat-map colours (`r0, g0, b0, ...`, viridis) of every point, saturating at `clip`
     /// (the colours of the coloured PLY).
     pub fn colors(&self, clip: f64) -> Uint8Array {

@@ -236,6 +236,28 @@ impl Evaluation {
         })
     }
 
+    /// The kept points' distances, ascending (NaN last): what curves of precision against τ
+    /// read (the page sorts them here, in the core's threads, not on its UI thread).
+    pub fn sorted_kept_distances(&self) -> Vec<f64> {
+        let mut kept: Vec<f64> = self
+            .distances
+            .iter()
+            .zip(&self.status)
+            .filter(|(_, s)| **s == PointStatus::Kept)
+            .map(|(&d, _)| d)
+            .collect();
+        parallel::sort_floats(&mut kept);
+        kept
+    }
+
+    /// The completeness distances, ascending (NaN last, for a sample the search found no
+    /// point for).
+    pub fn sorted_completeness_distances(&self) -> Vec<f64> {
+        let mut d = self.completeness_distances.clone();
+        parallel::sort_floats(&mut d);
+        d
+    }
+
     /// The inverse of `slot_input`: the slot of every input point.
     fn slot_of_input(&self) -> Vec<u32> {
         let mut slot_of = vec![0u32; self.slot_input.len()];
@@ -664,6 +686,17 @@ mod tests {
             }
         }
         assert!(!kept.is_empty() && kept.len() < in_gt.len());
+        // The sorted lists the page's curves read: the kept distances and every completeness
+        // distance, as a plain sort of them.
+        let mut want: Vec<f64> = (0..in_gt.len())
+            .filter(|&i| a.status[i] == PointStatus::Kept)
+            .map(|i| a.distances[i])
+            .collect();
+        want.sort_by(|x, y| x.partial_cmp(y).unwrap());
+        assert_eq!(a.sorted_kept_distances(), want);
+        let mut want = a.completeness_distances.clone();
+        want.sort_by(|x, y| x.partial_cmp(y).unwrap());
+        assert_eq!(a.sorted_completeness_distances(), want);
         for (q, d) in a.completeness_points.iter().zip(&a.completeness_distances) {
             let brute = kept
                 .iter()

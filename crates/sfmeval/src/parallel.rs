@@ -148,6 +148,21 @@ pub(crate) fn sort_unstable_by_key<T: Send, K: Ord>(
     slice.sort_unstable_by_key(key);
 }
 
+/// Sorts numbers ascending with NaN last (the order of JavaScript's typed-array sort), in
+/// parallel where threads are available. Every NaN becomes the positive quiet NaN.
+pub(crate) fn sort_floats(values: &mut [f64]) {
+    for v in values.iter_mut().filter(|v| v.is_nan()) {
+        *v = f64::NAN;
+    }
+    #[cfg(feature = "parallel")]
+    {
+        use rayon::prelude::*;
+        values.par_sort_unstable_by(f64::total_cmp);
+    }
+    #[cfg(not(feature = "parallel"))]
+    values.sort_unstable_by(f64::total_cmp);
+}
+
 /// Runs `a` and `b`, in parallel where threads are available.
 #[cfg(feature = "parallel")]
 pub(crate) fn join<RA: Send, RB: Send>(
@@ -337,6 +352,31 @@ mod tests {
                 }
             })
             .collect()
+    }
+
+    /// Ascending, NaN (of either sign) last, -0 before +0, across many chunks.
+    #[test]
+    fn floats_sort_as_javascript_sorts_typed_arrays() {
+        let mut v: Vec<f64> = (0..100_000u64)
+            .map(|i| ((i.wrapping_mul(0x9e37_79b9_7f4a_7c15) >> 40) as f64) * 1e-3 - 100.0)
+            .collect();
+        v[7] = f64::NAN;
+        v[70] = -f64::NAN;
+        v[700] = f64::INFINITY;
+        v[7000] = 0.0;
+        v[7001] = -0.0;
+        let mut want: Vec<f64> = v.iter().copied().filter(|x| !x.is_nan()).collect();
+        want.sort_by(|a, b| a.partial_cmp(b).unwrap());
+        sort_floats(&mut v);
+        assert_eq!(v.len(), want.len() + 2);
+        assert!(
+            v[want.len()..]
+                .iter()
+                .all(|x| x.is_nan() && x.is_sign_positive())
+        );
+        assert_eq!(&v[..want.len()], &want[..]);
+        let zero = v.iter().position(|&x| x == 0.0).unwrap();
+        assert!(v[zero].is_sign_negative() && v[zero + 1].is_sign_positive());
     }
 
     #[test]
