@@ -307,6 +307,7 @@ async function loadRecon(fileList, name) {
     state.shown = null;
     viewer.setCoverage(null);
     viewer.clearPoints();
+    $('drawn-note').textContent = '';
     state.pairs = [];
     updatePairs();
     inputFailed('recon', e);
@@ -506,15 +507,24 @@ function displayedPositions() {
   return out;
 }
 
+/** 2 → "2nd", 3 → "3rd", 11 → "11th", 21 → "21st". */
+function ordinal(k) {
+  const teen = k % 100 >= 11 && k % 100 <= 13;
+  return `${k}${teen ? 'th' : ({ 1: 'st', 2: 'nd', 3: 'rd' }[k % 10] ?? 'th')}`;
+}
+
 function refreshPoints() {
   const pos = displayedPositions();
   if (!pos) return;
-  const f32 = new Float32Array(pos);
   let colors = null;
   const useHeat = state.result && !document.body.dataset.stale && $('heat').checked && viewMode() === 'after' && !state.picking;
   if (useHeat) colors = state.result.colors;
   else if (state.recon.colors) colors = state.recon.colors;
-  viewer.setPoints(f32, colors);
+  viewer.setPoints(pos, colors);
+  const { count, total, stride } = viewer.drawn;
+  $('drawn-note').textContent = stride > 1
+    ? `drawn: every ${ordinal(stride)} point (${count.toLocaleString('en')} of ${total.toLocaleString('en')}; all are measured)`
+    : '';
   viewer.setVisible('recon', $('show-recon').checked);
   state.shown = pos;
   drawMarkers();
@@ -896,11 +906,8 @@ function showResults(r) {
   $('summary').innerHTML = h;
   showStages(rep);
   for (const b of ['dl-report', 'dl-ply', 'dl-csv']) $(b).disabled = false;
-  // sorted distances for the curves and the τ slider
-  const kept = [];
-  for (let k = 0; k < r.distances.length; k++) if (r.status[k] === 0) kept.push(r.distances[k]);
-  r.sortedKept = Float64Array.from(kept).sort();
-  r.sortedComp = Float64Array.from(r.completeness.filter(Number.isFinite)).sort();
+  // the curves and the τ slider read the sorted distances (sorted by the worker; a NaN
+  // completeness distance, last, is never below τ and counts as missed)
   r.compTotal = r.completeness.length;
   r.tauMax = Math.max(rep.accuracy.percentiles.p95, rep.completeness.percentiles.p95, ...rep.thresholds.map((t) => t.tau)) * 1.5 || 1;
   histogramPlot($('hist'), rep.accuracy.histogram);

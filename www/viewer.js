@@ -5,6 +5,9 @@ import * as THREE from 'three';
 import { OrbitControls } from 'three/addons/controls/OrbitControls.js';
 import { TransformControls } from 'three/addons/controls/TransformControls.js';
 
+/** Most reconstruction points drawn; a denser cloud is drawn every k-th point. */
+export const MAX_DRAWN_POINTS = 2_000_000;
+
 export class Viewer {
   constructor(container) {
     this.container = container;
@@ -122,12 +125,31 @@ export class Viewer {
     this.orbit.update();
   }
 
-  /** Sets the points to show (Float32Array, GT frame) with RGB colours (Uint8Array or null). */
+  /**
+   * Sets the points to show (x, y, z in the GT frame: Float32Array or Float64Array) with RGB
+   * colours (Uint8Array or null). Past MAX_DRAWN_POINTS every k-th point is drawn (the fewest k
+   * that fit): uploading and drawing a dense cloud whole froze the page for about 0.8 s at 10M
+   * points (software WebGL) and shows nothing more on a canvas of a few million pixels. A pick
+   * still names the point's index in the whole cloud; `drawn` says what is on screen.
+   */
   setPoints(positions, colors) {
     if (this.points) { this.world.remove(this.points); this.points.geometry.dispose(); }
+    const total = positions.length / 3;
+    const stride = Math.max(1, Math.ceil(total / MAX_DRAWN_POINTS));
+    const count = Math.ceil(total / stride);
+    let xyz = positions, rgb = colors;
+    if (stride > 1 || !(positions instanceof Float32Array)) {
+      xyz = new Float32Array(3 * count);
+      rgb = colors ? new Uint8Array(3 * count) : null;
+      for (let j = 0, i = 0; j < count; j++, i += 3 * stride) {
+        xyz[3 * j] = positions[i]; xyz[3 * j + 1] = positions[i + 1]; xyz[3 * j + 2] = positions[i + 2];
+        if (rgb) { rgb[3 * j] = colors[i]; rgb[3 * j + 1] = colors[i + 1]; rgb[3 * j + 2] = colors[i + 2]; }
+      }
+    }
+    this.drawn = { count, total, stride };
     const g = new THREE.BufferGeometry();
-    g.setAttribute('position', new THREE.BufferAttribute(positions, 3));
-    if (colors) g.setAttribute('color', new THREE.BufferAttribute(colors, 3, true));
+    g.setAttribute('position', new THREE.BufferAttribute(xyz, 3));
+    if (rgb) g.setAttribute('color', new THREE.BufferAttribute(rgb, 3, true));
     const m = new THREE.PointsMaterial({
       size: this.pointSize, sizeAttenuation: false, vertexColors: !!colors, color: colors ? 0xffffff : 0xff7043,
     });
@@ -360,7 +382,7 @@ export class Viewer {
     if (!hits.length) return;
     const h = hits[0];
     const c = this.offset ?? [0, 0, 0];
-    if (h.object === this.points) this.onPick({ kind: 'recon', index: h.index });
+    if (h.object === this.points) this.onPick({ kind: 'recon', index: h.index * this.drawn.stride });
     else this.onPick({ kind: 'gt', point: [h.point.x + c[0], h.point.y + c[1], h.point.z + c[2]] });
   }
 
