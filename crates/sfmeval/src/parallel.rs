@@ -56,6 +56,31 @@ where
     }
 }
 
+/// Maps `f` over `0..n` cut into ranges of `size` (the last one shorter), keeping order: the
+/// cuts depend on `n` and `size` only, so partial sums made per range and added in order give
+/// the same bits for any thread count.
+pub(crate) fn map_fixed_ranges<R, F>(n: usize, size: usize, f: F) -> Vec<R>
+where
+    R: Send,
+    F: Fn(std::ops::Range<usize>) -> R + Sync + Send,
+{
+    let size = size.max(1);
+    let range = |j: usize| j * size..((j + 1) * size).min(n);
+    #[cfg(feature = "parallel")]
+    {
+        use rayon::prelude::*;
+        (0..n.div_ceil(size))
+            .into_par_iter()
+            .map(range)
+            .map(f)
+            .collect()
+    }
+    #[cfg(not(feature = "parallel"))]
+    {
+        (0..n.div_ceil(size)).map(range).map(f).collect()
+    }
+}
+
 /// Maps `f` over `0..n`, keeping order (no progress).
 pub(crate) fn map_range<R, F>(n: usize, f: F) -> Vec<R>
 where

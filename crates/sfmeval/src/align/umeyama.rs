@@ -112,9 +112,130 @@ pub(crate) fn umeyama_weighted(
         cov_s += w(i) * a * a.transpose();
         var_s += w(i) * a.norm_squared();
     }
-    sigma /= total;
-    cov_s /= total;
-    var_s /= total;
+    solve(
+        &Moments {
+            mu_s,
+            mu_d,
+            ks,
+            kd,
+            sigma: sigma / total,
+            cov_s: cov_s / total,
+            var_s: var_s / total,
+        },
+        with_scale,
+    )
+}
+
+/// What the closed form needs of the pairs: the means, the spreads the centred points were
+/// divided by (1 unless extreme), and the cross-covariance, covariance and variance of the
+/// centred, divided points (averaged).
+#[derive(Clone, Copy)]
+struct Moments {
+    mu_s: Vector3<f64>,
+    mu_d: Vector3<f64>,
+    ks: f64,
+    kd: f64,
+    sigma: Matrix3<f64>,
+    cov_s: Matrix3<f64>,
+    var_s: f64,
+}
+
+/// Pairs per partial sum of [`umeyama_pairs`].
+const PAIRS_PER_SUM: usize = 4096;
+
+/// [`umeyama`] (with scale) of `n` pairs `(src(i), dst(i))`, read in place and summed in
+/// parallel: partial sums over fixed runs of [`PAIRS_PER_SUM`] pairs, added in run order, so
+/// the result does not depend on the thread count (its last bits differ from [`umeyama`]'s,
+/// which adds the pairs one by one). For ICP's fits over a million matches.
+pub(crate) fn umeyama_pairs(
+    n: usize,
+    src: impl Fn(usize) -> Point3 + Sync,
+    dst: impl Fn(usize) -> Point3 + Sync,
+) -> Result<Similarity> {
+    if n < 3 {
+        return Err(Error::InvalidOption(format!(
+            "a similarity needs at least 3 point pairs, got {n}"
+        )));
+    }
+    let sums = crate::parallel::map_fixed_ranges(n, PAIRS_PER_SUM, |r| {
+        let (mut s, mut d) = (Vector3::zeros(), Vector3::zeros());
+        for i in r {
+            s += to_v(src(i));
+            d += to_v(dst(i));
+        }
+        (s, d)
+    });
+    let (mut mu_s, mut mu_d) = (Vector3::<f64>::zeros(), Vector3::<f64>::zeros());
+    for (s, d) in sums {
+        mu_s += s;
+        mu_d += d;
+    }
+    let total = n as f64;
+    mu_s /= total;
+    mu_d /= total;
+    // The spreads (largest deviation from the mean) come with the unscaled sums; in the rare
+    // case that one leaves [1e-100, 1e100] the sums are made again on divided points.
+    let centred = |ks: f64, kd: f64| {
+        let parts = crate::parallel::map_fixed_ranges(n, PAIRS_PER_SUM, |r| {
+            let (mut sigma, mut cov_s, mut var_s) = (Matrix3::zeros(), Matrix3::zeros(), 0.0);
+            let (mut ms, mut md) = (0.0f64, 0.0f64);
+            for i in r {
+                let a = to_v(src(i)) - mu_s;
+                let b = to_v(dst(i)) - mu_d;
+                ms = ms.max(a.amax());
+                md = md.max(b.amax());
+                let (a, b) = (a / ks, b / kd);
+                sigma += b * a.transpose();
+                cov_s += a * a.transpose();
+                var_s += a.norm_squared();
+            }
+            (sigma, cov_s, var_s, ms, md)
+        });
+        let (mut sigma, mut cov_s, mut var_s) = (Matrix3::zeros(), Matrix3::zeros(), 0.0);
+        let (mut ms, mut md) = (0.0f64, 0.0f64);
+        for (s, c, v, a, b) in parts {
+            sigma += s;
+            cov_s += c;
+            var_s += v;
+            ms = ms.max(a);
+            md = md.max(b);
+        }
+        (sigma, cov_s, var_s, ms, md)
+    };
+    let extreme = |m: f64| m > 0.0 && !(1e-100..=1e100).contains(&m);
+    let (mut sigma, mut cov_s, mut var_s, ms, md) = centred(1.0, 1.0);
+    let (ks, kd) = (
+        if extreme(ms) { ms } else { 1.0 },
+        if extreme(md) { md } else { 1.0 },
+    );
+    if ks != 1.0 || kd != 1.0 {
+        (sigma, cov_s, var_s, _, _) = centred(ks, kd);
+    }
+    solve(
+        &Moments {
+            mu_s,
+            mu_d,
+            ks,
+            kd,
+            sigma: sigma / total,
+            cov_s: cov_s / total,
+            var_s: var_s / total,
+        },
+        true,
+    )
+}
+
+/// The similarity from the pairs' moments (Umeyama's closed form with the reflection fix).
+fn solve(m: &Moments, with_scale: bool) -> Result<Similarity> {
+    let Moments {
+        mu_s,
+        mu_d,
+        ks,
+        kd,
+        sigma,
+        cov_s,
+        var_s,
+    } = *m;
     let (l, _) = super::sorted_eigen(&cov_s);
     if !(l[0] > 0.0) {
         return Err(Error::Geometry(
@@ -226,5 +347,63 @@ mod tests {
         // Weighted: zero weights drop pairs.
         assert!(umeyama_weighted(&tri, &tri, Some(&[1.0, 1.0, 0.0]), true).is_err());
         assert!(umeyama_weighted(&tri, &tri, Some(&[1.0, 1.0, -1.0]), true).is_err());
+    }
+
+    /// The parallel sums give the one-by-one fit to rounding, across several runs of
+    /// `PAIRS_PER_SUM`, at ordinary and at extreme spreads (where both divide by the spread),
+    /// and the same bits on one thread as on several; degenerate pairs are errors as in
+    /// `umeyama`.
+    #[test]
+    fn pairs_in_parallel_equal_the_one_by_one_fit() {
+        let n = 3 * PAIRS_PER_SUM + 17;
+        for spread in [1.0, 1e-120, 1e120] {
+            let truth = Similarity::from_parts(
+                1.7,
+                rot([1.0, 2.0, -0.5], 31.0),
+                [0.4, -3.0, 2.0].map(|v| v * spread),
+            );
+            let src: Vec<Point3> = (0..n)
+                .map(|i| {
+                    let f = i as f64;
+                    [
+                        (f * 0.37).sin(),
+                        (f * 0.11).cos() * 0.5,
+                        (f * 0.07).sin() * 0.2,
+                    ]
+                    .map(|v| v * spread + 5.0 * spread)
+                })
+                .collect();
+            let dst: Vec<Point3> = src
+                .iter()
+                .enumerate()
+                .map(|(i, p)| {
+                    let q = truth.apply(*p);
+                    let e = 1e-3 * spread * ((i as f64) * 0.9).sin();
+                    [q[0] + e, q[1] - e, q[2] + 0.5 * e]
+                })
+                .collect();
+            let one = umeyama(&src, &dst, true).unwrap();
+            let par = umeyama_pairs(n, |i| src[i], |i| dst[i]).unwrap();
+            for r in 0..3 {
+                for c in 0..4 {
+                    // Rotation and scale entries are O(1), translations O(spread).
+                    let size = if c == 3 { 10.0 * spread } else { 1.0 };
+                    let (a, b) = (one.matrix[r][c], par.matrix[r][c]);
+                    assert!((a - b).abs() <= 1e-12 * size, "{spread}: {a} vs {b}");
+                }
+            }
+            #[cfg(feature = "parallel")]
+            {
+                let single = rayon::ThreadPoolBuilder::new()
+                    .num_threads(1)
+                    .build()
+                    .unwrap();
+                let alone = single.install(|| umeyama_pairs(n, |i| src[i], |i| dst[i]).unwrap());
+                assert_eq!(alone.matrix, par.matrix);
+            }
+        }
+        let line: Vec<Point3> = (0..10).map(|i| [f64::from(i); 3]).collect();
+        assert!(umeyama_pairs(10, |i| line[i], |i| line[i]).is_err());
+        assert!(umeyama_pairs(2, |i| line[i], |i| line[i]).is_err());
     }
 }

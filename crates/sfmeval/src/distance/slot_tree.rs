@@ -111,7 +111,8 @@ impl NodeBox {
 
 /// The boxes of a k-d tree over storage in [`kd_order`]: node `i` (heap layout, children
 /// `2i + 1` and `2i + 2`) covers a range of slots that halves at every level; the leaves are
-/// the nodes of the last level. Only live points (a predicate on the slot) count.
+/// the nodes of the last level. Only live points (a predicate on the slot) count. Slots are
+/// `u32`, as [`kd_order`]'s.
 pub(crate) struct SlotTree {
     boxes: Vec<NodeBox>,
     depth: u32,
@@ -126,6 +127,7 @@ impl SlotTree {
         point: impl Fn(usize) -> Point3 + Sync,
         live: impl Fn(usize) -> bool + Sync,
     ) -> SlotTree {
+        debug_assert!(u32::try_from(n).is_ok());
         let depth = depth_for(n);
         let leaves = 1usize << depth;
         let first_leaf = leaves - 1;
@@ -213,18 +215,21 @@ impl SlotTree {
     fn walk(&self, q: Point3, bound: f64, mut leaf: impl FnMut(usize, usize) -> f64) {
         let mut bound = bound;
         // Each level pushes two entries and pops one, so the stack never holds more than
-        // `depth + 2` (`depth` < 64 for any `usize` count).
-        // (node, first slot, end slot, level, box distance)
-        let mut stack = [(0usize, 0usize, 0usize, 0u32, 0f64); 66];
+        // `depth + 2` entries (`depth` ≤ 27: slots are `u32`, leaves hold up to 32). An entry
+        // is (node, first slot, end slot, box distance): 24 bytes, so the stack zeroed at
+        // every query is small.
+        let first_leaf = (1usize << self.depth) - 1;
+        let mut stack = [(0u32, 0u32, 0u32, 0f64); 30];
         let mut top = 1;
-        stack[0] = (0, 0, self.n, 0, self.boxes[0].distance2(&q));
+        stack[0] = (0, 0, self.n as u32, self.boxes[0].distance2(&q));
         while top > 0 {
             top -= 1;
-            let (node, s, e, level, d) = stack[top];
+            let (node, s, e, d) = stack[top];
             if d >= bound {
                 continue;
             }
-            if level == self.depth {
+            let (node, s, e) = (node as usize, s as usize, e as usize);
+            if node >= first_leaf {
                 bound = leaf(s, e);
                 continue;
             }
@@ -238,11 +243,11 @@ impl SlotTree {
                 ((r, m, e, dr), (l, s, m, dl))
             };
             if far.3 < bound {
-                stack[top] = (far.0, far.1, far.2, level + 1, far.3);
+                stack[top] = (far.0 as u32, far.1 as u32, far.2 as u32, far.3);
                 top += 1;
             }
             if near.3 < bound {
-                stack[top] = (near.0, near.1, near.2, level + 1, near.3);
+                stack[top] = (near.0 as u32, near.1 as u32, near.2 as u32, near.3);
                 top += 1;
             }
         }

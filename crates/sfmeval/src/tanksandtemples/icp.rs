@@ -15,7 +15,7 @@
 //! iteration counts are those of a plain nearest-neighbour query.
 
 use super::matrix::{self, IDENTITY, Matrix4};
-use crate::align::umeyama;
+use crate::align::{umeyama, umeyama_pairs};
 use crate::distance::kd_cloud::{KdCloud, NO_POINT, distance2};
 use crate::distance::neighbour_list::NeighbourList;
 use crate::geometry::Point3;
@@ -161,7 +161,7 @@ pub fn registration_icp(
     let mut current = matches(&moved, target, limit, &mut queries);
     let mut iterations = 0;
     while iterations < criteria.max_iterations {
-        let update = fit(|k| moved[k], |j| target.point(j), &current.pairs);
+        let update = fit_pairs(&moved, target, &current.pairs);
         transformation = matrix::mul(&update, &transformation);
         parallel::map_mut(&mut moved, |_, p| *p = matrix::apply(&update, *p));
         iterations += 1;
@@ -181,8 +181,20 @@ pub fn registration_icp(
     }
 }
 
-/// The scaled Umeyama fit of the matches; the identity without matches or when they are
-/// degenerate (Open3D returns the identity for no matches).
+/// The scaled Umeyama fit of ICP's matches `(moved point, target slot)`, summed in parallel;
+/// the identity without matches or when they are degenerate (Open3D returns the identity for
+/// no matches).
+fn fit_pairs(moved: &[Point3], target: &KdCloud, pairs: &[(u32, u32)]) -> Matrix4 {
+    umeyama_pairs(
+        pairs.len(),
+        |k| moved[pairs[k].0 as usize],
+        |k| target.point(pairs[k].1 as usize),
+    )
+    .map_or(IDENTITY, |s| s.matrix)
+}
+
+/// The scaled Umeyama fit of a few pairs (the trajectory alignment's samples); the identity
+/// when they are degenerate.
 pub(crate) fn fit(
     source: impl Fn(usize) -> Point3,
     target: impl Fn(usize) -> Point3,
