@@ -102,42 +102,42 @@ pub(crate) fn umeyama_weighted(
         }
     };
     let (ks, kd) = (spread(src, &mu_s), spread(dst, &mu_d));
-    let mut sigma = Matrix3::zeros();
-    let mut cov_s = Matrix3::zeros();
-    let mut var_s = 0.0;
+    let mut sums = CentredSums::ZERO;
     for i in 0..src.len() {
         let a = (to_v(src[i]) - mu_s) / ks;
         let b = (to_v(dst[i]) - mu_d) / kd;
-        sigma += w(i) * b * a.transpose();
-        cov_s += w(i) * a * a.transpose();
-        var_s += w(i) * a.norm_squared();
+        sums.add(w(i), &a, &b);
     }
-    solve(
-        &Moments {
-            mu_s,
-            mu_d,
-            ks,
-            kd,
-            sigma: sigma / total,
-            cov_s: cov_s / total,
-            var_s: var_s / total,
-        },
-        with_scale,
-    )
+    solve((mu_s, mu_d), (ks, kd), &sums, total, with_scale)
 }
 
-/// What the closed form needs of the pairs: the means, the spreads the centred points were
-/// divided by (1 unless extreme), and the cross-covariance, covariance and variance of the
-/// centred, divided points (averaged).
+/// The sums the closed form needs over the centred points `a` (source) and `b` (target),
+/// each divided by its spread: Σ w·b·aᵀ, Σ w·a·aᵀ and Σ w·|a|².
 #[derive(Clone, Copy)]
-struct Moments {
-    mu_s: Vector3<f64>,
-    mu_d: Vector3<f64>,
-    ks: f64,
-    kd: f64,
+struct CentredSums {
     sigma: Matrix3<f64>,
     cov_s: Matrix3<f64>,
     var_s: f64,
+}
+
+impl CentredSums {
+    const ZERO: CentredSums = CentredSums {
+        sigma: Matrix3::new(0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0),
+        cov_s: Matrix3::new(0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0),
+        var_s: 0.0,
+    };
+
+    fn add(&mut self, w: f64, a: &Vector3<f64>, b: &Vector3<f64>) {
+        self.sigma += w * b * a.transpose();
+        self.cov_s += w * a * a.transpose();
+        self.var_s += w * a.norm_squared();
+    }
+
+    fn merge(&mut self, other: &CentredSums) {
+        self.sigma += other.sigma;
+        self.cov_s += other.cov_s;
+        self.var_s += other.var_s;
+    }
 }
 
 /// Pairs per partial sum of [`umeyama_pairs`].
@@ -157,7 +157,7 @@ pub(crate) fn umeyama_pairs(
             "a similarity needs at least 3 point pairs, got {n}"
         )));
     }
-    let sums = crate::parallel::map_fixed_ranges(n, PAIRS_PER_SUM, |r| {
+    let parts = crate::parallel::map_fixed_ranges(n, PAIRS_PER_SUM, |r| {
         let (mut s, mut d) = (Vector3::zeros(), Vector3::zeros());
         for i in r {
             s += to_v(src(i));
@@ -166,76 +166,62 @@ pub(crate) fn umeyama_pairs(
         (s, d)
     });
     let (mut mu_s, mut mu_d) = (Vector3::<f64>::zeros(), Vector3::<f64>::zeros());
-    for (s, d) in sums {
+    for (s, d) in parts {
         mu_s += s;
         mu_d += d;
     }
     let total = n as f64;
     mu_s /= total;
     mu_d /= total;
-    // The spreads (largest deviation from the mean) come with the unscaled sums; in the rare
+    // The spreads (largest deviation from the mean) come with the undivided sums; in the rare
     // case that one leaves [1e-100, 1e100] the sums are made again on divided points.
     let centred = |ks: f64, kd: f64| {
         let parts = crate::parallel::map_fixed_ranges(n, PAIRS_PER_SUM, |r| {
-            let (mut sigma, mut cov_s, mut var_s) = (Matrix3::zeros(), Matrix3::zeros(), 0.0);
+            let mut sums = CentredSums::ZERO;
             let (mut ms, mut md) = (0.0f64, 0.0f64);
             for i in r {
                 let a = to_v(src(i)) - mu_s;
                 let b = to_v(dst(i)) - mu_d;
                 ms = ms.max(a.amax());
                 md = md.max(b.amax());
-                let (a, b) = (a / ks, b / kd);
-                sigma += b * a.transpose();
-                cov_s += a * a.transpose();
-                var_s += a.norm_squared();
+                sums.add(1.0, &(a / ks), &(b / kd));
             }
-            (sigma, cov_s, var_s, ms, md)
+            (sums, ms, md)
         });
-        let (mut sigma, mut cov_s, mut var_s) = (Matrix3::zeros(), Matrix3::zeros(), 0.0);
+        let mut sums = CentredSums::ZERO;
         let (mut ms, mut md) = (0.0f64, 0.0f64);
-        for (s, c, v, a, b) in parts {
-            sigma += s;
-            cov_s += c;
-            var_s += v;
-            ms = ms.max(a);
-            md = md.max(b);
+        for (part, a, b) in &parts {
+            sums.merge(part);
+            ms = ms.max(*a);
+            md = md.max(*b);
         }
-        (sigma, cov_s, var_s, ms, md)
+        (sums, ms, md)
     };
     let extreme = |m: f64| m > 0.0 && !(1e-100..=1e100).contains(&m);
-    let (mut sigma, mut cov_s, mut var_s, ms, md) = centred(1.0, 1.0);
+    let (mut sums, ms, md) = centred(1.0, 1.0);
     let (ks, kd) = (
         if extreme(ms) { ms } else { 1.0 },
         if extreme(md) { md } else { 1.0 },
     );
     if ks != 1.0 || kd != 1.0 {
-        (sigma, cov_s, var_s, _, _) = centred(ks, kd);
+        sums = centred(ks, kd).0;
     }
-    solve(
-        &Moments {
-            mu_s,
-            mu_d,
-            ks,
-            kd,
-            sigma: sigma / total,
-            cov_s: cov_s / total,
-            var_s: var_s / total,
-        },
-        true,
-    )
+    solve((mu_s, mu_d), (ks, kd), &sums, total, true)
 }
 
-/// The similarity from the pairs' moments (Umeyama's closed form with the reflection fix).
-fn solve(m: &Moments, with_scale: bool) -> Result<Similarity> {
-    let Moments {
-        mu_s,
-        mu_d,
-        ks,
-        kd,
-        sigma,
-        cov_s,
-        var_s,
-    } = *m;
+/// Umeyama's closed form with the reflection fix, from the means, the spreads the centred
+/// points were divided by (1 unless extreme), the sums over the centred, divided points and
+/// the total weight.
+fn solve(
+    (mu_s, mu_d): (Vector3<f64>, Vector3<f64>),
+    (ks, kd): (f64, f64),
+    sums: &CentredSums,
+    total: f64,
+    with_scale: bool,
+) -> Result<Similarity> {
+    let sigma = sums.sigma / total;
+    let cov_s = sums.cov_s / total;
+    let var_s = sums.var_s / total;
     let (l, _) = super::sorted_eigen(&cov_s);
     if !(l[0] > 0.0) {
         return Err(Error::Geometry(
