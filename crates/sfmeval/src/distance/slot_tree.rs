@@ -272,15 +272,22 @@ impl SlotTree {
         const { assert!(K > 0) };
         let mut count = 0;
         let mut bound = radius2;
+        // A leaf's points nearer than the bound, gathered without a branch a point (the test
+        // would mispredict often: a few points of a leaf pass it), then inserted in slot order,
+        // each against the bound as it stands then: the same list as inserting while scanning.
+        let mut below = [(0.0f64, 0u32); LEAF_SIZE];
         self.walk(q, radius2, |s, e| {
+            let mut found = 0;
+            // (a leaf holds at most LEAF_SIZE slots)
             for k in s..e {
-                if !live(k) {
-                    continue;
-                }
                 let a = point(k);
                 let d2 = (a[0] - q[0]) * (a[0] - q[0])
                     + (a[1] - q[1]) * (a[1] - q[1])
                     + (a[2] - q[2]) * (a[2] - q[2]);
+                below[found] = (d2, k as u32);
+                found += usize::from(d2 < bound && live(k));
+            }
+            for &(d2, k) in &below[..found] {
                 if d2 < bound {
                     // Insert in distance order (after equal distances), dropping the
                     // farthest when full.
@@ -289,7 +296,7 @@ impl SlotTree {
                         out[j] = out[j - 1];
                         j -= 1;
                     }
-                    out[j] = (d2, k as u32);
+                    out[j] = (d2, k);
                     if count < K {
                         count += 1;
                     }
