@@ -91,15 +91,11 @@ pub(crate) fn umeyama_weighted(
     // underflow or overflow), work on the centred points divided by their largest deviation
     // and scale back at the end; otherwise divide by 1 (bit-identical to the plain formula).
     let spread = |pts: &[Point3], mu: &Vector3<f64>| {
-        let m = pts
-            .iter()
-            .map(|p| (to_v(*p) - mu).amax())
-            .fold(0.0f64, f64::max);
-        if m > 0.0 && !(1e-100..=1e100).contains(&m) {
-            m
-        } else {
-            1.0
-        }
+        divisor(
+            pts.iter()
+                .map(|p| (to_v(*p) - mu).amax())
+                .fold(0.0f64, f64::max),
+        )
     };
     let (ks, kd) = (spread(src, &mu_s), spread(dst, &mu_d));
     let mut sums = CentredSums::ZERO;
@@ -109,6 +105,18 @@ pub(crate) fn umeyama_weighted(
         sums.add(w(i), &a, &b);
     }
     solve((mu_s, mu_d), (ks, kd), &sums, total, with_scale)
+}
+
+/// What the centred points are divided by, from their largest deviation from the mean: the
+/// deviation itself when it leaves [1e-100, 1e100] (squares and sums of squares would underflow
+/// or overflow), else 1 (bit-identical to the plain formula).
+fn divisor(largest_deviation: f64) -> f64 {
+    let m = largest_deviation;
+    if m > 0.0 && !(1e-100..=1e100).contains(&m) {
+        m
+    } else {
+        1.0
+    }
 }
 
 /// The sums the closed form needs over the centred points `a` (source) and `b` (target),
@@ -197,12 +205,8 @@ pub(crate) fn umeyama_pairs(
         }
         (sums, ms, md)
     };
-    let extreme = |m: f64| m > 0.0 && !(1e-100..=1e100).contains(&m);
     let (mut sums, ms, md) = centred(1.0, 1.0);
-    let (ks, kd) = (
-        if extreme(ms) { ms } else { 1.0 },
-        if extreme(md) { md } else { 1.0 },
-    );
+    let (ks, kd) = (divisor(ms), divisor(md));
     if ks != 1.0 || kd != 1.0 {
         sums = centred(ks, kd).0;
     }

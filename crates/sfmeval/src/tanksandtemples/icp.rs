@@ -15,7 +15,7 @@
 //! iteration counts are those of a plain nearest-neighbour query.
 
 use super::matrix::{self, IDENTITY, Matrix4};
-use crate::align::{umeyama, umeyama_pairs};
+use crate::align::umeyama_pairs;
 use crate::distance::kd_cloud::{KdCloud, NO_POINT, distance2};
 use crate::distance::neighbour_list::NeighbourList;
 use crate::geometry::Point3;
@@ -191,21 +191,6 @@ fn fit_pairs(moved: &[Point3], target: &KdCloud, pairs: &[(u32, u32)]) -> Matrix
         |k| target.point(pairs[k].1 as usize),
     )
     .map_or(IDENTITY, |s| s.matrix)
-}
-
-/// The scaled Umeyama fit of a few pairs (the trajectory alignment's samples); the identity
-/// when they are degenerate.
-pub(crate) fn fit(
-    source: impl Fn(usize) -> Point3,
-    target: impl Fn(usize) -> Point3,
-    pairs: &[(u32, u32)],
-) -> Matrix4 {
-    if pairs.is_empty() {
-        return IDENTITY;
-    }
-    let src: Vec<Point3> = pairs.iter().map(|&(i, _)| source(i as usize)).collect();
-    let dst: Vec<Point3> = pairs.iter().map(|&(_, j)| target(j as usize)).collect();
-    umeyama(&src, &dst, true).map_or(IDENTITY, |s| s.matrix)
 }
 
 #[cfg(test)]

@@ -17,8 +17,8 @@ use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use serde::{Deserialize, Serialize};
 
-use super::icp::fit;
-use super::matrix::{self, Matrix4};
+use super::matrix::{self, IDENTITY, Matrix4};
+use crate::align::umeyama;
 use crate::distance::CloudIndex;
 use crate::error::{Error, Result};
 use crate::geometry::Point3;
@@ -150,6 +150,20 @@ pub fn align_trajectories(
         inlier_rmse,
         iterations: options.max_iterations,
     })
+}
+
+/// The scaled Umeyama fit of a sample's pairs; the identity when they are degenerate.
+fn fit(
+    source: impl Fn(usize) -> Point3,
+    target: impl Fn(usize) -> Point3,
+    pairs: &[(u32, u32)],
+) -> Matrix4 {
+    if pairs.is_empty() {
+        return IDENTITY;
+    }
+    let src: Vec<Point3> = pairs.iter().map(|&(i, _)| source(i as usize)).collect();
+    let dst: Vec<Point3> = pairs.iter().map(|&(_, j)| target(j as usize)).collect();
+    umeyama(&src, &dst, true).map_or(IDENTITY, |s| s.matrix)
 }
 
 #[cfg(test)]
