@@ -227,41 +227,38 @@ where
     }
 }
 
-/// [`map_mut`] where `f` also gets a state carried from one item to the next within a work
-/// unit of [`STATE_CHUNK`] items (each starts from `S::default()`), as in [`map_with_state`].
-/// The results go straight into one buffer (no per-unit vectors to copy).
-pub(crate) fn map_mut_with_state<T, R, S, F>(items: &mut [T], f: F) -> Vec<R>
+/// Runs `f(state, acc, k, &mut items[k])` over every item, in fixed runs of `size` items (in
+/// parallel where threads are available); each run starts from `S::default()` and `init()`,
+/// goes through its items in order, and its accumulator comes back in run order. The runs do
+/// not depend on the thread count, so neither does any reduction of the accumulators in order.
+pub(crate) fn fold_runs_mut<T, S, A, I, F>(items: &mut [T], size: usize, init: I, f: F) -> Vec<A>
 where
     T: Send,
-    R: Send + Clone + Default,
+    A: Send,
     S: Default,
-    F: Fn(&mut S, usize, &mut T) -> R + Sync + Send,
+    I: Fn() -> A + Sync + Send,
+    F: Fn(&mut S, &mut A, usize, &mut T) + Sync + Send,
 {
-    let mut out = vec![R::default(); items.len()];
-    let unit = |(c, (unit, out)): (usize, (&mut [T], &mut [R]))| {
-        let mut state = S::default();
-        let first = c * STATE_CHUNK;
-        for (j, (t, r)) in unit.iter_mut().zip(out.iter_mut()).enumerate() {
-            *r = f(&mut state, first + j, t);
+    let size = size.max(1);
+    let run = |(c, run): (usize, &mut [T])| {
+        let (mut state, mut acc) = (S::default(), init());
+        for (j, t) in run.iter_mut().enumerate() {
+            f(&mut state, &mut acc, c * size + j, t);
         }
+        acc
     };
     #[cfg(feature = "parallel")]
     {
         use rayon::prelude::*;
         items
-            .par_chunks_mut(STATE_CHUNK)
-            .zip(out.par_chunks_mut(STATE_CHUNK))
+            .par_chunks_mut(size)
             .enumerate()
             .with_max_len(1)
-            .for_each(unit);
+            .map(run)
+            .collect()
     }
     #[cfg(not(feature = "parallel"))]
-    items
-        .chunks_mut(STATE_CHUNK)
-        .zip(out.chunks_mut(STATE_CHUNK))
-        .enumerate()
-        .for_each(unit);
-    out
+    items.chunks_mut(size).enumerate().map(run).collect()
 }
 
 /// Indices per work unit of [`map_range_with_state`]: closest-point queries in tree order take

@@ -213,6 +213,134 @@ pub(crate) fn umeyama_pairs(
     solve((mu_s, mu_d), (ks, kd), &sums, total, true)
 }
 
+/// The sums for a scaled Umeyama fit gathered in one pass over the pairs, for a fit whose pairs
+/// are found on the fly (ICP's matches) and never stored: each side is taken relative to a
+/// shift near its points (for ICP the moved cloud's centroid, for both sides), and the centred
+/// sums follow from `Σ(b−μ_b)(a−μ_a)ᵀ = Σ b·aᵀ − n·μ_b·μ_aᵀ`. With each shift within a few
+/// spreads of its points, the cancellation costs a digit or two against [`umeyama_pairs`]' two
+/// passes. Partial sums over fixed runs
+/// merged in run order give the same bits for any thread count.
+#[derive(Clone, Copy)]
+pub(crate) struct PairSums {
+    shift_src: [f64; 3],
+    shift_dst: [f64; 3],
+    n: u64,
+    /// Σ a, Σ b (a = source − shift_src, b = target − shift_dst).
+    sum_a: [f64; 3],
+    sum_b: [f64; 3],
+    /// Σ b·aᵀ, row-major.
+    ba: [[f64; 3]; 3],
+    /// Σ a·aᵀ on and above the diagonal: 00, 01, 02, 11, 12, 22.
+    aa: [f64; 6],
+    /// Σ |b|².
+    bb: f64,
+}
+
+impl PairSums {
+    /// No pairs yet, each side relative to its shift.
+    pub(crate) fn new(shift_src: Point3, shift_dst: Point3) -> PairSums {
+        PairSums {
+            shift_src,
+            shift_dst,
+            n: 0,
+            sum_a: [0.0; 3],
+            sum_b: [0.0; 3],
+            ba: [[0.0; 3]; 3],
+            aa: [0.0; 6],
+            bb: 0.0,
+        }
+    }
+
+    /// Adds the pair (`src`, `dst`).
+    #[inline]
+    pub(crate) fn add(&mut self, src: Point3, dst: Point3) {
+        let a = [0, 1, 2].map(|k| src[k] - self.shift_src[k]);
+        let b = [0, 1, 2].map(|k| dst[k] - self.shift_dst[k]);
+        self.n += 1;
+        for k in 0..3 {
+            self.sum_a[k] += a[k];
+            self.sum_b[k] += b[k];
+        }
+        for (row, bi) in self.ba.iter_mut().zip(b) {
+            for (s, aj) in row.iter_mut().zip(a) {
+                *s += bi * aj;
+            }
+        }
+        let c = &mut self.aa;
+        c[0] += a[0] * a[0];
+        c[1] += a[0] * a[1];
+        c[2] += a[0] * a[2];
+        c[3] += a[1] * a[1];
+        c[4] += a[1] * a[2];
+        c[5] += a[2] * a[2];
+        self.bb += b[0] * b[0] + b[1] * b[1] + b[2] * b[2];
+    }
+
+    /// Adds the pairs summed in `other` (same shifts).
+    pub(crate) fn merge(&mut self, other: &PairSums) {
+        self.n += other.n;
+        for k in 0..3 {
+            self.sum_a[k] += other.sum_a[k];
+            self.sum_b[k] += other.sum_b[k];
+            for j in 0..3 {
+                self.ba[k][j] += other.ba[k][j];
+            }
+        }
+        for k in 0..6 {
+            self.aa[k] += other.aa[k];
+        }
+        self.bb += other.bb;
+    }
+
+    /// Pairs added.
+    pub(crate) fn len(&self) -> u64 {
+        self.n
+    }
+
+    /// The scaled fit, or `None` when the one-pass sums cannot be trusted: a spread outside
+    /// [1e-90, 1e90] (where squares lose range; [`umeyama_pairs`] divides the points first) or
+    /// a sum that is not finite. Errors as [`umeyama`]'s for fewer than 3 pairs or degenerate
+    /// points.
+    pub(crate) fn similarity(&self) -> Option<Result<Similarity>> {
+        if self.n < 3 {
+            return Some(Err(Error::InvalidOption(format!(
+                "a similarity needs at least 3 point pairs, got {}",
+                self.n
+            ))));
+        }
+        let total = self.n as f64;
+        let mu_a = Vector3::from(self.sum_a) / total;
+        let mu_b = Vector3::from(self.sum_b) / total;
+        let c = &self.aa;
+        let aa = Matrix3::new(c[0], c[1], c[2], c[1], c[3], c[4], c[2], c[4], c[5]);
+        let sums = CentredSums {
+            sigma: Matrix3::from_fn(|i, j| self.ba[i][j]) - total * mu_b * mu_a.transpose(),
+            cov_s: aa - total * mu_a * mu_a.transpose(),
+            var_s: (c[0] + c[3] + c[5]) - total * mu_a.norm_squared(),
+        };
+        let var_d = self.bb - total * mu_b.norm_squared();
+        let fine = |v: f64| (1e-180..=1e180).contains(&(v / total));
+        let finite = sums
+            .sigma
+            .iter()
+            .chain(sums.cov_s.iter())
+            .all(|v| v.is_finite());
+        if !(finite && fine(sums.var_s) && fine(var_d)) {
+            return None;
+        }
+        Some(solve(
+            (
+                Vector3::from(self.shift_src) + mu_a,
+                Vector3::from(self.shift_dst) + mu_b,
+            ),
+            (1.0, 1.0),
+            &sums,
+            total,
+            true,
+        ))
+    }
+}
+
 /// Umeyama's closed form with the reflection fix, from the means, the spreads the centred
 /// points were divided by (1 unless extreme), the sums over the centred, divided points and
 /// the total weight.
@@ -395,5 +523,89 @@ mod tests {
         let line: Vec<Point3> = (0..10).map(|i| [f64::from(i); 3]).collect();
         assert!(umeyama_pairs(10, |i| line[i], |i| line[i]).is_err());
         assert!(umeyama_pairs(2, |i| line[i], |i| line[i]).is_err());
+    }
+
+    /// The one-pass sums, in runs merged in order, against the two-pass fit: within 1e-12 with
+    /// shifts inside the clouds, near the origin or 100 to 7000 spreads from it; extreme spreads
+    /// decline (the caller
+    /// then takes the two-pass fit); fewer than 3 pairs and collinear points are errors.
+    #[test]
+    fn one_pass_sums_equal_the_two_pass_fit_or_decline() {
+        let n = 10_000;
+        for (spread, offset) in [
+            (1.0, 0.0),
+            (1.0, 100.0),
+            (1e-3, 7.0),
+            (1e-120, 0.0),
+            (1e120, 0.0),
+        ] {
+            let truth = Similarity::from_parts(
+                0.8,
+                rot([0.2, -1.0, 0.4], -17.0),
+                [0.4, -3.0, 2.0].map(|v| v * spread),
+            );
+            let src: Vec<Point3> = (0..n)
+                .map(|i| {
+                    let f = i as f64;
+                    [
+                        (f * 0.37).sin(),
+                        (f * 0.11).cos() * 0.5,
+                        (f * 0.07).sin() * 0.2,
+                    ]
+                    .map(|v| v * spread + offset)
+                })
+                .collect();
+            let dst: Vec<Point3> = src
+                .iter()
+                .enumerate()
+                .map(|(i, p)| {
+                    let q = truth.apply(*p);
+                    let e = 1e-3 * spread * ((i as f64) * 0.9).sin();
+                    [q[0] + e, q[1] - e, q[2] + 0.5 * e]
+                })
+                .collect();
+            // Shifts a spread or so from each side's centroid.
+            let shifts = (src[n / 2], truth.apply(src[n / 3]));
+            let mut sums = PairSums::new(shifts.0, shifts.1);
+            for run in (0..n).collect::<Vec<_>>().chunks(1000) {
+                let mut part = PairSums::new(shifts.0, shifts.1);
+                for &i in run {
+                    part.add(src[i], dst[i]);
+                }
+                sums.merge(&part);
+            }
+            assert_eq!(sums.len(), n as u64);
+            let Some(fitted) = sums.similarity() else {
+                assert!(!(1e-90..=1e90).contains(&spread), "{spread} declined");
+                continue;
+            };
+            assert!((1e-90..=1e90).contains(&spread), "{spread} accepted");
+            let one_pass = fitted.unwrap();
+            let two_pass = umeyama_pairs(n, |i| src[i], |i| dst[i]).unwrap();
+            for r in 0..3 {
+                for c in 0..4 {
+                    let size = if c == 3 {
+                        10.0 * (spread + offset)
+                    } else {
+                        1.0
+                    };
+                    let (a, b) = (one_pass.matrix[r][c], two_pass.matrix[r][c]);
+                    assert!(
+                        (a - b).abs() <= 1e-12 * size,
+                        "{spread} {offset}: {a} vs {b}"
+                    );
+                }
+            }
+        }
+        let line: Vec<Point3> = (0..10).map(|i| [f64::from(i); 3]).collect();
+        let mut sums = PairSums::new([0.0; 3], [0.0; 3]);
+        for p in &line[..2] {
+            sums.add(*p, *p);
+        }
+        assert!(matches!(sums.similarity(), Some(Err(_))));
+        for p in &line[2..] {
+            sums.add(*p, *p);
+        }
+        assert!(matches!(sums.similarity(), Some(Err(_))));
     }
 }

@@ -15,7 +15,7 @@
 //! iteration counts are those of a plain nearest-neighbour query.
 
 use super::matrix::{self, IDENTITY, Matrix4};
-use crate::align::umeyama_pairs;
+use crate::align::{PairSums, umeyama_pairs};
 use crate::distance::kd_cloud::{KdCloud, NO_POINT, distance2};
 use crate::distance::neighbour_list::NeighbourList;
 use crate::geometry::Point3;
@@ -54,10 +54,9 @@ pub struct IcpResult {
     pub iterations: u32,
 }
 
-/// Matches and their score for the source as it stands.
+/// What a pass over the source found: the fit's sums over the matches and their score.
 struct Matches {
-    /// (source index, target slot) in source order.
-    pairs: Vec<(u32, u32)>,
+    sums: PairSums,
     fitness: f64,
     inlier_rmse: f64,
 }
@@ -65,9 +64,11 @@ struct Matches {
 /// No match (in `Query::slot`).
 const UNMATCHED: u32 = u32::MAX;
 
-/// What a source point's query keeps between iterations: its match and its neighbour list.
+/// A source point as it stands and what its query keeps between iterations: its match and its
+/// neighbour list.
 #[derive(Clone, Copy)]
 struct Query {
+    point: Point3,
     slot: u32,
     list: NeighbourList,
 }
@@ -76,61 +77,81 @@ struct Query {
 /// that a point with no match keeps an empty list while it moves by less than half of one.
 const LIST_REACH: f64 = 1.5;
 
-/// Each moved point's nearest target point strictly closer than the correspondence distance
-/// (`limit` = its square). `moved` and `queries` are in the visiting order (Morton). A point
-/// matched before starts from its previous match (it moved a little: the nearest now is at most
-/// that far), the others from the radius; the nearest found is the exact one either way
-/// (through the point's neighbour list, which answers as the tree does), so the matches are
-/// those of an unbounded nearest-neighbour query filtered by the distance. Pairs and the error
-/// sum come in the visiting order, so that the fit then reads the moved points in memory order.
-fn matches(moved: &[Point3], target: &KdCloud, limit: f64, queries: &mut [Query]) -> Matches {
+/// Source points per run of a pass: each run sums its matches on its own and the runs' sums
+/// are added in order, so the fits do not depend on the thread count.
+const RUN: usize = 1024;
+
+/// One pass over the source: each point moved by `update` (none for the first pass), then its
+/// nearest target point strictly closer than the correspondence distance (`limit` = its square)
+/// found and added to the fit's sums (relative to `shift`, the moved cloud's centroid). The
+/// queries are in the visiting order (Morton). A point matched before starts from its previous
+/// match (it moved a little: the nearest now is at most that far), the others from the radius;
+/// the nearest found is the exact one either way (through the point's neighbour list, which
+/// answers as the tree does), so the matches are those of an unbounded nearest-neighbour query
+/// filtered by the distance. Moving, matching and summing in one pass reads each point once an
+/// iteration: the passes are bound by memory more than by arithmetic.
+fn matches(
+    queries: &mut [Query],
+    update: Option<&Matrix4>,
+    shift: Point3,
+    target: &KdCloud,
+    limit: f64,
+) -> Matches {
     let reach2 = limit * LIST_REACH * LIST_REACH;
-    // The state: the last full list made or read in this work unit, a neighbour's in the
-    // visiting order.
-    let found = parallel::map_mut_with_state(queries, |hint: &mut NeighbourList, k, query| {
-        let q = moved[k];
-        let bound = match query.slot {
-            UNMATCHED => (limit, NO_POINT),
-            slot => {
-                let d2 = distance2(target.point(slot as usize), q);
-                if d2 < limit {
-                    (d2, slot as usize)
-                } else {
-                    (limit, NO_POINT)
-                }
+    // The state: the last full list made or read in this run, a neighbour's in the visiting
+    // order.
+    let runs = parallel::fold_runs_mut(
+        queries,
+        RUN,
+        || (PairSums::new(shift, shift), 0.0),
+        |hint: &mut NeighbourList, (sums, error2): &mut (PairSums, f64), _, query| {
+            if let Some(update) = update {
+                query.point = matrix::apply(update, query.point);
             }
-        };
-        let (d2, slot) = query
-            .list
-            .nearest_below(target, q, bound, reach2, Some(hint));
-        if query.list.is_full() {
-            *hint = query.list;
-        }
-        query.slot = if slot == NO_POINT {
-            UNMATCHED
-        } else {
-            slot as u32
-        };
-        (d2, query.slot)
-    });
-    let mut pairs = Vec::new();
+            let q = query.point;
+            let bound = match query.slot {
+                UNMATCHED => (limit, NO_POINT),
+                slot => {
+                    let d2 = distance2(target.point(slot as usize), q);
+                    if d2 < limit {
+                        (d2, slot as usize)
+                    } else {
+                        (limit, NO_POINT)
+                    }
+                }
+            };
+            let (d2, slot) = query
+                .list
+                .nearest_below(target, q, bound, reach2, Some(hint));
+            if query.list.is_full() {
+                *hint = query.list;
+            }
+            if slot == NO_POINT {
+                query.slot = UNMATCHED;
+            } else {
+                query.slot = slot as u32;
+                sums.add(q, target.point(slot));
+                *error2 += d2;
+            }
+        },
+    );
+    let mut sums = PairSums::new(shift, shift);
     let mut error2 = 0.0;
-    for (k, &(d2, slot)) in found.iter().enumerate() {
-        if slot != UNMATCHED {
-            error2 += d2;
-            pairs.push((k as u32, slot));
-        }
+    for (run, run_error2) in &runs {
+        sums.merge(run);
+        error2 += run_error2;
     }
-    let (fitness, inlier_rmse) = if pairs.is_empty() {
+    let matched = sums.len();
+    let (fitness, inlier_rmse) = if matched == 0 {
         (0.0, 0.0)
     } else {
         (
-            pairs.len() as f64 / moved.len() as f64,
-            (error2 / pairs.len() as f64).sqrt(),
+            matched as f64 / queries.len() as f64,
+            (error2 / matched as f64).sqrt(),
         )
     };
     Matches {
-        pairs,
+        sums,
         fitness,
         inlier_rmse,
     }
@@ -146,27 +167,28 @@ pub fn registration_icp(
     let limit = max_distance * max_distance;
     // The moves are small: one spatial visiting order serves every iteration, and the moved
     // points and their queries are kept in it (neighbours in space, neighbours in memory).
-    let mut moved: Vec<Point3> = morton_order(source)
+    let mut queries: Vec<Query> = morton_order(source)
         .iter()
-        .map(|&i| source[i as usize])
-        .collect();
-    let mut queries = vec![
-        Query {
+        .map(|&i| Query {
+            point: source[i as usize],
             slot: UNMATCHED,
             list: NeighbourList::NONE,
-        };
-        source.len()
-    ];
+        })
+        .collect();
+    // The fits' shift: the source's centroid, moved with the points.
+    let mut shift = centroid(source);
     let mut transformation = IDENTITY;
-    let mut current = matches(&moved, target, limit, &mut queries);
+    let mut current = matches(&mut queries, None, shift, target, limit);
     let mut iterations = 0;
     while iterations < criteria.max_iterations {
-        let update = fit_pairs(&moved, target, &current.pairs);
+        let update = fit(&queries, target, &current.sums);
         transformation = matrix::mul(&update, &transformation);
-        parallel::map_mut(&mut moved, |_, p| *p = matrix::apply(&update, *p));
+        shift = matrix::apply(&update, shift);
         iterations += 1;
-        let previous =
-            std::mem::replace(&mut current, matches(&moved, target, limit, &mut queries));
+        let previous = std::mem::replace(
+            &mut current,
+            matches(&mut queries, Some(&update), shift, target, limit),
+        );
         if (previous.fitness - current.fitness).abs() < criteria.relative_fitness
             && (previous.inlier_rmse - current.inlier_rmse).abs() < criteria.relative_rmse
         {
@@ -181,16 +203,32 @@ pub fn registration_icp(
     }
 }
 
-/// The scaled Umeyama fit of ICP's matches `(moved point, target slot)`, summed in parallel;
-/// the identity without matches or when they are degenerate (Open3D returns the identity for
-/// no matches).
-fn fit_pairs(moved: &[Point3], target: &KdCloud, pairs: &[(u32, u32)]) -> Matrix4 {
-    umeyama_pairs(
-        pairs.len(),
-        |k| moved[pairs[k].0 as usize],
-        |k| target.point(pairs[k].1 as usize),
-    )
-    .map_or(IDENTITY, |s| s.matrix)
+/// The mean of `points` (the origin for none).
+fn centroid(points: &[Point3]) -> Point3 {
+    let mut sum = [0.0; 3];
+    for p in points {
+        for k in 0..3 {
+            sum[k] += p[k];
+        }
+    }
+    let n = points.len().max(1) as f64;
+    sum.map(|v| v / n)
+}
+
+/// The scaled Umeyama fit of ICP's matches from the pass's sums, or, in the rare case they
+/// cannot be trusted (extreme spreads), from the matches read again through the queries; the
+/// identity without matches or when they are degenerate (Open3D returns the identity for no
+/// matches).
+fn fit(queries: &[Query], target: &KdCloud, sums: &PairSums) -> Matrix4 {
+    let fitted = sums.similarity().unwrap_or_else(|| {
+        let matched: Vec<&Query> = queries.iter().filter(|q| q.slot != UNMATCHED).collect();
+        umeyama_pairs(
+            matched.len(),
+            |k| matched[k].point,
+            |k| target.point(matched[k].slot as usize),
+        )
+    });
+    fitted.map_or(IDENTITY, |s| s.matrix)
 }
 
 #[cfg(test)]
@@ -210,36 +248,46 @@ mod tests {
 
     #[test]
     fn recovers_a_small_similarity_exactly() {
-        let target = grid();
-        // source = target moved by a small similarity; ICP must undo it.
-        let c = libm::cos(0.02);
-        let s = libm::sin(0.02);
-        let t: Matrix4 = [
-            [1.01 * c, -1.01 * s, 0.0, 0.01],
-            [1.01 * s, 1.01 * c, 0.0, -0.005],
-            [0.0, 0.0, 1.01, 0.002],
-            [0.0, 0.0, 0.0, 1.0],
-        ];
-        let source: Vec<Point3> = target.iter().map(|p| matrix::apply(&t, *p)).collect();
-        let index = KdCloud::new(&target).unwrap();
-        let strict = IcpCriteria {
-            relative_fitness: 1e-12,
-            relative_rmse: 1e-12,
-            max_iterations: 50,
-        };
-        let r = registration_icp(&source, &index, 0.2, strict);
-        assert_eq!(r.fitness, 1.0);
-        assert!(r.inlier_rmse < 1e-9, "{}", r.inlier_rmse);
-        for p in &target {
-            let back = matrix::apply(&r.transformation, matrix::apply(&t, *p));
-            assert!((0..3).all(|k| (back[k] - p[k]).abs() < 1e-9));
+        // At unit size the fits come from the passes' one-pass sums; at 1e-100 those decline
+        // (squares out of range) and the two-pass fit over the queries' matches answers.
+        for size in [1.0, 1e-100] {
+            let target: Vec<Point3> = grid().iter().map(|p| p.map(|v| v * size)).collect();
+            // source = target moved by a small similarity; ICP must undo it.
+            let c = libm::cos(0.02);
+            let s = libm::sin(0.02);
+            let t: Matrix4 = [
+                [1.01 * c, -1.01 * s, 0.0, 0.01 * size],
+                [1.01 * s, 1.01 * c, 0.0, -0.005 * size],
+                [0.0, 0.0, 1.01, 0.002 * size],
+                [0.0, 0.0, 0.0, 1.0],
+            ];
+            let source: Vec<Point3> = target.iter().map(|p| matrix::apply(&t, *p)).collect();
+            let index = KdCloud::new(&target).unwrap();
+            let strict = IcpCriteria {
+                relative_fitness: 1e-12,
+                relative_rmse: 1e-12,
+                max_iterations: 50,
+            };
+            let r = registration_icp(&source, &index, 0.2 * size, strict);
+            assert_eq!(r.fitness, 1.0, "{size}");
+            assert!(r.inlier_rmse < 1e-9 * size, "{size}: {}", r.inlier_rmse);
+            for p in &target {
+                let back = matrix::apply(&r.transformation, matrix::apply(&t, *p));
+                assert!(
+                    (0..3).all(|k| (back[k] - p[k]).abs() < 1e-9 * size),
+                    "{size}"
+                );
+            }
+            // The toolbox's criteria stop once the match count settles: here after 1 update.
+            let r = registration_icp(&source, &index, 0.2 * size, IcpCriteria::TOOLBOX);
+            assert_eq!(r.iterations, 1);
+            // No match within the distance: nothing moves.
+            let far: Vec<Point3> = target
+                .iter()
+                .map(|p| [p[0] + 10.0 * size, p[1], p[2]])
+                .collect();
+            let r = registration_icp(&far, &index, 0.2 * size, IcpCriteria::TOOLBOX);
+            assert_eq!((r.fitness, r.transformation), (0.0, IDENTITY));
         }
-        // The toolbox's criteria stop once the match count settles: here after 1 update.
-        let r = registration_icp(&source, &index, 0.2, IcpCriteria::TOOLBOX);
-        assert_eq!(r.iterations, 1);
-        // No match within the distance: nothing moves.
-        let far: Vec<Point3> = target.iter().map(|p| [p[0] + 10.0, p[1], p[2]]).collect();
-        let r = registration_icp(&far, &index, 0.2, IcpCriteria::TOOLBOX);
-        assert_eq!((r.fitness, r.transformation), (0.0, IDENTITY));
     }
 }
