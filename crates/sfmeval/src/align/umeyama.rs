@@ -341,6 +341,21 @@ impl PairSums {
     }
 }
 
+/// Whether the covariance `cov` (symmetric, positive semi-definite up to rounding) has
+/// `λ₂/λ₁` far above the collinear threshold, proven from its invariants without an eigen
+/// decomposition (which took most of a RANSAC sample's fit): with `T = λ₁+λ₂+λ₃` (the trace)
+/// and `M = λ₁λ₂+λ₁λ₃+λ₂λ₃` (the principal 2×2 minors), `M ≤ 3λ₁λ₂` and `λ₁ ≤ T` give
+/// `λ₂/λ₁ ≥ M/(3T²)`. A bound of 1e-12 (with rounding of a few 1e-16 T²) is a hundred times
+/// the threshold's 1e-14, so the eigenvalues would decide the same; below it they decide.
+fn clearly_not_collinear(cov: &Matrix3<f64>) -> bool {
+    let c = |i: usize, j: usize| cov[(i, j)];
+    let trace = c(0, 0) + c(1, 1) + c(2, 2);
+    let minors = (c(0, 0) * c(1, 1) - c(0, 1) * c(1, 0))
+        + (c(0, 0) * c(2, 2) - c(0, 2) * c(2, 0))
+        + (c(1, 1) * c(2, 2) - c(1, 2) * c(2, 1));
+    trace > 0.0 && minors >= 3e-12 * trace * trace
+}
+
 /// Umeyama's closed form with the reflection fix, from the means, the spreads the centred
 /// points were divided by (1 unless extreme), the sums over the centred, divided points and
 /// the total weight.
@@ -354,16 +369,19 @@ fn solve(
     let sigma = sums.sigma / total;
     let cov_s = sums.cov_s / total;
     let var_s = sums.var_s / total;
-    let (l, _) = super::sorted_eigen(&cov_s);
-    if !(l[0] > 0.0) {
-        return Err(Error::Geometry(
-            "all source points coincide: no similarity is defined".into(),
-        ));
-    }
-    if (l[1] / l[0]).sqrt() < COLLINEAR_RATIO {
-        return Err(Error::Geometry(
-            "the source points are collinear: the rotation about their line is undetermined".into(),
-        ));
+    if !clearly_not_collinear(&cov_s) {
+        let (l, _) = super::sorted_eigen(&cov_s);
+        if !(l[0] > 0.0) {
+            return Err(Error::Geometry(
+                "all source points coincide: no similarity is defined".into(),
+            ));
+        }
+        if (l[1] / l[0]).sqrt() < COLLINEAR_RATIO {
+            return Err(Error::Geometry(
+                "the source points are collinear: the rotation about their line is undetermined"
+                    .into(),
+            ));
+        }
     }
     let svd = sigma.svd(true, true);
     let (u, vt) = match (svd.u, svd.v_t) {
@@ -607,5 +625,39 @@ mod tests {
             sums.add(*p, *p);
         }
         assert!(matches!(sums.similarity(), Some(Err(_))));
+    }
+
+    /// The invariant test only answers "not collinear" where the eigenvalues say so too, and
+    /// answers it for ordinary point sets (so that the eigen decomposition is skipped there).
+    #[test]
+    fn invariant_test_agrees_with_the_eigenvalues() {
+        for thickness in [1.0, 1e-3, 1e-5, 1e-6, 3e-7, 1e-7, 3e-8, 1e-9, 0.0] {
+            for tilt in [0.0, 0.3, 1.1] {
+                let pts: Vec<Point3> = (0..12)
+                    .map(|i| {
+                        let f = f64::from(i);
+                        let (u, v) = (f - 5.5, thickness * (f * 1.7).sin());
+                        [u, v * (1.0 - tilt) + u * tilt, 2.0 + 0.5 * v]
+                    })
+                    .collect();
+                let n = pts.len() as f64;
+                let mu = pts.iter().fold(Vector3::zeros(), |m, p| m + to_v(*p)) / n;
+                let cov = pts.iter().fold(Matrix3::zeros(), |c, p| {
+                    let a = to_v(*p) - mu;
+                    c + a * a.transpose()
+                }) / n;
+                let (l, _) = crate::align::sorted_eigen(&cov);
+                let ratio = (l[1] / l[0]).sqrt();
+                if clearly_not_collinear(&cov) {
+                    assert!(
+                        ratio >= 10.0 * COLLINEAR_RATIO,
+                        "{thickness} {tilt}: {ratio}"
+                    );
+                }
+                if ratio > 1e-5 {
+                    assert!(clearly_not_collinear(&cov), "{thickness} {tilt}: {ratio}");
+                }
+            }
+        }
     }
 }

@@ -42,6 +42,21 @@ impl CloudIndex {
             .execute();
         (r.distance, r.item as usize)
     }
+
+    /// Squared distance from `p` to its second-nearest point (+∞ for a one-point cloud): for a
+    /// point of the cloud, the distance to its nearest other point.
+    pub(crate) fn second_nearest_squared(&self, p: Point3) -> f64 {
+        let two = std::num::NonZeroUsize::MIN.saturating_add(1);
+        let found = self
+            .tree
+            .query(&p)
+            .nearest_n::<SquaredEuclidean<f64>>(two)
+            .execute();
+        match found.as_slice() {
+            [a, b] => a.distance.max(b.distance),
+            _ => f64::INFINITY,
+        }
+    }
 }
 
 // Test data only: platform maths is fine here (reports use libm, see clippy.toml).

@@ -81,28 +81,23 @@ pub fn align_trajectories(
             options.ransac_n.max(3)
         )));
     }
-    let index = CloudIndex::new(reference_in_gt)?;
+    let reference = Reference::new(reference_in_gt)?;
     let limit2 = options.max_correspondence_distance * options.max_correspondence_distance;
     let mut rng = ChaCha8Rng::seed_from_u64(options.seed);
-    let samples: Vec<Vec<(u32, u32)>> = (0..options.max_iterations)
-        .map(|_| {
-            (0..options.ransac_n)
-                .map(|_| {
-                    let i = rng.random_range(0..n) as u32;
-                    (i, i)
-                })
-                .collect()
-        })
+    // The samples' frames, `ransac_n` a sample, in one buffer (frame i pairs with frame i).
+    let frames: Vec<u32> = (0..options.max_iterations as usize * options.ransac_n)
+        .map(|_| rng.random_range(0..n) as u32)
         .collect();
+    let samples: Vec<&[u32]> = frames.chunks(options.ransac_n).collect();
     // A sample's score: (matched, sum of squared distances), or None once it provably cannot beat
     // `bound` (the best of the chunks before): too few centres left to reach its match count, or
     // its match count reached at most and its squared error already larger. Pruning never
     // drops a sample that would have won, so the winner is the exhaustive search's.
-    let score = |sample: &Vec<(u32, u32)>, bound: Option<(usize, f64)>| -> Option<(usize, f64)> {
-        let t = fit(|i| recon_centers[i], |j| reference_in_gt[j], sample);
+    let score = |sample: &&[u32], bound: Option<(usize, f64)>| -> Option<(usize, f64)> {
+        let t = fit(recon_centers, reference_in_gt, sample);
         let (mut matched, mut error2) = (0usize, 0.0);
         for (k, p) in recon_centers.iter().enumerate() {
-            let (d2, _) = index.nearest_squared(matrix::apply(&t, *p));
+            let d2 = reference.nearest2(k, matrix::apply(&t, *p));
             if d2 < limit2 {
                 matched += 1;
                 error2 += d2;
@@ -145,24 +140,63 @@ pub fn align_trajectories(
         )));
     }
     Ok(TrajectoryAlignment {
-        gt_from_recon: fit(|i| recon_centers[i], |j| reference_in_gt[j], &samples[best]),
+        gt_from_recon: fit(recon_centers, reference_in_gt, samples[best]),
         fitness,
         inlier_rmse,
         iterations: options.max_iterations,
     })
 }
 
-/// The scaled Umeyama fit of a sample's pairs; the identity when they are degenerate.
-fn fit(
-    source: impl Fn(usize) -> Point3,
-    target: impl Fn(usize) -> Point3,
-    pairs: &[(u32, u32)],
-) -> Matrix4 {
-    if pairs.is_empty() {
+/// The reference centres indexed for the scores' nearest-centre searches.
+struct Reference<'a> {
+    centres: &'a [Point3],
+    index: CloudIndex,
+    /// Per centre, a quarter of the squared distance to its nearest other centre (less a
+    /// margin): a point that close to centre `k` has `k` as its nearest centre.
+    own_reach2: Vec<f64>,
+}
+
+impl<'a> Reference<'a> {
+    fn new(centres: &'a [Point3]) -> Result<Reference<'a>> {
+        let index = CloudIndex::new(centres)?;
+        let own_reach2 = centres
+            .iter()
+            .map(|&c| index.second_nearest_squared(c) * 0.25 * (1.0 - 1e-9))
+            .collect();
+        Ok(Reference {
+            centres,
+            index,
+            own_reach2,
+        })
+    }
+
+    /// The squared distance from `q` (the moved centre of frame `k`) to its nearest reference
+    /// centre, the search's to the bit. A centre within half the distance from its own
+    /// reference centre to the next one has its own as the nearest (any other is farther by the
+    /// triangle inequality, by a relative 1e-9 with the margin, far above the rounding): the
+    /// distance is then computed as the search computes it, without a search. Most frames of a
+    /// good sample are such.
+    fn nearest2(&self, k: usize, q: Point3) -> f64 {
+        let own = self.centres[k];
+        let d2 = (own[0] - q[0]) * (own[0] - q[0])
+            + (own[1] - q[1]) * (own[1] - q[1])
+            + (own[2] - q[2]) * (own[2] - q[2]);
+        if d2 <= self.own_reach2[k] {
+            d2
+        } else {
+            self.index.nearest_squared(q).0
+        }
+    }
+}
+
+/// The scaled Umeyama fit of a sample's frames (`source[i]` to `target[i]`); the identity when
+/// they are degenerate.
+fn fit(source: &[Point3], target: &[Point3], frames: &[u32]) -> Matrix4 {
+    if frames.is_empty() {
         return IDENTITY;
     }
-    let src: Vec<Point3> = pairs.iter().map(|&(i, _)| source(i as usize)).collect();
-    let dst: Vec<Point3> = pairs.iter().map(|&(_, j)| target(j as usize)).collect();
+    let src: Vec<Point3> = frames.iter().map(|&i| source[i as usize]).collect();
+    let dst: Vec<Point3> = frames.iter().map(|&i| target[i as usize]).collect();
     umeyama(&src, &dst, true).map_or(IDENTITY, |s| s.matrix)
 }
 
@@ -206,5 +240,42 @@ mod tests {
             .unwrap_err()
             .to_string();
         assert!(e.contains("39 frames"), "{e}");
+    }
+
+    /// The shortcut through a frame's own reference centre gives the search's distance to the
+    /// bit, for points near their own centre, between centres, near duplicated centres and far
+    /// away.
+    #[test]
+    fn nearest_reference_distance_equals_the_search() {
+        let mut centres: Vec<Point3> = (0..30)
+            .map(|i| {
+                let a = f64::from(i) * 0.4;
+                [libm::cos(a), libm::sin(a), 0.1 * f64::from(i)]
+            })
+            .collect();
+        centres[7] = centres[3];
+        centres[8] = [centres[9][0] + 1e-12, centres[9][1], centres[9][2]];
+        let reference = Reference::new(&centres).unwrap();
+        let mut s = 0x2545_f491_4f6c_dd1du64;
+        let mut next = move || {
+            s ^= s << 13;
+            s ^= s >> 7;
+            s ^= s << 17;
+            (s >> 11) as f64 / (1u64 << 53) as f64 - 0.5
+        };
+        let mut shortcuts = 0;
+        for reach in [1e-6, 0.01, 0.1, 0.3, 1.0, 10.0] {
+            for (k, c) in centres.iter().enumerate() {
+                let q = [0, 1, 2].map(|a| c[a] + reach * next());
+                let want = reference.index.nearest_squared(q).0;
+                assert_eq!(
+                    reference.nearest2(k, q).to_bits(),
+                    want.to_bits(),
+                    "{k} {q:?}"
+                );
+                shortcuts += usize::from(want <= reference.own_reach2[k]);
+            }
+        }
+        assert!(shortcuts > 60, "{shortcuts}");
     }
 }
