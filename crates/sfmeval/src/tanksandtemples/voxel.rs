@@ -44,7 +44,16 @@ pub fn voxel_down_sample(points: &[Point3], size: f64) -> Result<Vec<Point3>> {
     // truncation of `as` is the floor (and saturates the same for ±∞ and NaN) without a call
     // to `floor`.
     let index = |p: &Point3| [0, 1, 2].map(|k| ((p[k] - start[k]) / size) as i32);
-    if cells < f64::from(1u32 << 21) {
+    // Voxels per axis (a point's index is at most the maximum's, computed the same way).
+    let per_axis = [0, 1, 2].map(|k| ((max[k] - start[k]) / size).floor() + 1.0);
+    let voxels = per_axis.iter().product::<f64>();
+    if voxels <= f64::from(u32::MAX) && u32::try_from(points.len()).is_ok() {
+        let [_, ny, nz] = per_axis.map(|c| c as u64);
+        Ok(packed_means(points, |p| {
+            let [x, y, z] = index(p).map(|i| u64::from(i as u32));
+            (x * ny + y) * nz + z
+        }))
+    } else if cells < f64::from(1u32 << 21) {
         Ok(sorted_means(points, |p| {
             let [x, y, z] = index(p).map(|i| u64::from(i as u32));
             (x << 42) | (y << 21) | z
@@ -108,6 +117,39 @@ fn sorted_means(points: &[Point3], key: impl Fn(&Point3) -> u64 + Sync + Send) -
     drop(keyed);
     parallel::sort_unstable_by_key(&mut voxels, |&(first, _)| first);
     voxels.into_iter().map(|(_, p)| p).collect()
+}
+
+/// [`sorted_means`] for voxel numbers below 2³² (the common case): each point's voxel number
+/// and index packed in one `u64` (number above, index below), so that the sort compares plain
+/// integers (and keeps each voxel's points in input order), and the voxels put in the order of
+/// their first point through a second sort of packed `u64`s rather than of the means.
+fn packed_means(points: &[Point3], voxel: impl Fn(&Point3) -> u64 + Sync + Send) -> Vec<Point3> {
+    let mut keyed = parallel::map_range(points.len(), |i| (voxel(&points[i]) << 32) | i as u64);
+    parallel::sort_unstable(&mut keyed);
+    let starts: Vec<usize> = (0..keyed.len())
+        .filter(|&k| k == 0 || keyed[k] >> 32 != keyed[k - 1] >> 32)
+        .collect();
+    let index = |k: usize| (keyed[k] & u64::from(u32::MAX)) as usize;
+    let means = parallel::map_range(starts.len(), |v| {
+        let end = starts.get(v + 1).copied().unwrap_or(keyed.len());
+        let mut sum = [0.0; 3];
+        for k in starts[v]..end {
+            let p = points[index(k)];
+            for a in 0..3 {
+                sum[a] += p[a];
+            }
+        }
+        mean(sum, (end - starts[v]) as u32)
+    });
+    // (first point's index, voxel) packed and sorted: the voxels in first-point order.
+    let mut firsts = parallel::map_range(starts.len(), |v| {
+        ((index(starts[v]) as u64) << 32) | v as u64
+    });
+    drop(keyed);
+    parallel::sort_unstable(&mut firsts);
+    parallel::map_range(firsts.len(), |j| {
+        means[(firsts[j] & u64::from(u32::MAX)) as usize]
+    })
 }
 
 /// Sums and counts per key, in the order keys first appear, points summed in input order (for
@@ -215,7 +257,7 @@ mod tests {
     }
 
     #[test]
-    fn sorted_runs_equal_the_hash_map_in_voxels_order_and_bits() {
+    fn sorted_and_packed_runs_equal_the_hash_map_in_voxels_order_and_bits() {
         // 60k seeded points over ~4k voxels, in no spatial order, several chunks of the sort.
         let mut state = 0x2545_f491_4f6c_dd1du64;
         let mut next = move || {
@@ -237,6 +279,28 @@ mod tests {
             .collect();
         let got = sorted_means(&pts, key);
         assert!(want.len() > 4000);
+        assert_eq!(got.len(), want.len());
+        for (g, w) in got.iter().zip(&want) {
+            assert_eq!(g.map(f64::to_bits), w.map(f64::to_bits));
+        }
+        // The packed path: voxel numbers below 2³² (a 17 × 17 × 1200 grid here).
+        let packed = packed_means(&pts, |p| {
+            let [x, y, z] = [0, 1, 2].map(|k| (p[k].floor() as i64 + 100) as u64);
+            ((x - 100) * 17 + (y - 92)) * 1200 + (z - 100)
+        });
+        assert_eq!(packed.len(), want.len());
+        for (g, w) in packed.iter().zip(&want) {
+            assert_eq!(g.map(f64::to_bits), w.map(f64::to_bits));
+        }
+        // And through voxel_down_sample, which takes it for this cloud: the hash map's means
+        // on the grid anchored half a voxel below the minimum.
+        let (min, _) = bounds(&pts);
+        let start = min.map(|m| m - 0.5);
+        let want: Vec<Point3> = group(&pts, |p| [0, 1, 2].map(|k| (p[k] - start[k]) as i32))
+            .into_iter()
+            .map(|(s, n)| mean(s, n))
+            .collect();
+        let got = voxel_down_sample(&pts, 1.0).unwrap();
         assert_eq!(got.len(), want.len());
         for (g, w) in got.iter().zip(&want) {
             assert_eq!(g.map(f64::to_bits), w.map(f64::to_bits));
