@@ -185,10 +185,12 @@ fn in_prism(polygon: &[Point3], axis: Axis, axis_min: f64, axis_max: f64, p: Poi
     if p[w] < axis_min || p[w] > axis_max {
         return false;
     }
-    let n = polygon.len();
     let mut below = 0usize;
-    for i in 0..n {
-        let (a, b) = (polygon[i], polygon[(i + 1) % n]);
+    // Edge i runs from vertex i to the next (the last to the first), without a modulo a vertex.
+    for (&a, &b) in polygon
+        .iter()
+        .zip(polygon.iter().skip(1).chain(polygon.first()))
+    {
         if (a[v] < p[v] && b[v] >= p[v]) || (b[v] < p[v] && a[v] >= p[v]) {
             let node = a[u] + (p[v] - a[v]) / (b[v] - a[v]) * (b[u] - a[u]);
             if node < p[u] {

@@ -18,6 +18,23 @@ where
     map_with_state(items, progress, |_: &mut (), t| f(t))
 }
 
+/// The `Some` results of `f` over `items`, in input order (a filter that keeps or maps each
+/// item on its own), in parallel where threads are available.
+pub(crate) fn filter_map<T, R, F>(items: &[T], f: F) -> Vec<R>
+where
+    T: Sync,
+    R: Send,
+    F: Fn(&T) -> Option<R> + Sync + Send,
+{
+    #[cfg(feature = "parallel")]
+    {
+        use rayon::prelude::*;
+        items.par_iter().with_min_len(4096).filter_map(f).collect()
+    }
+    #[cfg(not(feature = "parallel"))]
+    items.iter().filter_map(f).collect()
+}
+
 /// [`map`] where `f` also gets a state that starts as `S::default()` in each work unit and
 /// goes from one item to the next in order, to carry a hint (e.g. the previous query's answer);
 /// for results independent of the thread count they must not depend on it.

@@ -25,7 +25,7 @@ use crate::distance::kd_cloud::{KdCloud, NO_POINT};
 use crate::error::{Error, Result};
 use crate::geometry::Point3;
 use crate::parallel;
-use crate::progress::{NoProgress, Progress, Stage};
+use crate::progress::{Progress, Stage};
 use crate::report::Tool;
 
 /// The toolbox's point budget of the last refinement (`MAX_POINT_NUMBER`).
@@ -143,24 +143,15 @@ pub fn evaluate(
         });
     }
     let volume = &scene.crop;
-    // The crop tests run in parallel (a flag a point), the kept points are collected in order.
+    // The crops run in parallel, the kept points come in input order.
     let crop = |pts: &[Point3]| -> Vec<Point3> {
-        let inside = parallel::map(pts, &NoProgress, |p| volume.contains(*p));
-        pts.iter()
-            .zip(inside)
-            .filter_map(|(p, inside)| inside.then_some(*p))
-            .collect()
+        parallel::filter_map(pts, |p| volume.contains(*p).then_some(*p))
     };
     let crop_moved = |t: &Matrix4| -> Vec<Point3> {
-        let inside = parallel::map(recon_points, &NoProgress, |p| {
-            volume.contains(matrix::apply(t, *p))
-        });
-        recon_points
-            .iter()
-            .zip(inside)
-            .filter(|(_, inside)| *inside)
-            .map(|(p, _)| matrix::apply(t, *p))
-            .collect()
+        parallel::filter_map(recon_points, |p| {
+            let moved = matrix::apply(t, *p);
+            volume.contains(moved).then_some(moved)
+        })
     };
     let nonempty = |pts: Vec<Point3>, what: &str| -> Result<Vec<Point3>> {
         if pts.is_empty() {
