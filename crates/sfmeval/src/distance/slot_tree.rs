@@ -199,9 +199,10 @@ impl SlotTree {
                 let d2 = (a[0] - q[0]) * (a[0] - q[0])
                     + (a[1] - q[1]) * (a[1] - q[1])
                     + (a[2] - q[2]) * (a[2] - q[2]);
-                if d2 < best.0 {
-                    best = (d2, k);
-                }
+                // A select, not a branch: a leaf's new best is rare and unpredictable.
+                let better = d2 < best.0;
+                best.0 = if better { d2 } else { best.0 };
+                best.1 = if better { k } else { best.1 };
             }
             best.0
         });
