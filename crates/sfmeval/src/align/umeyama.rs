@@ -489,6 +489,37 @@ mod tests {
     /// `PAIRS_PER_SUM`, at ordinary and at extreme spreads (where both divide by the spread),
     /// and the same bits on one thread as on several; degenerate pairs are errors as in
     /// `umeyama`.
+    /// `n` source points on a smooth curve of size `spread` around `offset`, and their images
+    /// under `truth` with a small deterministic noise.
+    fn noisy_pairs(
+        n: usize,
+        spread: f64,
+        offset: f64,
+        truth: &Similarity,
+    ) -> (Vec<Point3>, Vec<Point3>) {
+        let src: Vec<Point3> = (0..n)
+            .map(|i| {
+                let f = i as f64;
+                [
+                    (f * 0.37).sin(),
+                    (f * 0.11).cos() * 0.5,
+                    (f * 0.07).sin() * 0.2,
+                ]
+                .map(|v| v * spread + offset)
+            })
+            .collect();
+        let dst = src
+            .iter()
+            .enumerate()
+            .map(|(i, p)| {
+                let q = truth.apply(*p);
+                let e = 1e-3 * spread * ((i as f64) * 0.9).sin();
+                [q[0] + e, q[1] - e, q[2] + 0.5 * e]
+            })
+            .collect();
+        (src, dst)
+    }
+
     #[test]
     fn pairs_in_parallel_equal_the_one_by_one_fit() {
         let n = 3 * PAIRS_PER_SUM + 17;
@@ -498,26 +529,7 @@ mod tests {
                 rot([1.0, 2.0, -0.5], 31.0),
                 [0.4, -3.0, 2.0].map(|v| v * spread),
             );
-            let src: Vec<Point3> = (0..n)
-                .map(|i| {
-                    let f = i as f64;
-                    [
-                        (f * 0.37).sin(),
-                        (f * 0.11).cos() * 0.5,
-                        (f * 0.07).sin() * 0.2,
-                    ]
-                    .map(|v| v * spread + 5.0 * spread)
-                })
-                .collect();
-            let dst: Vec<Point3> = src
-                .iter()
-                .enumerate()
-                .map(|(i, p)| {
-                    let q = truth.apply(*p);
-                    let e = 1e-3 * spread * ((i as f64) * 0.9).sin();
-                    [q[0] + e, q[1] - e, q[2] + 0.5 * e]
-                })
-                .collect();
+            let (src, dst) = noisy_pairs(n, spread, 5.0 * spread, &truth);
             let one = umeyama(&src, &dst, true).unwrap();
             let par = umeyama_pairs(n, |i| src[i], |i| dst[i]).unwrap();
             for r in 0..3 {
@@ -562,26 +574,7 @@ mod tests {
                 rot([0.2, -1.0, 0.4], -17.0),
                 [0.4, -3.0, 2.0].map(|v| v * spread),
             );
-            let src: Vec<Point3> = (0..n)
-                .map(|i| {
-                    let f = i as f64;
-                    [
-                        (f * 0.37).sin(),
-                        (f * 0.11).cos() * 0.5,
-                        (f * 0.07).sin() * 0.2,
-                    ]
-                    .map(|v| v * spread + offset)
-                })
-                .collect();
-            let dst: Vec<Point3> = src
-                .iter()
-                .enumerate()
-                .map(|(i, p)| {
-                    let q = truth.apply(*p);
-                    let e = 1e-3 * spread * ((i as f64) * 0.9).sin();
-                    [q[0] + e, q[1] - e, q[2] + 0.5 * e]
-                })
-                .collect();
+            let (src, dst) = noisy_pairs(n, spread, offset, &truth);
             // Shifts a spread or so from each side's centroid.
             let shifts = (src[n / 2], truth.apply(src[n / 3]));
             let mut sums = PairSums::new(shifts.0, shifts.1);
