@@ -175,21 +175,6 @@ pub(crate) fn sort_unstable<T: Ord + Send>(slice: &mut [T]) {
     slice.sort_unstable();
 }
 
-/// `slice.sort_unstable_by_key(key)` for keys that are all distinct (so that the order is
-/// the same whatever the sort), in parallel where threads are available.
-pub(crate) fn sort_unstable_by_key<T: Send, K: Ord>(
-    slice: &mut [T],
-    key: impl Fn(&T) -> K + Sync + Send,
-) {
-    #[cfg(feature = "parallel")]
-    {
-        use rayon::prelude::*;
-        slice.par_sort_unstable_by_key(key);
-    }
-    #[cfg(not(feature = "parallel"))]
-    slice.sort_unstable_by_key(key);
-}
-
 /// Sorts numbers ascending with NaN last (the order of JavaScript's typed-array sort), in
 /// parallel where threads are available. Every NaN becomes the positive quiet NaN.
 pub(crate) fn sort_floats(values: &mut [f64]) {
@@ -244,7 +229,7 @@ where
     }
 }
 
-/// Runs `f(state, acc, k, &mut items[k])` over every item, in fixed runs of `size` items (in
+/// Runs `f(state, acc, &mut item)` over every item, in fixed runs of `size` items (in
 /// parallel where threads are available); each run starts from `S::default()` and `init()`,
 /// goes through its items in order, and its accumulator comes back in run order. The runs do
 /// not depend on the thread count, so neither does any reduction of the accumulators in order.
@@ -254,28 +239,27 @@ where
     A: Send,
     S: Default,
     I: Fn() -> A + Sync + Send,
-    F: Fn(&mut S, &mut A, usize, &mut T) + Sync + Send,
+    F: Fn(&mut S, &mut A, &mut T) + Sync + Send,
 {
-    let size = size.max(1);
-    let run = |(c, run): (usize, &mut [T])| {
+    let run = |run: &mut [T]| {
         let (mut state, mut acc) = (S::default(), init());
-        for (j, t) in run.iter_mut().enumerate() {
-            f(&mut state, &mut acc, c * size + j, t);
+        for t in run {
+            f(&mut state, &mut acc, t);
         }
         acc
     };
+    let size = size.max(1);
     #[cfg(feature = "parallel")]
     {
         use rayon::prelude::*;
         items
             .par_chunks_mut(size)
-            .enumerate()
             .with_max_len(1)
             .map(run)
             .collect()
     }
     #[cfg(not(feature = "parallel"))]
-    items.chunks_mut(size).enumerate().map(run).collect()
+    items.chunks_mut(size).map(run).collect()
 }
 
 /// Indices per work unit of [`map_range_with_state`]: closest-point queries in tree order take

@@ -218,8 +218,8 @@ pub(crate) fn umeyama_pairs(
 /// shift near its points (for ICP the moved cloud's centroid, for both sides), and the centred
 /// sums follow from `Σ(b−μ_b)(a−μ_a)ᵀ = Σ b·aᵀ − n·μ_b·μ_aᵀ`. With each shift within a few
 /// spreads of its points, the cancellation costs a digit or two against [`umeyama_pairs`]' two
-/// passes. Partial sums over fixed runs
-/// merged in run order give the same bits for any thread count.
+/// passes. Partial sums over fixed runs merged in run order give the same bits for any thread
+/// count.
 #[derive(Clone, Copy)]
 pub(crate) struct PairSums {
     shift_src: [f64; 3],
@@ -485,10 +485,6 @@ mod tests {
         assert!(umeyama_weighted(&tri, &tri, Some(&[1.0, 1.0, -1.0]), true).is_err());
     }
 
-    /// The parallel sums give the one-by-one fit to rounding, across several runs of
-    /// `PAIRS_PER_SUM`, at ordinary and at extreme spreads (where both divide by the spread),
-    /// and the same bits on one thread as on several; degenerate pairs are errors as in
-    /// `umeyama`.
     /// `n` source points on a smooth curve of size `spread` around `offset`, and their images
     /// under `truth` with a small deterministic noise.
     fn noisy_pairs(
@@ -520,6 +516,10 @@ mod tests {
         (src, dst)
     }
 
+    /// The parallel sums give the one-by-one fit to rounding, across several runs of
+    /// `PAIRS_PER_SUM`, at ordinary and at extreme spreads (where both divide by the spread),
+    /// and the same bits on one thread as on several; degenerate pairs are errors as in
+    /// `umeyama`.
     #[test]
     fn pairs_in_parallel_equal_the_one_by_one_fit() {
         let n = 3 * PAIRS_PER_SUM + 17;
@@ -557,8 +557,8 @@ mod tests {
 
     /// The one-pass sums, in runs merged in order, against the two-pass fit: within 1e-12 with
     /// shifts inside the clouds, near the origin or 100 to 7000 spreads from it; extreme spreads
-    /// decline (the caller
-    /// then takes the two-pass fit); fewer than 3 pairs and collinear points are errors.
+    /// decline (the caller then takes the two-pass fit); fewer than 3 pairs and collinear points
+    /// are errors.
     #[test]
     fn one_pass_sums_equal_the_two_pass_fit_or_decline() {
         let n = 10_000;

@@ -104,7 +104,7 @@ fn matches(
         queries,
         RUN,
         || (PairSums::new(shift, shift), 0.0),
-        |hint: &mut NeighbourList, (sums, error2): &mut (PairSums, f64), _, query| {
+        |hint: &mut NeighbourList, (sums, error2): &mut (PairSums, f64), query| {
             if let Some(update) = update {
                 query.point = matrix::apply(update, query.point);
             }

@@ -190,11 +190,8 @@ impl<'a> Reference<'a> {
 }
 
 /// The scaled Umeyama fit of a sample's frames (`source[i]` to `target[i]`); the identity when
-/// they are degenerate.
+/// they are degenerate (fewer than 3, collinear, ...).
 fn fit(source: &[Point3], target: &[Point3], frames: &[u32]) -> Matrix4 {
-    if frames.is_empty() {
-        return IDENTITY;
-    }
     let src: Vec<Point3> = frames.iter().map(|&i| source[i as usize]).collect();
     let dst: Vec<Point3> = frames.iter().map(|&i| target[i as usize]).collect();
     umeyama(&src, &dst, true).map_or(IDENTITY, |s| s.matrix)

@@ -47,13 +47,15 @@ pub fn voxel_down_sample(points: &[Point3], size: f64) -> Result<Vec<Point3>> {
     // Voxels per axis (a point's index is at most the maximum's, computed the same way).
     let per_axis = [0, 1, 2].map(|k| ((max[k] - start[k]) / size).floor() + 1.0);
     let voxels = per_axis.iter().product::<f64>();
-    if voxels <= f64::from(u32::MAX) && u32::try_from(points.len()).is_ok() {
+    // Both sorted paths hold point indices in 32 bits; larger clouds take the hash map.
+    let indexable = u32::try_from(points.len()).is_ok();
+    if indexable && voxels <= f64::from(u32::MAX) {
         let [_, ny, nz] = per_axis.map(|c| c as u64);
         Ok(packed_means(points, |p| {
             let [x, y, z] = index(p).map(|i| u64::from(i as u32));
             (x * ny + y) * nz + z
         }))
-    } else if cells < f64::from(1u32 << 21) {
+    } else if indexable && cells < f64::from(1u32 << 21) {
         Ok(sorted_means(points, |p| {
             let [x, y, z] = index(p).map(|i| u64::from(i as u32));
             (x << 42) | (y << 21) | z
@@ -95,55 +97,54 @@ fn mean(sum: [f64; 3], n: u32) -> Point3 {
 }
 
 /// The voxel means, in the order of each voxel's first point, through a sort of the
-/// `(key, index)` pairs: a voxel's points are then one run, in input order.
+/// `(key, index)` pairs: a voxel's points are then one run, in input order (for grids of 2³²
+/// voxels or more, with 21 bits an axis).
 fn sorted_means(points: &[Point3], key: impl Fn(&Point3) -> u64 + Sync + Send) -> Vec<Point3> {
-    let mut keyed = parallel::map_range(points.len(), |i| (key(&points[i]), i as u32));
-    parallel::sort_unstable(&mut keyed);
-    let starts: Vec<usize> = (0..keyed.len())
-        .filter(|&k| k == 0 || keyed[k].0 != keyed[k - 1].0)
-        .collect();
-    let mut voxels = parallel::map_range(starts.len(), |v| {
-        let end = starts.get(v + 1).copied().unwrap_or(keyed.len());
-        let run = &keyed[starts[v]..end];
-        let mut sum = [0.0; 3];
-        for &(_, i) in run {
-            let p = points[i as usize];
-            for k in 0..3 {
-                sum[k] += p[k];
-            }
-        }
-        (run[0].1, mean(sum, run.len() as u32))
-    });
-    drop(keyed);
-    parallel::sort_unstable_by_key(&mut voxels, |&(first, _)| first);
-    voxels.into_iter().map(|(_, p)| p).collect()
+    let keyed = parallel::map_range(points.len(), |i| (key(&points[i]), i as u32));
+    means_in_first_order(points, keyed, |e| e.0, |e| e.1 as usize)
 }
 
 /// [`sorted_means`] for voxel numbers below 2³² (the common case): each point's voxel number
 /// and index packed in one `u64` (number above, index below), so that the sort compares plain
-/// integers (and keeps each voxel's points in input order), and the voxels put in the order of
-/// their first point through a second sort of packed `u64`s rather than of the means.
+/// integers (and keeps each voxel's points in input order).
 fn packed_means(points: &[Point3], voxel: impl Fn(&Point3) -> u64 + Sync + Send) -> Vec<Point3> {
-    let mut keyed = parallel::map_range(points.len(), |i| (voxel(&points[i]) << 32) | i as u64);
+    let keyed = parallel::map_range(points.len(), |i| (voxel(&points[i]) << 32) | i as u64);
+    means_in_first_order(
+        points,
+        keyed,
+        |e| e >> 32,
+        |e| (e & u64::from(u32::MAX)) as usize,
+    )
+}
+
+/// The means of the voxels `keyed` names (an entry a point, ordered by voxel and then by point
+/// index, read by `voxel_of` and `index_of`; fewer than 2³² points), in the order of each
+/// voxel's first point: `keyed` sorted makes each voxel's points one run in input order, and
+/// the voxels are put in first-point order by a second sort of packed `u64`s (first point,
+/// voxel) rather than of the means.
+fn means_in_first_order<E: Ord + Copy + Send + Sync>(
+    points: &[Point3],
+    mut keyed: Vec<E>,
+    voxel_of: impl Fn(E) -> u64 + Sync,
+    index_of: impl Fn(E) -> usize + Sync,
+) -> Vec<Point3> {
     parallel::sort_unstable(&mut keyed);
     let starts: Vec<usize> = (0..keyed.len())
-        .filter(|&k| k == 0 || keyed[k] >> 32 != keyed[k - 1] >> 32)
+        .filter(|&k| k == 0 || voxel_of(keyed[k]) != voxel_of(keyed[k - 1]))
         .collect();
-    let index = |k: usize| (keyed[k] & u64::from(u32::MAX)) as usize;
     let means = parallel::map_range(starts.len(), |v| {
         let end = starts.get(v + 1).copied().unwrap_or(keyed.len());
         let mut sum = [0.0; 3];
-        for k in starts[v]..end {
-            let p = points[index(k)];
+        for &e in &keyed[starts[v]..end] {
+            let p = points[index_of(e)];
             for a in 0..3 {
                 sum[a] += p[a];
             }
         }
         mean(sum, (end - starts[v]) as u32)
     });
-    // (first point's index, voxel) packed and sorted: the voxels in first-point order.
     let mut firsts = parallel::map_range(starts.len(), |v| {
-        ((index(starts[v]) as u64) << 32) | v as u64
+        ((index_of(keyed[starts[v]]) as u64) << 32) | v as u64
     });
     drop(keyed);
     parallel::sort_unstable(&mut firsts);
