@@ -11,6 +11,11 @@ mapped before comparing (numbers compare exactly, as parsed from the JSON text):
   `tau_percent_of_diagonal` (percent, = fraction * 100); `options.align` is the requested mode
   (was the method that ran, still in `alignment.method`); `cameras` keys come in declaration
   order (compared as objects, so order does not matter).
+  sfmeval.report/2 -> /3: `schema`; the `warnings` strings (and `cameras.warnings`) became typed
+  `notes` (and `cameras.notes`), and `alignment.stages[].note` moved into them: both sides' notes
+  and warnings are left out of the comparison (tests check the notes by code); with `--align
+  given` (or `icp`) and cameras, the pose errors are measured after the camera alignment, as
+  `auto` measures them, not after the final transform.
 
 Prints one line per case and exits 1 when any case differs. `DIR` holds demo depth maps
 (tests/browser/make_demo_depth.py) for the visibility and track-error case.
@@ -69,13 +74,23 @@ def run(binary, args, path):
 
 
 def upgrade(old, new):
-    """The /1 report `old` in /2 terms (`new` gives the requested mode)."""
-    if old.get("schema") != "sfmeval.report/1":
-        return old
-    old["schema"] = "sfmeval.report/2"
-    for t in old.get("thresholds", []):
-        t["tau_percent_of_diagonal"] = t.pop("tau_relative_to_diagonal") * 100
-    old["options"]["align"] = new["options"]["align"]
+    """The /1 or /2 report `old` in /3 terms (`new` gives the requested mode); the notes of both
+    are dropped (see the module's doc)."""
+    if old.get("schema") == "sfmeval.report/1":
+        old["schema"] = "sfmeval.report/2"
+        for t in old.get("thresholds", []):
+            t["tau_percent_of_diagonal"] = t.pop("tau_relative_to_diagonal") * 100
+        old["options"]["align"] = new["options"]["align"]
+    if old.get("schema") == "sfmeval.report/2":
+        old["schema"] = "sfmeval.report/3"
+    for rep in (old, new):
+        rep.pop("warnings", None)
+        rep.pop("notes", None)
+        for stage in rep.get("alignment", {}).get("stages", []):
+            stage.pop("note", None)
+        if rep.get("cameras"):
+            rep["cameras"].pop("warnings", None)
+            rep["cameras"].pop("notes", None)
     return old
 
 

@@ -572,7 +572,14 @@ function onPick(hit) {
 
 function showStages(report) {
   const a = report.alignment;
-  const rows = (a.stages || []).map((s) => `<tr><td>${esc(s.method)}</td><td>${g(s.scale)}</td><td>${s.rmse == null ? '—' : g(s.rmse)}</td><td>${s.inlier_ratio == null ? '—' : s.inlier_ratio.toFixed(4)}</td><td>${s.iterations}</td><td>${s.converged ? 'yes' : 'no'}</td></tr>`).join('');
+  // a stage's warnings (by their `values.stage`) mark its row; a rejected refinement says so
+  const notes = reportNotes(report);
+  const rows = (a.stages || []).map((s) => {
+    const own = notes.filter((n) => n.stage === s.method && n.level === 'warn');
+    const rejected = own.some((n) => n.code === 'alignment.icp_rejected');
+    const mark = own.length ? ` <span class="warn" data-stage-warnings="${own.length}" title="${own.length} warning(s) below">⚠</span>` : '';
+    return `<tr><td>${esc(s.method)}${mark}</td><td>${g(s.scale)}</td><td>${s.rmse == null ? '—' : g(s.rmse)}</td><td>${s.inlier_ratio == null ? '—' : s.inlier_ratio.toFixed(4)}</td><td>${s.iterations}</td><td>${rejected ? 'rejected' : s.converged ? 'yes' : 'no'}</td></tr>`;
+  }).join('');
   $('stages').innerHTML = `<tr><th>stage</th><th>scale</th><th>rmse</th><th>inliers</th><th>iter</th><th>conv.</th></tr>${rows}`;
   $('matrix').textContent = matrixText(a.gt_from_recon);
   $('matrix').title = `gt_from_recon, full precision:\n${a.gt_from_recon.map((r) => r.join(' ')).join('\n')}`;
@@ -596,92 +603,21 @@ export function matrixText(m) {
 }
 
 /**
- * The report's warnings for the page: alignment stage notes (written by the core as
- * "alignment (STAGE): NOTE; NOTE...") worded for users and split into routine information
- * and doubtful results (warnings, with the reason); every other warning stays a warning.
- * Also notes the final stage's fit: a warning when it did not settle with a loose fit
- * (rmse > 0.5 % of the GT diagonal or < 50 % of the points within its gate) or fitted few
- * points; information when it did not settle but fits tightly. Returns [{level, html}].
+ * The report's notes as the core wrote them (`rep.notes`: `{code, level, message, values}`,
+ * docs/notes.md): the level picks the style, the code goes on the element (`data-code`) and
+ * places stage notes beside their stage (`values.stage`); the message is shown as written. The
+ * page never reads the message text. Returns [{code, level, stage, html}].
  */
 export function reportNotes(rep) {
-  const out = [];
-  const diag = rep.inputs && rep.inputs.ground_truth ? rep.inputs.ground_truth.diagonal : 0;
-  for (const w of rep.warnings || []) {
-    const m = /^alignment \(([^)]*)\): (.*)$/s.exec(w);
-    if (!m) { out.push({ level: 'warn', html: `warning: ${esc(w)}` }); continue; }
-    const refined = !!(rep.alignment && rep.alignment.stages && rep.alignment.stages.some((s) => s.method === 'icp'));
-    for (const n of alignmentNotes(m[1], m[2], diag, refined)) out.push(n);
-  }
-  const a = rep.alignment;
-  const last = a && a.stages && a.stages[a.stages.length - 1];
-  const rejected = (rep.warnings || []).some((w) => /^alignment \(icp\): .*rejected, kept the start transform/.test(w));
-  if (last && !rejected && ['icp', 'global'].includes(last.method)) {
-    // The final stage's fit: rmse of the points inside its distance gate, share of them.
-    const ratio = last.inlier_ratio;
-    const rel = last.rmse != null && diag > 0 ? last.rmse / diag : null;
-    const name = { icp: 'ICP', global: 'global search' }[last.method];
-    const fit = `rmse ${last.rmse != null ? g(last.rmse) : '—'}${rel != null ? ` = ${(100 * rel).toPrecision(2)} % of the diagonal` : ''}${ratio != null ? `, ${(100 * ratio).toFixed(0)} % of the points within its distance gate` : ''}`;
-    if (ratio != null && ratio < FEW_INLIERS) {
-      out.push({ level: 'warn', html: `warning: ${name} fitted only ${(100 * ratio).toFixed(0)} % of the reconstruction's points <span class="why">— the others lie outside its distance gate of the ground truth (background, outliers, or part of the cloud misaligned); check the view</span>` });
-    }
-    if (!last.converged) {
-      // not settled but a tight fit on most points: the last steps are jitter, not a search
-      const tight = rel != null && rel <= TIGHT_RMSE && ratio != null && ratio >= FEW_INLIERS;
-      out.push(tight
-        ? { level: 'info', html: `alignment: ${name} stopped after ${last.iterations} iterations before its steps fell below the stopping tolerance <span class="why">— its fit is tight (${fit}), so this is unlikely to matter</span>` }
-        : { level: 'warn', html: `warning: ${name} stopped after ${last.iterations} iterations without settling, and its fit is loose (${fit}) <span class="why">— the transform may be imprecise; check the points against the ground truth in the viewer</span>` });
-    }
-  }
-  return out;
-}
-
-/** Below this share of points inside the last stage's gate, the fit is doubtful. */
-const FEW_INLIERS = 0.5;
-/** An rmse at most this fraction of the GT diagonal is a tight fit. */
-const TIGHT_RMSE = 0.005;
-
-/** The notes of one stage (see `reportNotes`), matched against what the core writes. */
-function alignmentNotes(stage, text, diag, refined) {
-  const stageName = { global: 'global shape search', icp: 'ICP refinement', cameras: 'camera-based alignment', points: 'point pairs' }[stage] || stage;
-  const pct = (v) => (diag > 0 ? ` (${(100 * v / diag).toPrecision(2)} % of the ground-truth diagonal)` : '');
-  const rules = [
-    // crates/sfmeval/src/align/global.rs
-    [/^best of (\d+) starts \(start #(\d+)\), score (\S+?)(?=; |$)/, 'info', (x) => {
-      const score = Number(x[3]);
-      return `alignment: a global shape search tried ${x[1]} starting poses; the best (#${x[2]}) scores ${esc(x[3])}${pct(score)}${refined ? ', then ICP refined it' : ''} <span class="why">— score: the mean of the smallest 80 % of distances from a subsample of the reconstruction to ground-truth surface samples, plus the same from those samples to the subsample, in ground-truth units; lower is better</span>`;
-    }],
-    [/^ambiguous: a pose (\d+)° away scores within 5 % \((\S+)\); the object may be symmetric(?=; |$)/, 'warn', (x) =>
-      `warning: the automatic alignment may have picked the wrong pose: another pose ${x[1]}° away fits almost as well (score ${esc(x[2])}, within 5 %) <span class="why">— the object may be symmetric; check the view, or give a transform or point pairs</span>`],
-    [/^(\d+) non-finite reconstruction point\(s\) ignored(?=; |$)/, 'warn', (x) =>
-      `warning: ${stageName}: ${x[1]} reconstruction point(s) with non-finite coordinates were ignored`],
-    // crates/sfmeval/src/align/icp.rs: the scale-collapse guard and the overlap check
-    [/^rejected, kept the start transform: (.*)$/s, 'warn', (x) =>
-      `warning: the ICP refinement was rejected, the previous stage's transform is used <span class="why">— ${esc(x[1])}</span>`],
-    // crates/sfmeval/src/align/auto.rs: fallbacks
-    [/^(cameras|points) stage failed \((.*?)\)(?=; |$)/s, 'warn', (x) =>
-      `warning: ${x[1] === 'cameras' ? 'the camera-based alignment' : 'the point-pair alignment'} failed <span class="why">— ${esc(x[2])}</span>`],
-    [/^fell back to (\w+)(?=; |$)/, 'warn', (x) =>
-      `warning: the alignment fell back to the ${x[1] === 'global' ? 'global shape search (no correspondences)' : esc(x[1])}`],
-    [/^ICP started from the identity \(no start transform given\)(?=; |$)/, 'warn', () =>
-      'warning: ICP started from the identity (no start transform was given) <span class="why">— it converges only when the reconstruction is already close to the ground truth</span>'],
-    // crates/sfmeval/src/align/ransac.rs
-    [/^(\d+) of (\d+) cameras are outliers \(farther than (\S+) from their ground-truth centre\)(?=; |$)/, 'warn', (x) =>
-      `warning: the camera-based alignment left out ${x[1]} of ${x[2]} cameras as outliers <span class="why">— their centres end farther than ${esc(x[3])} from the ground-truth ones</span>`],
-    [/^(\d+) camera pair\(s\) with non-finite poses skipped(?=; |$)/, 'warn', (x) =>
-      `warning: the camera-based alignment skipped ${x[1]} camera(s) with non-finite poses`],
-    [/^camera centres (fewer than 3|nearly collinear): rotation from the camera orientations, scale and translation from the centres(?=; |$)/, 'info', (x) =>
-      `alignment: the camera centres are ${esc(x[1])}, so the rotation comes from the camera orientations and the scale and translation from the centres`],
-  ];
-  const out = [];
-  let rest = text;
-  while (rest) {
-    const hit = rules.map(([re, level, f]) => [re.exec(rest), level, f]).find(([x]) => x);
-    if (!hit) { out.push({ level: 'warn', html: `warning: alignment (${esc(stage)}): ${esc(rest)}` }); break; }
-    const [x, level, f] = hit;
-    out.push({ level, html: f(x) });
-    rest = rest.slice(x[0].length).replace(/^; /, '');
-  }
-  return out;
+  return (rep.notes || []).map((n) => {
+    const warning = n.level === 'warning';
+    return {
+      code: n.code,
+      level: warning ? 'warn' : 'info',
+      stage: (n.values && n.values.stage) || null,
+      html: `${warning ? 'warning' : 'note'}: ${esc(n.message)}`,
+    };
+  });
 }
 
 // ---- crop -------------------------------------------------------------------------------
@@ -902,7 +838,7 @@ function showResults(r) {
     const cams = Object.entries(rep.cameras).filter(([, v]) => typeof v === 'number').map(([k, v]) => `${esc(k)} ${Number.isInteger(v) ? v : g(v)}`);
     h += `<div class="line" id="r-cameras">cameras: ${cams.join(', ')}</div>`;
   }
-  for (const n of reportNotes(rep)) h += `<div class="${n.level}">${n.level === 'info' ? 'note: ' : ''}${n.html}</div>`;
+  for (const n of reportNotes(rep)) h += `<div class="${n.level}" data-code="${esc(n.code)}">${n.html}</div>`;
   $('summary').innerHTML = h;
   showStages(rep);
   for (const b of ['dl-report', 'dl-ply', 'dl-csv']) $(b).disabled = false;

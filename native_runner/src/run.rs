@@ -581,7 +581,8 @@ fn collect(work: &Path, output: &Path, rec: &mut RunRecord) -> Result<()> {
         bail!("the tool wrote no model or cloud into its output folder");
     }
     let input = sfmeval::pipeline::read_reconstruction(&rec.pipeline, &files)?;
-    rec.warnings.extend(input.warnings.iter().cloned());
+    rec.warnings
+        .extend(input.notes.iter().map(|n| n.message.clone()));
     let model_dir = work.join("model");
     std::fs::create_dir_all(&model_dir)?;
     if let Some(model) = &input.model {

@@ -352,34 +352,29 @@ try {
     await page.context().close();
   }
 
-  // ---- the page's wording of the core's alignment notes (crates/sfmeval/src/align) ---------
+  // ---- the core's typed notes: the page shows them by code and level, never by their words ----
   {
     const page = await newPage(1366, 768);
     const notes = await page.evaluate(() => {
-      const rep = (warnings, stages) => ({ warnings, inputs: { ground_truth: { diagonal: 2 } }, alignment: { stages } });
-      const ok = [{ method: 'global', converged: true, iterations: 34 }, { method: 'icp', converged: true, iterations: 12 }];
-      const f = (w, s = ok) => window.sfmeval.reportNotes(rep(w, s)).map((n) => [n.level, n.html.replace(/<[^>]+>/g, '')]);
-      return {
-        routine: f(['alignment (global): best of 240 starts (start #18), score 5.258e-2']),
-        ambiguous: f(['alignment (global): best of 240 starts (start #3), score 1.000e-2; ambiguous: a pose 180° away scores within 5 % (1.020e-2); the object may be symmetric']),
-        fallback: f(['alignment (global): cameras stage failed (only 1 matched camera with a finite pose: the cameras stage needs at least 3 (2 with orientations)); fell back to global; best of 240 starts (start #0), score 3.000e-2']),
-        rejected: f(['alignment (icp): rejected, kept the start transform: the scale drifted to the bound ×1.250 of the start (scale 1.000000 → 1.250000): likely a collapse onto part of the surface'],
-          [{ method: 'global', converged: true }, { method: 'icp', converged: false, iterations: 60 }]),
-        notConvergedLoose: f([], [{ method: 'cameras', converged: true }, { method: 'icp', converged: false, iterations: 100, rmse: 0.03, inlier_ratio: 0.9 }]),
-        notConvergedTight: f([], [{ method: 'cameras', converged: true }, { method: 'icp', converged: false, iterations: 100, rmse: 0.001, inlier_ratio: 0.9 }]),
-        fewInliers: f([], [{ method: 'global', converged: true }, { method: 'icp', converged: true, iterations: 20, rmse: 0.001, inlier_ratio: 0.3 }]),
-        other: f(['the SfM model has no 3D points']),
+      // messages reworded on purpose: the page must still show each note by its code and level
+      const rep = {
+        notes: [
+          { code: 'alignment.global_search_result', level: 'info', message: 'REWORDED search <b>', values: { stage: 'global', starts: 240 } },
+          { code: 'alignment.icp_rejected', level: 'warning', message: 'REWORDED refinement text', values: { stage: 'icp', reason: 'scale_drift' } },
+          { code: 'alignment.unsettled_tight_fit', level: 'info', message: 'REWORDED tight', values: { stage: 'icp', min_inlier_ratio: 0.5 } },
+          { code: 'input.model_no_points', level: 'warning', message: 'REWORDED no points' },
+        ],
       };
+      return window.sfmeval.reportNotes(rep);
     });
-    const levels = (l) => l.map((n) => n[0]).join(',');
-    check('alignment-note-routine-is-information', levels(notes.routine) === 'info' && /240 starting poses/.test(notes.routine[0][1])
-      && /scores 5\.258e-2 \(2\.6 % of the ground-truth diagonal\), then ICP refined it/.test(notes.routine[0][1]) && /smallest 80 % of distances/.test(notes.routine[0][1]), JSON.stringify(notes.routine));
-    check('alignment-note-doubtful-is-warning', levels(notes.ambiguous) === 'info,warn' && /symmetric/.test(notes.ambiguous[1][1])
-      && levels(notes.fallback) === 'warn,warn,info' && /needs at least 3 \(2 with orientations\)/.test(notes.fallback[0][1])
-      && levels(notes.rejected) === 'warn' && /rejected.*collapse/.test(notes.rejected[0][1])
-      && levels(notes.notConvergedLoose) === 'warn' && /without settling.*1\.5 % of the diagonal/.test(notes.notConvergedLoose[0][1])
-      && levels(notes.notConvergedTight) === 'info' && levels(notes.fewInliers) === 'warn' && /only 30 %/.test(notes.fewInliers[0][1])
-      && levels(notes.other) === 'warn', JSON.stringify(notes));
+    const want = [
+      ['alignment.global_search_result', 'info', 'global', 'note: REWORDED search &lt;b&gt;'],
+      ['alignment.icp_rejected', 'warn', 'icp', 'warning: REWORDED refinement text'],
+      ['alignment.unsettled_tight_fit', 'info', 'icp', 'note: REWORDED tight'],
+      ['input.model_no_points', 'warn', null, 'warning: REWORDED no points'],
+    ];
+    const got = notes.map((n) => [n.code, n.level, n.stage, n.html]);
+    check('notes-shown-by-code-and-level-with-the-core-words', JSON.stringify(got) === JSON.stringify(want), JSON.stringify(got));
     await page.context().close();
   }
 } catch (e) {

@@ -279,7 +279,8 @@ def test_eval_icp_from_a_transform_file_and_from_the_identity(run_eval, suzanne_
     pts_gt = apply(truth, recon)
     write_ply(tmp_path / "near.ply", apply(np.linalg.inv(near), pts_gt))
     rep, m = eval_align(run_eval, tmp_path / "near.ply", "--align", "icp")
-    assert any("identity" in w for w in rep["warnings"]), rep["warnings"]
+    assert any(n["code"] == "alignment.icp_from_identity" and "identity" in n["message"]
+               for n in rep["notes"]), rep["notes"]
     assert rot_err_deg(m, near) < 0.1 and scale_err(m, near) < 0.002, rep["alignment"]
     # The accuracy after ICP is at the noise level (0.2 % of the diagonal, 3D RMS).
     diag = np.linalg.norm(v.max(0) - v.min(0))

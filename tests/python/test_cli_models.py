@@ -158,8 +158,8 @@ def test_ply_camera_centres_are_removed_and_counted(case, scene, run_eval, tmp_p
     rep, _ = run_eval(scene, ply, "--transform", tmp_path / "t.txt", "--samples", 20000)
     n = len(centres)
     assert n == 6
-    removed = [w for w in rep["warnings"] if f"removed {n} point(s)" in w]
-    assert len(removed) == 1, rep["warnings"]
+    removed = [w for w in [n["message"] for n in rep["notes"]] if f"removed {n} point(s)" in w]
+    assert len(removed) == 1, [n["message"] for n in rep["notes"]]
     assert rep["inputs"]["reconstruction"]["points"] == ply_vertex_count(ply) - n
     ref, _ = run_eval(scene, model, "--transform", tmp_path / "t.txt", "--samples", 20000)
     assert rep["accuracy"]["count"] == ref["accuracy"]["count"]
@@ -186,7 +186,7 @@ def test_ply_with_model_cameras_is_stripped_at_the_centres(scene, run_eval, tmp_
     # Alone: the recoloured centres are not markers, nothing is removed.
     rep, _ = run_eval(scene, ply, "--samples", 20000)
     assert rep["inputs"]["reconstruction"]["points"] == 107
-    assert not any("removed" in w for w in rep["warnings"]), rep["warnings"]
+    assert not any("removed" in w for w in [n["message"] for n in rep["notes"]]), [n["message"] for n in rep["notes"]]
     # The reference: theia.nvm's own points and cameras.
     ref, _ = run_eval(scene, MODELS / "theia.nvm", "--align", "cameras",
                       "--gt-cameras", GT_CAMERAS, "--samples", 20000)
@@ -200,7 +200,7 @@ def test_ply_with_model_cameras_is_stripped_at_the_centres(scene, run_eval, tmp_
         inp = rep["inputs"]["reconstruction"]
         assert (inp["format"], inp["points"], inp["images"]) == ("ply+nvm", 101, 6)
         assert any("removed 6 point(s) at the 6 known camera centre(s)" in w
-                   for w in rep["warnings"]), rep["warnings"]
+                   for w in [n["message"] for n in rep["notes"]]), [n["message"] for n in rep["notes"]]
         assert rep["cameras"]["matched"] == 6
         np.testing.assert_allclose(rep["alignment"]["gt_from_recon"],
                                    ref["alignment"]["gt_from_recon"], rtol=0, atol=1e-12)
@@ -285,10 +285,13 @@ def test_one_matched_camera_falls_back_to_global_or_errors(sfmeval_bin, scene, t
     d = edited_model(tmp_path, "one", rename_except(1))
     p, rep = run_bad(sfmeval_bin, scene, d, "auto", tmp_path)
     assert rep["alignment"]["method"] == "global+icp"
-    assert any(w.startswith("alignment (global): cameras stage failed (unusable geometry: "
-                            "only 1 matched camera") and "fell back to global" in w
-               for w in rep["warnings"]), rep["warnings"]
-    assert any("only 1 camera(s) matched" in w for w in rep["warnings"]), rep["warnings"]
+    notes = rep["notes"]
+    assert any(n["code"] == "alignment.stage_failed" and n["values"]["stage"] == "cameras"
+               and n["values"]["error"].startswith("unusable geometry: only 1 matched camera")
+               for n in notes), notes
+    assert any(n["code"] == "alignment.fell_back" and n["values"]["to"] == "global"
+               for n in notes), notes
+    assert any("only 1 camera(s) matched" in w for w in [n["message"] for n in rep["notes"]]), [n["message"] for n in rep["notes"]]
     p, rep = run_bad(sfmeval_bin, scene, d, "cameras", tmp_path)
     assert rep is None and "needs at least 3 (2 with orientations)" in p.stderr, p.stderr
 
@@ -298,8 +301,8 @@ def test_two_matched_cameras_use_their_orientations(sfmeval_bin, scene, tmp_path
     centres; said in the warnings, and still close to the 6-camera fit."""
     d = edited_model(tmp_path, "two", rename_except(2))
     p, rep = run_bad(sfmeval_bin, scene, d, "cameras", tmp_path)
-    assert any("fewer than 3" in w and "orientations" in w for w in rep["warnings"]), rep
-    assert any("only 2 camera(s) matched" in w for w in rep["warnings"]), rep["warnings"]
+    assert any("fewer than 3" in w and "orientations" in w for w in [n["message"] for n in rep["notes"]]), rep
+    assert any("only 2 camera(s) matched" in w for w in [n["message"] for n in rep["notes"]]), [n["message"] for n in rep["notes"]]
     full, src, names = umeyama_to_gt(colmap_centres(MODELS / "colmap_text" / "images.txt"))
     m = np.array(rep["alignment"]["gt_from_recon"])
     err = np.linalg.norm(apply(m, src) - np.array([GT[n] for n in names]), axis=1)
@@ -309,7 +312,11 @@ def test_two_matched_cameras_use_their_orientations(sfmeval_bin, scene, tmp_path
 def test_identical_centres_fall_back_or_error(sfmeval_bin, scene, tmp_path):
     d = edited_model(tmp_path, "same", same_centre)
     p, rep = run_bad(sfmeval_bin, scene, d, "auto", tmp_path)
-    assert any("coincide" in w and "fell back to global" in w for w in rep["warnings"]), rep
+    notes = rep["notes"]
+    assert any(n["code"] == "alignment.stage_failed" and "coincide" in n["message"]
+               for n in notes), notes
+    assert any(n["code"] == "alignment.fell_back" and n["values"]["to"] == "global"
+               for n in notes), notes
     assert rep["alignment"]["stages"][0]["method"] == "global"
     p, rep = run_bad(sfmeval_bin, scene, d, "cameras", tmp_path)
     assert rep is None and "coincide" in p.stderr, p.stderr
@@ -327,9 +334,9 @@ def test_no_name_match_skips_cameras_with_a_warning(sfmeval_bin, scene, tmp_path
     p, rep = run_bad(sfmeval_bin, scene, d, "auto", tmp_path)
     assert rep.get("cameras") is None
     assert any(w.startswith("cameras: none of the 6 estimated image(s) matches")
-               and "estimate 'x_" in w for w in rep["warnings"]), rep["warnings"]
+               and "estimate 'x_" in w for w in [n["message"] for n in rep["notes"]]), [n["message"] for n in rep["notes"]]
     assert any(w.startswith("alignment (global): cameras stage skipped")
-               for w in rep["warnings"]), rep["warnings"]
+               for w in [n["message"] for n in rep["notes"]]), [n["message"] for n in rep["notes"]]
     assert rep["alignment"]["method"] == "global+icp"
     p, rep = run_bad(sfmeval_bin, scene, d, "cameras", tmp_path)
     assert rep is None and "none of the 6 estimated image(s) matches" in p.stderr, p.stderr

@@ -417,7 +417,7 @@ def test_unknown_colmap_image_size_is_a_warning(evaluate, scene, tmp_path):
     kind, rep = evaluate("--gt", scene, "--recon", tmp_path / "sparse",
                          "--gt-cameras", MODELS / "gt_cameras.json")
     assert kind == "ok", rep
-    assert any("camera 1" in w and "unknown" in w for w in rep["warnings"]), rep["warnings"]
+    assert any("camera 1" in w and "unknown" in w for w in [n["message"] for n in rep["notes"]]), [n["message"] for n in rep["notes"]]
     assert rep["cameras"]["matched"] == 6
 
 
@@ -548,5 +548,5 @@ def test_ground_truth_camera_warnings_reach_the_report(evaluate, tmp_path):
     kind, rep = evaluate("--gt", ROOT / "tests" / "fixtures" / "core" / "trimesh_mesh.glb",
                          "--gt-cameras", gt_cams, "--recon", MODELS / "colmap_text", "--align", "cameras")
     assert kind == "ok", rep
-    hits = [w for w in rep["warnings"] if w.startswith("ground-truth cameras: ")]
-    assert hits and "principal point" in hits[0] and "outside" in hits[0], rep["warnings"]
+    hits = [w for w in [n["message"] for n in rep["notes"]] if w.startswith("ground-truth cameras: ")]
+    assert hits and "principal point" in hits[0] and "outside" in hits[0], [n["message"] for n in rep["notes"]]

@@ -499,8 +499,8 @@ fn align_cmd(input: &InputArgs, out: Option<&Path>, seed: u64) -> Result<()> {
         a.method, a.scale, a.rmse, a.converged
     );
     print!("{text}");
-    for w in &evaluation.report.warnings {
-        eprintln!("warning: {w}");
+    for n in &evaluation.report.notes {
+        eprintln!("{}: {}", n.level.as_str(), n.message);
     }
     Ok(())
 }
@@ -574,8 +574,8 @@ fn info(path: &Path, limits: &ReadLimits) -> Result<()> {
         println!("          max {:?}", b.max);
         println!("diagonal  {}", b.diagonal());
     }
-    for w in &gt.warnings {
-        println!("warning   {w}");
+    for n in &gt.notes {
+        println!("{:<9} {}", n.level.as_str(), n.message);
     }
     Ok(())
 }

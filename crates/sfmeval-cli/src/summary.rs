@@ -186,8 +186,8 @@ pub fn render(r: &Report) -> String {
             c.alignment.scale,
         ));
     }
-    for w in &r.warnings {
-        let _ = writeln!(s, "warning: {w}");
+    for n in &r.notes {
+        let _ = writeln!(s, "{}: {}", n.level.as_str(), n.message);
     }
     s
 }
@@ -228,8 +228,8 @@ pub fn render_cameras(c: &CamerasReport, stage: &str, scale: f64) -> String {
         g(c.ate_rmse),
         g(c.center_error_percent.mean)
     );
-    for w in &c.warnings {
-        let _ = writeln!(s, "warning: {w}");
+    for n in &c.notes {
+        let _ = writeln!(s, "{}: {}", n.level.as_str(), n.message);
     }
     s
 }

@@ -126,7 +126,9 @@ pub fn tnt_cmd(args: &TntArgs) -> Result<()> {
     };
     std::fs::create_dir_all(&out).with_context(|| format!("cannot create '{}'", out.display()))?;
     let mut report = evaluation.report.clone();
-    report.warnings.extend(recon.warnings);
+    report
+        .warnings
+        .extend(recon.notes.into_iter().map(|n| n.message));
     let json = serde_json::to_string_pretty(&report)? + "\n";
     write_atomic(&out.join("report.json"), json.as_bytes())?;
     let name = &scene.name;

@@ -182,10 +182,10 @@ impl GroundTruth {
             .unwrap_or_default()
     }
 
-    /// Notes from reading.
+    /// The messages of the notes from reading (the report lists them typed, in `notes`).
     #[wasm_bindgen(getter)]
     pub fn warnings(&self) -> Vec<String> {
-        self.dataset.loaded.warnings.clone()
+        messages(&self.dataset.loaded.notes)
     }
 
     /// Attaches the ground-truth cameras used by later evaluations (camera alignment and pose
@@ -316,10 +316,10 @@ impl Reconstruction {
         })
     }
 
-    /// Notes from reading.
+    /// The messages of the notes from reading (the report lists them typed, in `notes`).
     #[wasm_bindgen(getter)]
     pub fn warnings(&self) -> Vec<String> {
-        self.input.warnings.clone()
+        messages(&self.input.notes)
     }
 }
 
@@ -706,4 +706,9 @@ pub fn parse_point_pairs_text(text: &str) -> Result<JsValue, JsError> {
     pairs
         .serialize(&serde_wasm_bindgen::Serializer::json_compatible())
         .map_err(|e| js_err("point pairs", e.to_string()))
+}
+
+/// The messages of notes, for a loader's line in the page.
+fn messages(notes: &[sfmeval::note::Note]) -> Vec<String> {
+    notes.iter().map(|n| n.message.clone()).collect()
 }

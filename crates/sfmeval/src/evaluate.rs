@@ -9,6 +9,7 @@ use crate::distance::slot_tree::{SlotTree, kd_order};
 use crate::error::{Error, Result};
 use crate::geometry::{Point3, Positions, permute_in_place};
 use crate::metrics::{Thresholds, f_score, share_below};
+use crate::note::{Code, Note};
 use crate::parallel;
 use crate::prepared::PreparedGroundTruth;
 use crate::progress::{Progress, Stage};
@@ -109,8 +110,8 @@ pub struct InputInfo {
     pub gt_name: String,
     /// Ground-truth format.
     pub gt_format: String,
-    /// Warnings from reading.
-    pub warnings: Vec<String>,
+    /// Notes from reading and aligning.
+    pub notes: Vec<Note>,
 }
 
 /// Why a reconstructed point was discarded.
@@ -201,7 +202,7 @@ impl AlignmentInput {
             inlier_ratio: None,
             iterations: 0,
             converged: true,
-            note: None,
+            notes: Vec::new(),
         };
         AlignmentInput {
             gt_from_recon: t,
@@ -337,7 +338,7 @@ pub fn evaluate(
         });
     }
     let n = recon.len();
-    let mut warnings = info.warnings.clone();
+    let mut warnings = info.notes.clone();
     let t = alignment.gt_from_recon;
     crate::geometry::check_finite_with("aligned reconstruction", "point", n, |i| {
         t.apply(recon.get(i))
@@ -378,7 +379,10 @@ pub fn evaluate(
     }
     progress.finish();
     if options.signed && !gt.is_mesh() {
-        warnings.push("signed distances need a mesh ground truth; reported unsigned only".into());
+        warnings.push(Note::new(
+            Code::SignedNeedsMesh,
+            "signed distances need a mesh ground truth; reported unsigned only",
+        ));
     }
 
     let crop = &options.crop;
@@ -415,7 +419,10 @@ pub fn evaluate(
         count(PointStatus::TooFar),
     );
     if kept_n == 0 {
-        warnings.push("the crop discarded every reconstructed point".into());
+        warnings.push(Note::new(
+            Code::CropDiscardedEverything,
+            "the crop discarded every reconstructed point",
+        ));
     }
 
     // The ground truth's own samples while the searches run (no copy without a crop volume:
@@ -451,7 +458,10 @@ pub fn evaluate(
         d
     };
     if completeness_points.is_empty() {
-        warnings.push("no ground-truth sample lies inside the crop volume".into());
+        warnings.push(Note::new(
+            Code::NoGroundTruthInCrop,
+            "no ground-truth sample lies inside the crop volume",
+        ));
     }
 
     let diagonal = gt.aabb.diagonal();
@@ -559,7 +569,7 @@ pub fn evaluate(
         cameras: None,
         completeness_visible: None,
         track_error: None,
-        warnings,
+        notes: warnings,
     };
     Ok(Evaluation {
         report,

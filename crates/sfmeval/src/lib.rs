@@ -52,6 +52,7 @@ pub mod gt_views;
 pub mod io;
 pub mod metrics;
 pub mod model;
+pub mod note;
 pub mod parallel;
 pub mod pipeline;
 pub mod pose;

@@ -16,6 +16,7 @@ use crate::geometry::PointCloud;
 use crate::gt_views::GtView;
 use crate::io;
 use crate::model::{self, Reconstruction};
+use crate::note::{Code, Note};
 use crate::pose::{PoseOptions, evaluate_cameras_matched};
 use crate::prepared::PreparedGroundTruth;
 use crate::progress::{Progress, Stage};
@@ -36,7 +37,7 @@ pub struct ReconInput {
     /// a PLY cloud with the cameras of a model.
     pub format: String,
     /// Notes for the report.
-    pub warnings: Vec<String>,
+    pub notes: Vec<Note>,
     /// Whether `cloud` is the model's own points in order ([`Reconstruction::to_point_cloud`]),
     /// so that per-point model data (tracks) lines up with the evaluated points.
     pub cloud_is_model_points: bool,
@@ -86,15 +87,18 @@ pub fn read_reconstruction(name: &str, files: &BTreeMap<String, Vec<u8>>) -> Res
             });
         }
         let cloud = rec.to_point_cloud();
-        let mut warnings = rec.warnings.clone();
+        let mut notes = rec.notes.clone();
         if cloud.points.is_empty() {
-            warnings.push("the SfM model has no 3D points".into());
+            notes.push(Note::new(
+                Code::ModelNoPoints,
+                "the SfM model has no 3D points",
+            ));
         }
         return Ok(ReconInput {
             cloud,
             name: name.to_string(),
             format: rec.format.to_string(),
-            warnings,
+            notes,
             model: Some(rec),
             cloud_is_model_points: true,
         });
@@ -110,15 +114,15 @@ pub fn read_reconstruction(name: &str, files: &BTreeMap<String, Vec<u8>>) -> Res
 /// the front end, [`io::point_cloud_from_ply`]), as [`read_reconstruction`] makes it from the
 /// cloud's file.
 pub fn reconstruction_from_cloud(name: &str, loaded: io::LoadedCloud) -> ReconInput {
-    let mut warnings = loaded.warnings;
+    let mut notes = loaded.notes;
     let stripped = model::strip::strip_camera_points(loaded.cloud, None, name);
-    warnings.extend(stripped.warning);
+    notes.extend(stripped.note);
     ReconInput {
         cloud: stripped.cloud,
         model: None,
         name: name.to_string(),
         format: loaded.format.name().to_string(),
-        warnings,
+        notes,
         cloud_is_model_points: false,
     }
 }
@@ -178,27 +182,41 @@ fn cloud_with_cameras(
         });
     }
     let loaded = io::read_point_cloud(file_name, bytes)?;
-    let mut warnings = cameras.warnings.clone();
-    warnings.extend(loaded.warnings);
-    warnings.push(format!(
-        "evaluating the points of '{file_name}' with the {} camera(s) of the {} model '{cameras_name}'",
-        cameras.images.len(),
-        cameras.format
-    ));
+    let mut notes = cameras.notes.clone();
+    notes.extend(loaded.notes);
+    notes.push(
+        Note::new(
+            Code::CloudWithModelCameras,
+            format!(
+                "evaluating the points of '{file_name}' with the {} camera(s) of the {} model '{cameras_name}'",
+                cameras.images.len(),
+                cameras.format
+            ),
+        )
+        .with("cloud", file_name)
+        .with("model", cameras_name)
+        .with("cameras", cameras.images.len()),
+    );
     let centers = cameras.camera_centers();
     let stripped = model::strip::strip_camera_points(loaded.cloud, Some(&centers), file_name);
     if !stripped.by_centers {
-        warnings.push(format!(
-            "no point of '{file_name}' lies at one of the {} camera centres of '{cameras_name}' (fine for a cloud without camera points; otherwise they are not in one frame)",
-            centers.len()
-        ));
+        notes.push(
+            Note::new(
+                Code::NoPointAtCameraCentres,
+                format!(
+                    "no point of '{file_name}' lies at one of the {} camera centres of '{cameras_name}' (fine for a cloud without camera points; otherwise they are not in one frame)",
+                    centers.len()
+                ),
+            )
+            .with("cameras", centers.len()),
+        );
     }
-    warnings.extend(stripped.warning);
+    notes.extend(stripped.note);
     Ok(ReconInput {
         cloud: stripped.cloud,
         name: name.to_string(),
         format: format!("{}+{}", loaded.format.name(), cameras.format),
-        warnings,
+        notes,
         model: Some(cameras),
         cloud_is_model_points: false,
     })
@@ -267,17 +285,18 @@ pub fn run_owned(
         ));
     };
     let gt_cameras = dataset.cameras();
-    let gt_camera_warnings = gt_cameras
-        .into_iter()
-        .flat_map(|c| &c.warnings)
-        .map(|w| format!("ground-truth cameras: {w}"));
-    let mut warnings: Vec<String> = dataset
+    let gt_camera_notes = gt_cameras.into_iter().flat_map(|c| &c.notes).map(|n| {
+        n.clone()
+            .prefixed("ground-truth cameras: ")
+            .with("side", "ground_truth")
+    });
+    let mut notes: Vec<Note> = dataset
         .loaded
-        .warnings
+        .notes
         .iter()
         .cloned()
-        .chain(gt_camera_warnings)
-        .chain(recon.warnings.iter().cloned())
+        .chain(gt_camera_notes)
+        .chain(recon.notes.iter().cloned())
         .collect();
     let (pairs, matches) = match (gt_cameras, &recon.model) {
         (Some(g), Some(e)) => {
@@ -287,7 +306,10 @@ pub fn run_owned(
         _ => (Vec::new(), None),
     };
     if gt_cameras.is_some() && recon.model.is_none() {
-        warnings.push("ground-truth cameras were given but the reconstruction has no cameras (a bare point cloud): no camera-based alignment or pose metrics".into());
+        notes.push(Note::new(
+            Code::ReconstructionHasNoCameras,
+            "ground-truth cameras were given but the reconstruction has no cameras (a bare point cloud): no camera-based alignment or pose metrics",
+        ));
     }
     // Cameras on both sides but no image name in common: say so once, skip the camera stage
     // and the pose metrics instead of failing the whole evaluation.
@@ -296,8 +318,9 @@ pub fn run_owned(
         _ => None,
     };
     if let Some(detail) = &no_match {
-        warnings.push(format!(
-            "cameras: {detail}: no camera alignment and no pose metrics"
+        notes.push(Note::new(
+            Code::NoImageInCommon,
+            format!("cameras: {detail}: no camera alignment and no pose metrics"),
         ));
     }
     let alignment = align_recon(
@@ -309,14 +332,15 @@ pub fn run_owned(
         request,
         progress,
     )?;
-    warnings.extend(align::stage_notes(&alignment.report));
+    notes.extend(align::stage_notes(&alignment.report));
+    notes.extend(align::fit_verdict(&alignment.report, gt.aabb.diagonal()));
     let info = InputInfo {
         recon_name: recon.name.clone(),
         recon_format: recon.format.clone(),
         recon_images: recon.model.as_ref().map_or(0, |m| m.images.len() as u64),
         gt_name: dataset.name.clone(),
         gt_format: dataset.loaded.format.name().into(),
-        warnings,
+        notes,
     };
     let points = std::mem::take(&mut recon.cloud.points);
     recon.cloud.colors = None;
@@ -326,23 +350,26 @@ pub fn run_owned(
             g,
             e,
             m,
+            &pairs,
             &alignment,
-            &request.pose,
+            request,
             &mut evaluation,
         )?);
     }
     if let Some(views) = dataset.views() {
         add_visibility(&mut evaluation, views, request, progress);
         match (gt_cameras, &recon.model) {
-            (Some(_), Some(_)) if !recon.cloud_is_model_points => evaluation.report.warnings.push(
-                "depth maps were given but the evaluated cloud is not the SfM model's own points: no track-based error".into(),
-            ),
+            (Some(_), Some(_)) if !recon.cloud_is_model_points => evaluation.report.notes.push(Note::new(
+                Code::NoTrackError,
+                "depth maps were given but the evaluated cloud is not the SfM model's own points: no track-based error",
+            )),
             (Some(g), Some(e)) if e.points.iter().any(|p| !p.track.is_empty()) => {
                 add_track_error(&mut evaluation, g, e, views, &alignment, request, progress)?;
             }
-            _ => evaluation.report.warnings.push(
-                "depth maps were given but the reconstruction has no tracks (or no ground-truth cameras): no track-based error".into(),
-            ),
+            _ => evaluation.report.notes.push(Note::new(
+                Code::NoTrackError,
+                "depth maps were given but the reconstruction has no tracks (or no ground-truth cameras): no track-based error",
+            )),
         }
     }
     Ok(evaluation)
@@ -387,14 +414,16 @@ fn align_recon(
     if let (AlignMethod::Auto, Some(detail)) = (method, no_match)
         && let Some(first) = report.stages.first_mut()
     {
-        let fallback = format!(
-            "cameras stage skipped ({detail}); fell back to {}",
-            first.method
-        );
-        first.note = Some(match first.note.take() {
-            Some(old) => format!("{fallback}; {old}"),
-            None => fallback,
-        });
+        let mut notes = vec![
+            Note::new(
+                Code::StageFailed,
+                format!("the camera-based alignment was skipped: {detail}"),
+            )
+            .with("stage", "cameras"),
+            align::fell_back(&first.method),
+        ];
+        notes.append(&mut first.notes);
+        first.notes = notes;
     }
     Ok(AlignmentInput {
         gt_from_recon: t,
@@ -403,16 +432,20 @@ fn align_recon(
     })
 }
 
-/// The pose errors of the matched cameras. They are measured after the camera stage when
-/// there is one (as ATE aligns the trajectory itself): the point refinement may move the scale
-/// by the SfM's own camera/point inconsistency (e.g. a focal error), which the point metrics
-/// then show.
+/// The pose errors of the matched cameras, measured after the camera alignment whatever the
+/// points were aligned by (as ATE aligns the trajectory itself): the camera stage's transform
+/// when one ran, else the same camera alignment run for the poses alone (so `given`, `icp` and
+/// `global` report the pose errors `auto` reports). The point refinement may move the scale by
+/// the SfM's own camera/point inconsistency (e.g. a focal error), which the point metrics then
+/// show. Only when the cameras cannot be aligned (fewer than 3 usable pairs) are the poses
+/// measured after the final transform; `cameras.alignment.stage` names the transform used.
 fn camera_section(
     gt_cameras: &Reconstruction,
     est: &Reconstruction,
     matches: &model::matching::ImageMatches,
+    pairs: &[CameraPair],
     alignment: &AlignmentInput,
-    pose: &PoseOptions,
+    request: &EvalRequest,
     evaluation: &mut Evaluation,
 ) -> Result<CamerasSection> {
     let camera_stage = alignment
@@ -422,13 +455,30 @@ fn camera_section(
         .find(|s| s.method == "cameras");
     let (t, used) = match camera_stage {
         Some(stage) => (Similarity::from_matrix(stage.gt_from_recon)?, "cameras"),
-        None => (alignment.gt_from_recon, alignment.report.method.as_str()),
+        None => {
+            let opts = AlignOptions::default().with_seed(request.eval.seed);
+            match align::align_cameras(pairs, &opts.cameras) {
+                Ok((t, _)) => (t, "cameras"),
+                Err(_) => (alignment.gt_from_recon, alignment.report.method.as_str()),
+            }
+        }
     };
-    let errors = evaluate_cameras_matched(gt_cameras, est, matches, &t, pose)?;
+    let errors = evaluate_cameras_matched(gt_cameras, est, matches, &t, &request.pose)?;
+    if used != "cameras" {
+        evaluation.report.notes.push(
+            Note::new(
+                Code::PosesAfterFinalTransform,
+                format!(
+                    "the cameras could not be aligned on their own (fewer than 3 usable camera pairs): the pose errors are measured after the final transform ({used})"
+                ),
+            )
+            .with("transform", used),
+        );
+    }
     evaluation
         .report
-        .warnings
-        .extend(errors.warnings.iter().map(|w| format!("cameras: {w}")));
+        .notes
+        .extend(errors.notes.iter().map(|n| n.clone().prefixed("cameras: ")));
     Ok(CamerasSection {
         errors,
         alignment: CamerasAlignment {
@@ -495,7 +545,7 @@ fn add_visibility(
         whole_surface.then_some(report.inputs.ground_truth.area),
         request.eval.histogram_bins,
     );
-    report.warnings.extend(warning);
+    report.notes.extend(warning);
     report.options.min_views = Some(u64::from(min_views));
     evaluation.sample_labels = Some(visibility::labels(
         &counts,
@@ -542,11 +592,18 @@ fn add_track_error(
     // The evaluated cloud is the model's points in order (`Reconstruction::to_point_cloud`).
     let report = &mut evaluation.report;
     if outcomes.len() != evaluation.distances.len() {
-        report.warnings.push(format!(
-            "track error skipped: the model has {} points but {} were evaluated",
-            outcomes.len(),
-            evaluation.distances.len()
-        ));
+        report.notes.push(
+            Note::new(
+                Code::NoTrackError,
+                format!(
+                    "track error skipped: the model has {} points but {} were evaluated",
+                    outcomes.len(),
+                    evaluation.distances.len()
+                ),
+            )
+            .with("model_points", outcomes.len())
+            .with("evaluated", evaluation.distances.len()),
+        );
         return Ok(());
     }
     let kept: Vec<bool> = evaluation
@@ -562,7 +619,7 @@ fn add_track_error(
         &evaluation.thresholds.taus,
         request.eval.histogram_bins,
     );
-    report.warnings.extend(warning);
+    report.notes.extend(warning);
     report.track_error = Some(section);
     evaluation.track_errors = Some(outcomes.iter().map(|o| o.true_error).collect());
     Ok(())
@@ -695,7 +752,7 @@ mod tests {
             model: Some(est),
             name: "synthetic".into(),
             format: "colmap".into(),
-            warnings: vec![],
+            notes: vec![],
             cloud_is_model_points: true,
         };
         let gt = GroundTruth::Mesh(uv_sphere(128, 64));
@@ -747,11 +804,11 @@ mod tests {
         assert!(e.report.track_error.is_none() && e.report.completeness_visible.is_some());
         assert!(
             e.report
-                .warnings
+                .notes
                 .iter()
-                .any(|w| w.contains("not the SfM model's own points")),
+                .any(|w| w.message.contains("not the SfM model's own points")),
             "{:?}",
-            e.report.warnings
+            e.report.notes
         );
     }
 
@@ -775,7 +832,7 @@ mod tests {
         )
         .unwrap();
         assert_eq!(alone.cloud.points.len(), 107);
-        assert!(alone.model.is_none() && alone.warnings.is_empty());
+        assert!(alone.model.is_none() && alone.notes.is_empty());
         // Beside the Theia NVM (a Theia output folder), or with the model given separately.
         let folder = BTreeMap::from([
             ("reconstruction.nvm".to_string(), fixture("theia.nvm")),
@@ -791,16 +848,16 @@ mod tests {
             read_reconstruction("theia_out", &folder).unwrap(),
             read_reconstruction_with_cameras("points.ply", &files, nvm, "theia.nvm").unwrap(),
         ] {
-            assert_eq!(r.cloud.points.len(), 101, "{:?}", r.warnings);
+            assert_eq!(r.cloud.points.len(), 101, "{:?}", r.notes);
             assert_eq!(r.format, "ply+nvm");
             assert!(!r.cloud_is_model_points);
             assert_eq!(r.model.as_ref().unwrap().images.len(), 6);
             assert!(
-                r.warnings
-                    .iter()
-                    .any(|w| w.contains("removed 6 point(s) at the 6 known camera centre(s)")),
+                r.notes.iter().any(|w| w
+                    .message
+                    .contains("removed 6 point(s) at the 6 known camera centre(s)")),
                 "{:?}",
-                r.warnings
+                r.notes
             );
             let colors = r.cloud.colors.unwrap();
             assert!(colors.iter().all(|c| *c != [10, 200, 30]));
@@ -851,7 +908,7 @@ mod tests {
         let loaded = crate::io::LoadedGroundTruth {
             ground_truth: gt,
             format: crate::io::Format::Ply,
-            warnings: vec![],
+            notes: vec![],
         };
         let mut d = Dataset::new("gt.ply", loaded);
         d.set_cameras(cameras);
@@ -907,7 +964,7 @@ mod tests {
             model: Some(est),
             name: "renamed".into(),
             format: "colmap".into(),
-            warnings: vec![],
+            notes: vec![],
             cloud_is_model_points: true,
         };
         let gt = GroundTruth::Mesh(uv_sphere(32, 16));
@@ -923,19 +980,23 @@ mod tests {
         };
         let e = run(&mut with_cameras, &recon, &options("auto"), &NoProgress).unwrap();
         assert!(e.report.cameras.is_none());
-        let w = &e.report.warnings;
+        let w = &e.report.notes;
         assert!(
-            w.iter().any(
-                |w| w.starts_with("cameras: none of the 8 estimated image(s)")
-                    && w.contains("'other_0000.png'")
-            ),
+            w.iter().any(|w| w.code == Code::NoImageInCommon
+                && w.message
+                    .starts_with("cameras: none of the 8 estimated image(s)")
+                && w.message.contains("'other_0000.png'")),
             "{w:?}"
         );
         assert!(
-            w.iter().any(
-                |w| w.starts_with("alignment (global): cameras stage skipped")
-                    && w.contains("fell back to global")
-            ),
+            w.iter().any(|w| w.code == Code::StageFailed
+                && w.message.contains("skipped")
+                && w.values["stage"] == "cameras"),
+            "{w:?}"
+        );
+        assert!(
+            w.iter()
+                .any(|w| w.code == Code::FellBack && w.values["to"] == "global"),
             "{w:?}"
         );
         assert_eq!(e.report.alignment.method, "global+icp");

@@ -1,5 +1,9 @@
-//! The `sfmeval.report/2` JSON report (see `schemas/report.schema.json`). Every front end writes
+//! The `sfmeval.report/3` JSON report (see `schemas/report.schema.json`). Every front end writes
 //! this shape; fields may be added, none renamed without a schema bump.
+//!
+//! `/3` differs from `/2` in one place: the report's `warnings` (strings) became `notes`, typed
+//! [`Note`]s (`{code, level, message, values}`, `crate::note`) that also carry what the alignment
+//! stages' `note` strings said and the final fit's verdict, so front ends choose notes by code.
 //!
 //! `/2` differs from `/1` in three places: `options.align` is the requested mode (what ran is
 //! `alignment.method`), thresholds give `tau_percent_of_diagonal` in percent (was
@@ -8,16 +12,17 @@
 
 use serde::{Deserialize, Serialize};
 
+use crate::note::Note;
 use crate::pose::CamerasReport;
 use crate::stats::Statistics;
 
 /// Schema id of reports.
-pub(crate) const REPORT_SCHEMA: &str = "sfmeval.report/2";
+pub(crate) const REPORT_SCHEMA: &str = "sfmeval.report/3";
 
 /// The whole report.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Report {
-    /// Always `"sfmeval.report/2"`.
+    /// Always `"sfmeval.report/3"`.
     pub schema: String,
     /// The program that wrote it.
     pub tool: Tool,
@@ -45,8 +50,8 @@ pub struct Report {
     /// the reconstruction has tracks).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub track_error: Option<TrackErrorReport>,
-    /// Things the user should know.
-    pub warnings: Vec<String>,
+    /// What the reader should know besides the numbers, typed (`crate::note`).
+    pub notes: Vec<Note>,
 }
 
 /// Name and version of the writer.
@@ -167,9 +172,10 @@ pub struct AlignmentStage {
     pub iterations: u64,
     /// Whether the stage met its stopping criterion.
     pub converged: bool,
-    /// Why the stage was rejected or what it fell back to, if anything.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub note: Option<String>,
+    /// Why the stage was rejected or what it fell back to, if anything: the report lists these
+    /// in its `notes` (with the stage in their values), not in the stage.
+    #[serde(skip)]
+    pub notes: Vec<Note>,
 }
 
 /// The final transform and how it was found.

@@ -25,6 +25,7 @@ use crate::geometry::{Point3, norm, sub};
 use crate::gt_views::GtView;
 use crate::metrics::share_below;
 use crate::model::Reconstruction;
+use crate::note::{Code, Note};
 use crate::parallel;
 use crate::progress::Progress;
 use crate::report::{SlidingThresholdReport, TrackErrorReport};
@@ -180,7 +181,7 @@ pub(crate) fn aggregate(
     kept: &[bool],
     taus: &[f64],
     bins: usize,
-) -> (TrackErrorReport, Option<String>) {
+) -> (TrackErrorReport, Option<Note>) {
     let mut errors = Vec::new();
     let mut surface = Vec::new();
     let mut sums = [0u64; 7];
@@ -216,7 +217,10 @@ pub(crate) fn aggregate(
         })
         .collect();
     let warning = errors.is_empty().then(|| {
-        "no reconstructed point could be measured against its track (no image matched by name, or every observation fell on a silhouette)".to_string()
+        Note::new(
+            Code::NoTrackMeasured,
+            "no reconstructed point could be measured against its track (no image matched by name, or every observation fell on a silhouette)",
+        )
     });
     let report = TrackErrorReport {
         direction: "reconstruction_to_track_truth".into(),

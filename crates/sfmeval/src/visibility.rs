@@ -30,6 +30,7 @@ use serde::Serialize;
 use crate::geometry::Point3;
 use crate::gt_views::GtView;
 use crate::metrics::{f_score, share_below};
+use crate::note::{Code, Note};
 use crate::parallel;
 use crate::progress::Progress;
 use crate::report::{ThresholdReport, VisibleCompletenessReport, VisibleThresholdReport};
@@ -147,7 +148,7 @@ pub(crate) fn visible_completeness(
     views: usize,
     surface_area: Option<f64>,
     bins: usize,
-) -> (VisibleCompletenessReport, Option<String>) {
+) -> (VisibleCompletenessReport, Option<Note>) {
     let visible: Vec<f64> = view_counts
         .iter()
         .zip(completeness_distances)
@@ -174,9 +175,13 @@ pub(crate) fn visible_completeness(
         })
         .collect();
     let warning = visible.is_empty().then(|| {
-        format!(
-            "no ground-truth sample is seen in {min_views} or more images: check that the depth maps belong to these cameras"
+        Note::new(
+            Code::NothingVisible,
+            format!(
+                "no ground-truth sample is seen in {min_views} or more images: check that the depth maps belong to these cameras"
+            ),
         )
+        .with("min_views", min_views)
     });
     let report = VisibleCompletenessReport {
         direction: "ground_truth_to_reconstruction".into(),

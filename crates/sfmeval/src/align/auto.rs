@@ -9,6 +9,7 @@ use super::{
 };
 use crate::error::{Error, Result};
 use crate::geometry::Point3;
+use crate::note::{Code, Note};
 use crate::prepared::PreparedGroundTruth;
 use crate::report::{AlignmentReport, AlignmentStage};
 use crate::transform::Similarity;
@@ -105,13 +106,34 @@ impl AlignOptions {
     }
 }
 
-fn add_note(stage: &mut AlignmentStage, note: Option<String>) {
-    if let Some(n) = note {
-        stage.note = Some(match stage.note.take() {
-            Some(old) => format!("{n}; {old}"),
-            None => n,
-        });
+/// Puts `notes` (what happened before the stage ran) before the stage's own notes.
+fn add_notes(stage: &mut AlignmentStage, notes: Vec<Note>) {
+    if !notes.is_empty() {
+        let own = std::mem::take(&mut stage.notes);
+        stage.notes = notes;
+        stage.notes.extend(own);
     }
+}
+
+/// The note of a stage of `auto` that failed.
+fn stage_failed(stage: &str, error: &Error) -> Note {
+    let what = match stage {
+        "cameras" => "the camera-based alignment",
+        _ => "the point-pair alignment",
+    };
+    Note::new(Code::StageFailed, format!("{what} failed: {error}"))
+        .with("stage", stage)
+        .with("error", error.to_string())
+}
+
+/// The note of `auto` falling back to `to`.
+pub(crate) fn fell_back(to: &str) -> Note {
+    let what = match to {
+        "global" => "the global shape search (no correspondences)",
+        "points" => "the user's point pairs",
+        other => other,
+    };
+    Note::new(Code::FellBack, format!("the alignment fell back to {what}")).with("to", to)
 }
 
 /// Runs the chosen alignment; returns `gt_from_recon` and the report's `alignment` section.
@@ -125,7 +147,7 @@ pub fn align(
     opts: &AlignOptions,
 ) -> Result<(Similarity, AlignmentReport)> {
     let mut stages: Vec<AlignmentStage> = Vec::new();
-    let mut pending: Option<String> = None;
+    let mut pending: Vec<Note> = Vec::new();
     let coarse: Option<(Similarity, AlignmentStage)> = match method {
         AlignMethod::Cameras => Some(align_cameras(input.cameras, &opts.cameras)?),
         AlignMethod::Points => Some(align_points(input.point_pairs)?),
@@ -136,30 +158,27 @@ pub fn align(
             if !input.cameras.is_empty() {
                 match align_cameras(input.cameras, &opts.cameras) {
                     Ok(r) => found = Some(r),
-                    Err(e) => pending = Some(format!("cameras stage failed ({e})")),
+                    Err(e) => pending.push(stage_failed("cameras", &e)),
                 }
             }
             if found.is_none() && !input.point_pairs.is_empty() {
                 match align_points(input.point_pairs) {
                     Ok(mut r) => {
-                        add_note(
-                            &mut r.1,
-                            pending.take().map(|p| format!("{p}; fell back to points")),
-                        );
+                        if !pending.is_empty() {
+                            pending.push(fell_back("points"));
+                        }
+                        add_notes(&mut r.1, std::mem::take(&mut pending));
                         found = Some(r);
                     }
-                    Err(e) => {
-                        let p = pending.take().map_or(String::new(), |p| format!("{p}; "));
-                        pending = Some(format!("{p}points stage failed ({e})"));
-                    }
+                    Err(e) => pending.push(stage_failed("points", &e)),
                 }
             }
             if found.is_none() {
                 let mut r = align_global(gt, input.recon, &opts.global)?;
-                add_note(
-                    &mut r.1,
-                    pending.take().map(|p| format!("{p}; fell back to global")),
-                );
+                if !pending.is_empty() {
+                    pending.push(fell_back("global"));
+                }
+                add_notes(&mut r.1, std::mem::take(&mut pending));
                 found = Some(r);
             }
             found
@@ -172,7 +191,13 @@ pub fn align(
         }
         None => {
             if input.start.is_none() {
-                pending = Some("ICP started from the identity (no start transform given)".into());
+                pending.push(
+                    Note::new(
+                        Code::IcpFromIdentity,
+                        "ICP started from the identity (no start transform was given): it converges only when the reconstruction is already close to the ground truth",
+                    )
+                    .with("stage", "icp"),
+                );
             }
             input.start.unwrap_or(Similarity::IDENTITY)
         }
@@ -180,7 +205,7 @@ pub fn align(
     let run_icp = matches!(method, AlignMethod::Auto | AlignMethod::Icp) || opts.refine;
     if run_icp {
         let (t2, mut stage) = refine_icp(gt, input.recon, &t, &opts.icp)?;
-        add_note(&mut stage, pending.take());
+        add_notes(&mut stage, std::mem::take(&mut pending));
         t = t2;
         stages.push(stage);
     }
@@ -202,16 +227,11 @@ pub fn align(
     Ok((t, report))
 }
 
-/// The stage notes of an alignment report as warning lines (`"alignment (icp): ..."`), for the
-/// report's `warnings`.
-pub(crate) fn stage_notes(report: &AlignmentReport) -> Vec<String> {
+/// The notes of every stage of an alignment report, in stage order, for the report's `notes`.
+pub(crate) fn stage_notes(report: &AlignmentReport) -> Vec<Note> {
     report
         .stages
         .iter()
-        .filter_map(|s| {
-            s.note
-                .as_ref()
-                .map(|n| format!("alignment ({}): {n}", s.method))
-        })
+        .flat_map(|s| s.notes.iter().cloned())
         .collect()
 }

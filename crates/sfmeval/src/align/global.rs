@@ -24,10 +24,11 @@
 use nalgebra::{Matrix3, Quaternion, UnitQuaternion, Vector3};
 
 use super::icp::{box_corners, finite_subsample, motion, next_gate, update};
-use super::{from_m, make_stage, rotation_angle_deg, sorted_eigen};
+use super::{from_m, make_stage, non_finite_ignored, rotation_angle_deg, sorted_eigen};
 use crate::distance::CloudIndex;
 use crate::error::{Error, Result};
 use crate::geometry::Point3;
+use crate::note::{Code, Note};
 use crate::prepared::PreparedGroundTruth;
 use crate::progress::NoProgress;
 use crate::report::AlignmentStage;
@@ -450,27 +451,45 @@ pub(crate) fn align_global(
     let best = &finalists[0];
     let mut notes = Vec::new();
     if skipped > 0 {
-        notes.push(format!(
-            "{skipped} non-finite reconstruction point(s) ignored"
-        ));
+        notes.push(non_finite_ignored("global", skipped));
     }
-    notes.push(format!(
-        "best of {} starts (start #{}), score {:.3e}",
-        starts.len(),
-        best.index,
-        best.score
-    ));
+    notes.push(
+        Note::new(
+            Code::GlobalSearchResult,
+            format!(
+                "a global shape search tried {} starting poses; the best (#{}) scores {:.3e} (the mean of the smallest {:.0} % of distances from a subsample of the reconstruction to ground-truth surface samples, plus the same from those samples to the subsample, in ground-truth units; lower is better)",
+                starts.len(),
+                best.index,
+                best.score,
+                100.0 * opts.trim
+            ),
+        )
+        .with("stage", "global")
+        .with("starts", starts.len())
+        .with("best_start", best.index)
+        .with_number("score", best.score),
+    );
     if let Some(second) = finalists
         .iter()
         .skip(1)
         .find(|c| rotation_angle_deg(&c.t.rotation(), &best.t.rotation()) > 10.0)
         && second.score < 1.05 * best.score
     {
-        notes.push(format!(
-            "ambiguous: a pose {:.0}° away scores within 5 % ({:.3e}); the object may be symmetric",
-            rotation_angle_deg(&second.t.rotation(), &best.t.rotation()),
-            second.score
-        ));
+        let angle = rotation_angle_deg(&second.t.rotation(), &best.t.rotation());
+        notes.push(
+            Note::new(
+                Code::AmbiguousPose,
+                format!(
+                    "the automatic alignment may have picked the wrong pose: another pose {angle:.0}° away fits almost as well (score {:.3e}, within 5 %); the object may be symmetric: check the view, or give a transform or point pairs",
+                    second.score
+                ),
+            )
+            .with("stage", "global")
+            .with_number("angle_deg", angle)
+            .with_number("score", second.score)
+            .with_number("best_score", best.score)
+            .with_number("within", 0.05),
+        );
     }
     let iterations = (opts.search_iterations + 1 + opts.final_iterations) as u64;
     // A coarse stage: settled when the best start's last step moved < 0.1 % of the diagonal.
@@ -482,7 +501,7 @@ pub(crate) fn align_global(
         Some(best.inliers as f64 / final_pts.len() as f64),
         iterations,
         converged,
-        Some(notes.join("; ")),
+        notes,
     );
     Ok((best.t, stage))
 }

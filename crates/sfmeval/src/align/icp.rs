@@ -26,6 +26,7 @@ use nalgebra::Vector3;
 use super::{is_finite, make_stage, subsample_indices, to_v};
 use crate::error::{Error, Result};
 use crate::geometry::{Aabb, Point3};
+use crate::note::{Code, Note};
 use crate::prepared::PreparedGroundTruth;
 use crate::progress::NoProgress;
 use crate::report::AlignmentStage;
@@ -240,9 +241,7 @@ pub fn refine_icp(
     }
     let mut notes = Vec::new();
     if skipped > 0 {
-        notes.push(format!(
-            "{skipped} non-finite reconstruction point(s) ignored"
-        ));
+        notes.push(super::non_finite_ignored("icp", skipped));
     }
     let diag = gt.aabb.diagonal();
     let floor = 1e-12 * diag;
@@ -266,7 +265,8 @@ pub fn refine_icp(
     let mut hit_drift = false;
     let mut last: Option<(Vec<(Point3, f64)>, f64)> = None; // last-phase correspondences and gate
     let mut start_cover: Option<f64> = None;
-    let mut failure: Option<String> = None;
+    // Why the result is rejected: a reason key for the note's values, and the words.
+    let mut failure: Option<(&str, String)> = None;
     // Active set: points farther than 2 × gate at the last full pass are skipped until the
     // transform has moved any point by more than that gate (exactly the same result).
     let mut active: Vec<usize> = Vec::new();
@@ -325,9 +325,11 @@ pub fn refine_icp(
             opts.max_scale_drift,
             opts.with_scale,
         ) else {
-            failure = Some(format!(
-                "fewer than 3 correspondences within {:.3e} of the ground truth (is the start transform far off?)",
-                gate
+            failure = Some((
+                "few_correspondences",
+                format!(
+                    "fewer than 3 correspondences within {gate:.3e} of the ground truth (is the start transform far off?)"
+                ),
             ));
             break;
         };
@@ -401,29 +403,47 @@ pub fn refine_icp(
     let s1 = t.scale();
     if failure.is_none() {
         if hit_drift {
-            failure = Some(format!(
-                "the scale drifted to the bound ×{:.3} of the start (scale {s0:.6} → {s1:.6}): likely a collapse onto part of the surface",
-                s1 / s0
+            failure = Some((
+                "scale_drift",
+                format!(
+                    "the scale drifted to the bound ×{:.3} of the start (scale {s0:.6} → {s1:.6}): likely a collapse onto part of the surface",
+                    s1 / s0
+                ),
             ));
         } else if inlier_ratio < opts.min_overlap {
-            failure = Some(format!(
-                "only {:.1} % of the points lie within {gate:.3e} of the ground truth (minimum {:.1} %)",
-                100.0 * inlier_ratio,
-                100.0 * opts.min_overlap
+            failure = Some((
+                "low_overlap",
+                format!(
+                    "only {:.1} % of the points lie within {gate:.3e} of the ground truth (minimum {:.1} %)",
+                    100.0 * inlier_ratio,
+                    100.0 * opts.min_overlap
+                ),
             ));
         } else if let Some(c0) = start_cover {
             let c1 = covered_spread(&corr, gate);
             if opts.with_scale && s1 < 0.9 * s0 && c0 > 0.0 && c1 < 0.8 * c0 {
-                failure = Some(format!(
-                    "the cloud shrank onto part of the surface: scale ×{:.3} of the start while the covered part of the ground truth shrank ×{:.3}",
-                    s1 / s0,
-                    c1 / c0
+                failure = Some((
+                    "shrank",
+                    format!(
+                        "the cloud shrank onto part of the surface: scale ×{:.3} of the start while the covered part of the ground truth shrank ×{:.3}",
+                        s1 / s0,
+                        c1 / c0
+                    ),
                 ));
             }
         }
     }
-    if let Some(why) = failure {
-        notes.push(format!("rejected, kept the start transform: {why}"));
+    if let Some((reason, why)) = failure {
+        notes.push(
+            Note::new(
+                Code::IcpRejected,
+                format!(
+                    "the ICP refinement was rejected, the previous stage's transform is used: {why}"
+                ),
+            )
+            .with("stage", "icp")
+            .with("reason", reason),
+        );
         let stage = make_stage(
             "icp",
             start,
@@ -431,7 +451,7 @@ pub fn refine_icp(
             Some(inlier_ratio),
             iterations,
             false,
-            Some(notes.join("; ")),
+            notes,
         );
         return Ok((*start, stage));
     }
@@ -442,7 +462,7 @@ pub fn refine_icp(
         Some(inlier_ratio),
         iterations,
         converged,
-        (!notes.is_empty()).then(|| notes.join("; ")),
+        notes,
     );
     Ok((t, stage))
 }

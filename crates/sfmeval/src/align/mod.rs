@@ -16,6 +16,7 @@
 //! work goes through [`crate::parallel::map`], so results do not depend on the thread count.
 
 mod auto;
+mod fit;
 mod global;
 mod icp;
 mod points;
@@ -26,8 +27,10 @@ mod umeyama;
 #[cfg(test)]
 mod tests;
 
-pub(crate) use auto::stage_notes;
 pub use auto::{AlignInput, AlignMethod, AlignOptions, align};
+pub(crate) use auto::{fell_back, stage_notes};
+pub(crate) use fit::fit_verdict;
+pub use fit::{MIN_INLIER_RATIO, TIGHT_RMSE_PERCENT_OF_DIAGONAL};
 pub use global::GlobalOptions;
 pub use icp::{IcpOptions, refine_icp};
 pub use points::{PointPair, align_points, parse_point_pairs};
@@ -41,6 +44,7 @@ use rand::{Rng as _, SeedableRng as _};
 use rand_chacha::ChaCha8Rng;
 
 use crate::geometry::Point3;
+use crate::note::{Code, Note};
 use crate::report::AlignmentStage;
 use crate::transform::Similarity;
 
@@ -55,7 +59,7 @@ pub(crate) fn make_stage(
     inlier_ratio: Option<f64>,
     iterations: u64,
     converged: bool,
-    note: Option<String>,
+    notes: Vec<Note>,
 ) -> AlignmentStage {
     AlignmentStage {
         method: method.into(),
@@ -65,8 +69,20 @@ pub(crate) fn make_stage(
         inlier_ratio,
         iterations,
         converged,
-        note,
+        notes,
     }
+}
+
+/// The note of a stage that ignored `count` non-finite reconstruction points.
+pub(crate) fn non_finite_ignored(stage: &str, count: usize) -> Note {
+    Note::new(
+        Code::NonFinitePointsIgnored,
+        format!(
+            "{stage}: {count} reconstruction point(s) with non-finite coordinates were ignored"
+        ),
+    )
+    .with("stage", stage)
+    .with("count", count)
 }
 
 pub(crate) fn to_v(p: Point3) -> Vector3<f64> {

@@ -122,7 +122,7 @@ fn align_points_inner(pairs: &[PointPair]) -> Result<(Similarity, AlignmentStage
         .map(|(a, b)| sq_dist(t.apply(*a), *b))
         .sum();
     let rmse = (ss / pairs.len() as f64).sqrt();
-    let stage = make_stage("points", &t, Some(rmse), Some(1.0), 1, true, None);
+    let stage = make_stage("points", &t, Some(rmse), Some(1.0), 1, true, Vec::new());
     Ok((t, stage))
 }
 

@@ -15,6 +15,7 @@ use super::{
 };
 use crate::error::{Error, Result};
 use crate::geometry::Point3;
+use crate::note::{Code, Note};
 use crate::report::AlignmentStage;
 use crate::transform::Similarity;
 
@@ -230,10 +231,17 @@ pub fn align_cameras(
     let mut notes = Vec::new();
     let usable: Vec<CameraPair> = pairs.iter().copied().filter(CameraPair::finite).collect();
     if usable.len() < pairs.len() {
-        notes.push(format!(
-            "{} camera pair(s) with non-finite poses skipped",
-            pairs.len() - usable.len()
-        ));
+        let skipped = pairs.len() - usable.len();
+        notes.push(
+            Note::new(
+                Code::NonFiniteCameraPairs,
+                format!(
+                    "the camera-based alignment skipped {skipped} camera(s) with non-finite poses"
+                ),
+            )
+            .with("stage", "cameras")
+            .with("count", skipped),
+        );
     }
     let n = usable.len();
     if n == 0 {
@@ -362,10 +370,21 @@ pub fn align_cameras(
                 }
             )));
         }
-        notes.push(format!(
-            "camera centres {}: rotation from the camera orientations, scale and translation from the centres",
-            if n < 3 { "fewer than 3" } else { "nearly collinear" }
-        ));
+        let why = if n < 3 {
+            "fewer than 3"
+        } else {
+            "nearly collinear"
+        };
+        notes.push(
+            Note::new(
+                Code::CameraCentresDegenerate,
+                format!(
+                    "the camera centres are {why}, so the rotation comes from the camera orientations and the scale and translation from the centres"
+                ),
+            )
+            .with("stage", "cameras")
+            .with("cameras", n),
+        );
         let (t, inliers, its) = with_rotations(&usable, thr2, opts)?;
         iterations += its;
         stopped = true;
@@ -379,7 +398,19 @@ pub fn align_cameras(
     let rmse = rms(&best.t, &usable, &best.inliers);
     let ratio = best.inliers.len() as f64 / n as f64;
     if best.inliers.len() < n {
-        notes.push(format!("{} of {n} cameras are outliers (farther than {thr:.3e} from their ground-truth centre)", n - best.inliers.len()));
+        let outliers = n - best.inliers.len();
+        notes.push(
+            Note::new(
+                Code::CameraOutliers,
+                format!(
+                    "the camera-based alignment left out {outliers} of {n} cameras as outliers: their centres end farther than {thr:.3e} from the ground-truth ones"
+                ),
+            )
+            .with("stage", "cameras")
+            .with("outliers", outliers)
+            .with("cameras", n)
+            .with_number("threshold", thr),
+        );
     }
     let stage = make_stage(
         "cameras",
@@ -388,7 +419,7 @@ pub fn align_cameras(
         Some(ratio),
         iterations as u64,
         stopped,
-        (!notes.is_empty()).then(|| notes.join("; ")),
+        notes,
     );
     Ok((best.t, stage))
 }
@@ -557,7 +588,8 @@ mod tests {
         let (t, stage) = align_cameras(&pairs, &CamerasOptions::default()).unwrap();
         assert!(rotation_angle_deg(&t.rotation(), &truth.rotation()) < 1e-6);
         assert!((t.scale() / 0.02 - 1.0).abs() < 1e-9);
-        assert!(stage.note.unwrap().contains("collinear"));
+        assert!(stage.notes.iter().any(|n| n.code == Code::CameraCentresDegenerate
+            && n.message.contains("collinear")));
         let (t2, _) = align_cameras(&pairs[..2], &CamerasOptions::default()).unwrap();
         assert!((t2.scale() / 0.02 - 1.0).abs() < 1e-9);
     }
@@ -594,6 +626,11 @@ mod tests {
         pairs[3].recon_center[1] = f64::NAN;
         let (t, stage) = align_cameras(&pairs, &o).unwrap();
         assert!((t.scale() - 2.0).abs() < 1e-9);
-        assert!(stage.note.unwrap().contains("non-finite"));
+        assert!(
+            stage
+                .notes
+                .iter()
+                .any(|n| n.code == Code::NonFiniteCameraPairs && n.message.contains("non-finite"))
+        );
     }
 }

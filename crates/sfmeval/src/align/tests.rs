@@ -11,6 +11,7 @@ use rand_chacha::ChaCha8Rng;
 
 use super::*;
 use crate::geometry::{GroundTruth, TriangleMesh};
+use crate::note::Code;
 use crate::prepared::PreparedGroundTruth;
 use crate::progress::NoProgress;
 use crate::sampling::sample_surface;
@@ -250,7 +251,7 @@ proptest! {
         let cams = orbit_pairs(&mesh, &truth, 30, seed);
         let input = AlignInput { recon: &recon, cameras: &cams, ..Default::default() };
         let (t, report) = align(&gt, &input, AlignMethod::Auto, &accurate()).unwrap();
-        prop_assert!(report.stages[1].note.is_none(), "{:?}", report.stages[1]);
+        prop_assert!(report.stages[1].notes.is_empty(), "{:?}", report.stages[1]);
         // Half the surface constrains the pose less (a shorter lever arm, a sliding
         // direction), so the statistical bound is twice the full object's; a collapse would be
         // a scale error of many percent.
@@ -295,11 +296,7 @@ fn background_does_not_collapse_the_scale() {
         };
         let (t, stage) = refine_icp(&gt, &recon, &start, &opts).unwrap();
         let rel = t.scale() / truth.scale();
-        if stage
-            .note
-            .as_deref()
-            .is_some_and(|n| n.contains("rejected"))
-        {
+        if stage.notes.iter().any(|n| n.code == Code::IcpRejected) {
             assert_eq!(t, start, "a rejected ICP keeps its start");
         } else {
             assert!(
@@ -321,7 +318,12 @@ fn icp_without_overlap_is_rejected() {
     let (t, stage) = refine_icp(&gt, &recon, &start, &IcpOptions::default()).unwrap();
     assert_eq!(t, start);
     assert!(!stage.converged);
-    assert!(stage.note.unwrap().contains("rejected"));
+    assert!(
+        stage
+            .notes
+            .iter()
+            .any(|n| n.code == Code::IcpRejected && n.message.contains("rejected"))
+    );
     let nan = vec![[f64::NAN; 3]; 10];
     assert!(refine_icp(&gt, &nan, &start, &IcpOptions::default()).is_err());
 }
@@ -351,10 +353,13 @@ fn auto_falls_back_and_names_it() {
     ));
     let (t, report) = align(&gt, &input, AlignMethod::Auto, &AlignOptions::default()).unwrap();
     assert_eq!(report.method, "global+icp");
-    let note = report.stages[0].note.clone().unwrap();
+    let notes = &report.stages[0].notes;
+    let codes: Vec<Code> = notes.iter().map(|n| n.code).collect();
     assert!(
-        note.contains("cameras stage failed") && note.contains("fell back to global"),
-        "{note}"
+        codes.starts_with(&[Code::StageFailed, Code::FellBack, Code::GlobalSearchResult])
+            && notes[0].values["stage"] == "cameras"
+            && notes[1].values["to"] == "global",
+        "{notes:?}"
     );
     assert!(!stage_notes(&report).is_empty());
     let dr = rotation_angle_deg(&t.rotation(), &truth.rotation());

@@ -20,6 +20,7 @@ use gltf::mesh::Mode;
 use super::ReadLimits;
 use crate::error::{Error, Result};
 use crate::geometry::{MAX_COORDINATE, Point3, TriangleMesh, show};
+use crate::note::{Code, Note};
 
 const GLB: &str = "GLB";
 const GLTF: &str = "glTF";
@@ -48,7 +49,7 @@ pub struct GltfMesh {
     /// All triangles of the default scene, in the glTF world frame.
     pub mesh: TriangleMesh,
     /// Things skipped on the way (point/line primitives, ...), for the report's warnings.
-    pub warnings: Vec<String>,
+    pub notes: Vec<Note>,
     /// Number of mesh instances (node × mesh) read.
     pub instances: usize,
 }
@@ -206,7 +207,7 @@ pub(crate) fn read_gltf_with_limits(
         format,
         buffers,
         mesh: TriangleMesh::default(),
-        warnings: Vec::new(),
+        notes: Vec::new(),
         instances: 0,
     };
     // The counts are exact upper bounds of what the walk pushes.
@@ -229,7 +230,7 @@ pub(crate) fn read_gltf_with_limits(
     reader.mesh.validate(format)?;
     Ok(GltfMesh {
         mesh: reader.mesh,
-        warnings: reader.warnings,
+        notes: reader.notes,
         instances: reader.instances,
     })
 }
@@ -516,7 +517,7 @@ struct Walker {
     format: &'static str,
     buffers: Vec<Vec<u8>>,
     mesh: TriangleMesh,
-    warnings: Vec<String>,
+    notes: Vec<Note>,
     instances: usize,
 }
 
@@ -570,9 +571,14 @@ impl Walker {
             mode,
             Mode::Triangles | Mode::TriangleStrip | Mode::TriangleFan
         ) {
-            self.warnings.push(format!(
-                "mesh {mesh_index}: skipped a {mode:?} primitive (not a surface)"
-            ));
+            self.notes.push(
+                Note::new(
+                    Code::NonSurfacePrimitiveSkipped,
+                    format!("mesh {mesh_index}: skipped a {mode:?} primitive (not a surface)"),
+                )
+                .with("mesh", mesh_index)
+                .with("mode", format!("{mode:?}")),
+            );
             return Ok(());
         }
         let pos = prim.get(&gltf::Semantic::Positions).ok_or_else(|| {

@@ -10,6 +10,7 @@ use std::collections::BTreeMap;
 
 use crate::error::{Error, Result};
 use crate::geometry::{GroundTruth, PointCloud, TriangleMesh};
+use crate::note::{Code, Note};
 
 /// A file format the core reads.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -71,7 +72,7 @@ pub struct LoadedGroundTruth {
     /// The format read.
     pub format: Format,
     /// Notes for the report.
-    pub warnings: Vec<String>,
+    pub notes: Vec<Note>,
 }
 
 /// Limits on what a reader may build from a small file. A glTF scene instances meshes through
@@ -168,7 +169,7 @@ pub fn read_ground_truth_with_limits(
     let ground_truth = match format {
         Format::Glb | Format::Gltf => {
             let g = gltf::read_gltf_with_limits(bytes, external, limits)?;
-            warnings.extend(g.warnings);
+            warnings.extend(g.notes);
             GroundTruth::Mesh(g.mesh)
         }
         Format::Obj => {
@@ -180,10 +181,16 @@ pub fn read_ground_truth_with_limits(
             let p = ply::read_ply(bytes)?;
             limits.check("PLY", p.triangles.len() as u64, 0)?;
             if p.skipped_faces > 0 {
-                warnings.push(format!(
-                    "{} faces with fewer than 3 vertices were skipped",
-                    p.skipped_faces
-                ));
+                warnings.push(
+                    Note::new(
+                        Code::DegenerateFacesSkipped,
+                        format!(
+                            "{} faces with fewer than 3 vertices were skipped",
+                            p.skipped_faces
+                        ),
+                    )
+                    .with("count", p.skipped_faces),
+                );
             }
             if p.has_faces && !p.triangles.is_empty() {
                 let mesh = TriangleMesh {
@@ -208,7 +215,7 @@ pub fn read_ground_truth_with_limits(
     Ok(LoadedGroundTruth {
         ground_truth,
         format,
-        warnings,
+        notes: warnings,
     })
 }
 
@@ -220,7 +227,7 @@ pub struct LoadedCloud {
     /// The format read.
     pub format: Format,
     /// Notes for the report.
-    pub warnings: Vec<String>,
+    pub notes: Vec<Note>,
 }
 
 /// Reads a reconstructed point cloud (PLY; the vertices of a mesh PLY/OBJ/glTF are used as
@@ -241,14 +248,20 @@ pub fn read_point_cloud_with_limits(
     let cloud = match format {
         Format::Ply => return point_cloud_from_ply(name, ply::read_ply(bytes)?),
         Format::Obj => {
-            warnings.push("the reconstruction is a mesh; only its vertices are evaluated".into());
+            warnings.push(Note::new(
+                Code::MeshVerticesOnly,
+                "the reconstruction is a mesh; only its vertices are evaluated",
+            ));
             PointCloud {
                 points: obj::read_obj(bytes)?.vertices.into(),
                 colors: None,
             }
         }
         Format::Glb | Format::Gltf => {
-            warnings.push("the reconstruction is a mesh; only its vertices are evaluated".into());
+            warnings.push(Note::new(
+                Code::MeshVerticesOnly,
+                "the reconstruction is a mesh; only its vertices are evaluated",
+            ));
             PointCloud {
                 points: gltf::read_gltf_with_limits(bytes, &BTreeMap::new(), limits)?
                     .mesh
@@ -266,10 +279,16 @@ pub fn read_point_cloud_with_limits(
 pub fn point_cloud_from_ply(name: &str, p: ply::PlyData) -> Result<LoadedCloud> {
     let mut warnings = Vec::new();
     if !p.triangles.is_empty() {
-        warnings.push(format!(
-            "the reconstruction PLY has {} triangles; only its vertices are evaluated",
-            p.triangles.len()
-        ));
+        warnings.push(
+            Note::new(
+                Code::MeshVerticesOnly,
+                format!(
+                    "the reconstruction PLY has {} triangles; only its vertices are evaluated",
+                    p.triangles.len()
+                ),
+            )
+            .with("triangles", p.triangles.len()),
+        );
     }
     let cloud = PointCloud {
         points: p.vertices,
@@ -278,12 +297,7 @@ pub fn point_cloud_from_ply(name: &str, p: ply::PlyData) -> Result<LoadedCloud> 
     loaded(name, cloud, Format::Ply, warnings)
 }
 
-fn loaded(
-    name: &str,
-    cloud: PointCloud,
-    format: Format,
-    warnings: Vec<String>,
-) -> Result<LoadedCloud> {
+fn loaded(name: &str, cloud: PointCloud, format: Format, notes: Vec<Note>) -> Result<LoadedCloud> {
     if cloud.points.is_empty() {
         return Err(Error::Empty {
             what: format!("reconstruction '{name}' (no points)"),
@@ -292,6 +306,6 @@ fn loaded(
     Ok(LoadedCloud {
         cloud,
         format,
-        warnings,
+        notes,
     })
 }

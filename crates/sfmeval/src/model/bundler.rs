@@ -6,6 +6,7 @@
 use super::text::{self, Tokens};
 use super::{Camera, Image, Point3D, Reconstruction, Rigid};
 use crate::error::{Error, Result};
+use crate::note::{Code, Note};
 
 const FMT: &str = "Bundler";
 
@@ -170,19 +171,32 @@ pub fn read_bundler(out: &[u8], list: Option<&[u8]>) -> Result<Reconstruction> {
         });
     }
     if bad_refs > 0 {
-        rec.warnings.push(format!(
-            "{bad_refs} point view(s) refer to unknown or unregistered cameras; dropped"
-        ));
+        rec.notes.push(
+            Note::new(
+                Code::DanglingReferences,
+                format!(
+                    "{bad_refs} point view(s) refer to unknown or unregistered cameras; dropped"
+                ),
+            )
+            .with("count", bad_refs),
+        );
     }
     if !rec.unregistered.is_empty() {
-        rec.warnings.push(format!(
-            "{} camera(s) are unregistered (all zero)",
-            rec.unregistered.len()
-        ));
+        let note = Note::new(
+            Code::UnregisteredImages,
+            format!(
+                "{} camera(s) are unregistered (all zero)",
+                rec.unregistered.len()
+            ),
+        )
+        .with("count", rec.unregistered.len());
+        rec.notes.push(note);
     }
     if list.is_none() {
-        rec.warnings
-            .push("no image list: images are named camera_0, camera_1, ...".into());
+        rec.notes.push(Note::new(
+            Code::NoImageList,
+            "no image list: images are named camera_0, camera_1, ...",
+        ));
     }
     rec.validate(FMT, false)?;
     Ok(rec)
@@ -221,7 +235,7 @@ mod tests {
         }
         assert_eq!(b.points.len(), c.points.len());
         assert_eq!(b.cameras[0].fx, 210.0);
-        assert!(b.warnings.is_empty(), "{:?}", b.warnings);
+        assert!(b.notes.is_empty(), "{:?}", b.notes);
     }
 
     #[test]
@@ -237,7 +251,7 @@ mod tests {
         assert_eq!(r.images[0].cam_from_world.rotation[1][1], -1.0);
         assert_eq!(r.images[0].center(), [0.0, 0.0, 5.0]);
         assert_eq!(r.points[0].track.len(), 1);
-        assert!(r.warnings.iter().any(|w| w.contains("unregistered")));
+        assert!(r.notes.iter().any(|w| w.message.contains("unregistered")));
         let list = b"a.jpg 0 100\nimages/b.jpg\n";
         let r = read_bundler(out.as_bytes(), Some(list)).unwrap();
         assert_eq!(r.images[0].name, "images/b.jpg");

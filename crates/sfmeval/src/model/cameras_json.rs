@@ -8,6 +8,7 @@ use serde::Deserialize;
 
 use super::{Camera, Image, Reconstruction, Rigid};
 use crate::error::{Error, Result};
+use crate::note::{Code, Note};
 
 const FMT: &str = "cameras.json";
 
@@ -184,10 +185,16 @@ pub fn read_cameras_json(bytes: &[u8]) -> Result<Reconstruction> {
     rec.cameras = cameras;
     rec.validate(FMT, true)?;
     if let Some(f) = frame_note {
-        rec.warnings.push(format!(
-            "cameras.json frame is '{}', not 'gltf' or 'reconstruction'",
-            super::text::clip(&f)
-        ));
+        rec.notes.push(
+            Note::new(
+                Code::UnknownCameraFrame,
+                format!(
+                    "cameras.json frame is '{}', not 'gltf' or 'reconstruction'",
+                    super::text::clip(&f)
+                ),
+            )
+            .with("frame", f.as_str()),
+        );
     }
     Ok(rec)
 }
@@ -388,21 +395,21 @@ mod tests {
             .replace(r#""width":4,"height":3"#, r#""width":0,"height":0"#);
         let r = read_cameras_json(unknown.as_bytes()).unwrap();
         assert!(
-            r.warnings
+            r.notes
                 .iter()
-                .any(|w| w.contains("camera 1") && w.contains("unknown")),
+                .any(|w| w.message.contains("camera 1") && w.message.contains("unknown")),
             "{:?}",
-            r.warnings
+            r.notes
         );
         let outside = with(&format!(r#"{{"name":"a.jpg","camera_id":1,{pose}}}"#))
             .replace(r#""cx":2"#, r#""cx":-50"#);
         let r = read_cameras_json(outside.as_bytes()).unwrap();
         assert!(
-            r.warnings
-                .iter()
-                .any(|w| w.contains("camera 1: the principal point lies outside")),
+            r.notes.iter().any(|w| w
+                .message
+                .contains("camera 1: the principal point lies outside")),
             "{:?}",
-            r.warnings
+            r.notes
         );
         // JSON has no NaN literal: a NaN pose is a parse error, never a panic.
         let nan = pose.replace("[0,0,0]", "[NaN,0,0]");

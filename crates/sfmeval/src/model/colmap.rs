@@ -12,6 +12,7 @@ use std::collections::{BTreeMap, BTreeSet};
 use super::text;
 use super::{Camera, Image, Observation, Point3D, Reconstruction, Rigid, TrackElement};
 use crate::error::{Error, Result};
+use crate::note::{Code, Note};
 
 const TXT: &str = "COLMAP text";
 const BIN: &str = "COLMAP binary";
@@ -550,8 +551,10 @@ fn assemble(
 ) -> Result<Reconstruction> {
     let mut rec = Reconstruction::new(format);
     if no_points_file {
-        rec.warnings
-            .push("no points3D file: the model has cameras only".into());
+        rec.notes.push(Note::new(
+            Code::ModelNoPoints,
+            "no points3D file: the model has cameras only",
+        ));
     }
     let mut camera_ids = BTreeSet::new();
     for cam in &cameras {
@@ -653,14 +656,26 @@ fn assemble(
     }
     rec.cameras = cameras;
     if dangling_obs > 0 {
-        rec.warnings.push(format!(
-            "{dangling_obs} 2D observation(s) refer to 3D points that are not in points3D"
-        ));
+        rec.notes.push(
+            Note::new(
+                Code::DanglingReferences,
+                format!(
+                    "{dangling_obs} 2D observation(s) refer to 3D points that are not in points3D"
+                ),
+            )
+            .with("count", dangling_obs),
+        );
     }
     if dangling_track > 0 {
-        rec.warnings.push(format!(
-            "{dangling_track} track element(s) refer to images that are not in images; dropped"
-        ));
+        rec.notes.push(
+            Note::new(
+                Code::DanglingReferences,
+                format!(
+                    "{dangling_track} track element(s) refer to images that are not in images; dropped"
+                ),
+            )
+            .with("count", dangling_track),
+        );
     }
     rec.validate(fmt, true)?;
     Ok(rec)
@@ -756,12 +771,16 @@ pub(crate) fn read_colmap_models(
         });
     }
     if !skipped.is_empty() {
-        let note = format!(
-            "incomplete COLMAP model files ignored in {}",
-            skipped.join(", ")
-        );
+        let note = Note::new(
+            Code::IncompleteModelIgnored,
+            format!(
+                "incomplete COLMAP model files ignored in {}",
+                skipped.join(", ")
+            ),
+        )
+        .with("folders", skipped.join(", "));
         for (_, m) in &mut out {
-            m.warnings.push(note.clone());
+            m.notes.push(note.clone());
         }
     }
     Ok(out)
@@ -791,7 +810,7 @@ mod tests {
         assert_eq!((c.fx, c.fy, c.cx, c.cy), (210.0, 210.0, 120.0, 90.0));
         assert_eq!(r.images.len(), 6);
         assert!(r.points.len() > 50);
-        assert!(r.warnings.is_empty(), "{:?}", r.warnings);
+        assert!(r.notes.is_empty(), "{:?}", r.notes);
         // Every track element points back at an observation of that point.
         for (pi, p) in r.points.iter().enumerate() {
             assert!(p.track.len() >= 2);
@@ -937,7 +956,7 @@ mod tests {
                 keypoint: 0
             }]
         );
-        assert!(r.warnings.iter().any(|w| w.contains("track element")));
+        assert!(r.notes.iter().any(|w| w.message.contains("track element")));
         assert_eq!(r.images[1].center(), [-1.0, 0.0, -1.0]);
     }
 
@@ -1034,10 +1053,11 @@ mod tests {
         assert_eq!(r.num_models(), 3);
         let names: Vec<&str> = r.sub_models.iter().map(|s| s.name.as_str()).collect();
         assert_eq!(names, ["sparse/0", "sparse/2"]);
-        assert!(r.warnings.iter().any(|w| w.contains("largest")));
-        assert!(r.warnings.iter().any(|w| w.contains("sparse/3")));
+        assert!(r.notes.iter().any(|w| w.message.contains("largest")));
+        assert!(r.notes.iter().any(|w| w.message.contains("sparse/3")));
         assert!(
-            r.warnings.iter().any(|w| w.contains("no points3D")) || r.sub_models[1].points == 0
+            r.notes.iter().any(|w| w.message.contains("no points3D"))
+                || r.sub_models[1].points == 0
         );
         assert!(matches!(
             read_colmap_folder(&BTreeMap::new()),

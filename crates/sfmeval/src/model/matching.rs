@@ -3,6 +3,7 @@
 //! has no exact key match, its stem alone is tried (a tool that converted `0001.png` to
 //! `0001.jpg`), if that stem is unique on both sides.
 
+use crate::note::{Code, Note};
 use std::collections::BTreeMap;
 
 use super::Reconstruction;
@@ -36,7 +37,7 @@ pub(crate) struct ImageMatches {
     /// Estimated images whose name is in no ground-truth image.
     pub unmatched_est: Vec<usize>,
     /// Problems: duplicate keys, stem-only matches.
-    pub warnings: Vec<String>,
+    pub notes: Vec<Note>,
 }
 
 /// Matches the images of `est` to those of `gt` by [`image_key`] (then by unique stem).
@@ -50,7 +51,7 @@ pub(crate) fn match_images(gt: &Reconstruction, est: &Reconstruction) -> ImageMa
 /// [`match_images`] on plain name lists.
 pub(crate) fn match_names(gt: &[&str], est: &[&str]) -> ImageMatches {
     let mut out = ImageMatches::default();
-    let index = |names: &[&str], key: fn(&str) -> String, side: &str, warn: &mut Vec<String>| {
+    let index = |names: &[&str], key: fn(&str) -> String, side: &str, warn: &mut Vec<Note>| {
         let mut map: BTreeMap<String, usize> = BTreeMap::new();
         let mut dups = Vec::new();
         for (i, n) in names.iter().enumerate() {
@@ -63,11 +64,18 @@ pub(crate) fn match_names(gt: &[&str], est: &[&str]) -> ImageMatches {
             }
         }
         if !dups.is_empty() {
-            warn.push(format!(
-                "{} {side} image name(s) are not unique once folders are ignored (first kept): {}",
-                dups.len(),
-                dups.iter().take(5).cloned().collect::<Vec<_>>().join(", ")
-            ));
+            warn.push(
+                Note::new(
+                    Code::DuplicateImageNames,
+                    format!(
+                        "{} {side} image name(s) are not unique once folders are ignored (first kept): {}",
+                        dups.len(),
+                        dups.iter().take(5).cloned().collect::<Vec<_>>().join(", ")
+                    ),
+                )
+                .with("side", side)
+                .with("count", dups.len()),
+            );
         }
         map
     };
@@ -90,9 +98,16 @@ pub(crate) fn match_names(gt: &[&str], est: &[&str]) -> ImageMatches {
         }
     }
     if est_dups > 0 {
-        warnings.push(format!(
-            "{est_dups} estimated image(s) repeat the name of another estimated image; first kept"
-        ));
+        warnings.push(
+            Note::new(
+                Code::DuplicateImageNames,
+                format!(
+                    "{est_dups} estimated image(s) repeat the name of another estimated image; first kept"
+                ),
+            )
+            .with("side", "estimated")
+            .with("count", est_dups),
+        );
     }
     // Stem fallback for what is left, unique stems only.
     let stems = |names: &[&str], free: &dyn Fn(usize) -> bool| {
@@ -119,9 +134,15 @@ pub(crate) fn match_names(gt: &[&str], est: &[&str]) -> ImageMatches {
         }
     }
     if stem_matches > 0 {
-        warnings.push(format!(
-            "{stem_matches} image(s) matched by file stem only (the extension differs)"
-        ));
+        warnings.push(
+            Note::new(
+                Code::ImagesMatchedByStem,
+                format!(
+                    "{stem_matches} image(s) matched by file stem only (the extension differs)"
+                ),
+            )
+            .with("count", stem_matches),
+        );
     }
     for (g, m) in matched_gt.iter().enumerate() {
         match m {
@@ -135,7 +156,7 @@ pub(crate) fn match_names(gt: &[&str], est: &[&str]) -> ImageMatches {
         .filter(|(_, u)| !**u)
         .map(|(i, _)| i)
         .collect();
-    out.warnings = warnings;
+    out.notes = warnings;
     out
 }
 
@@ -183,8 +204,8 @@ mod tests {
         assert_eq!(m.pairs, vec![(0, 1), (1, 0), (3, 4)]);
         assert_eq!(m.unmatched_gt, vec![2]);
         assert_eq!(m.unmatched_est, vec![2, 3]);
-        assert!(m.warnings.iter().any(|w| w.contains("repeat")));
-        assert!(m.warnings.iter().any(|w| w.contains("stem")));
+        assert!(m.notes.iter().any(|w| w.message.contains("repeat")));
+        assert!(m.notes.iter().any(|w| w.code == Code::ImagesMatchedByStem));
         let none = match_names(&gt, &["a.jpg"]);
         assert!(none.pairs.is_empty());
         assert_eq!(none.unmatched_gt.len(), 4);

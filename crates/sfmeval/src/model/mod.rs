@@ -31,6 +31,7 @@ pub(crate) mod fuzz_tests;
 
 use crate::error::{Error, Result};
 use crate::geometry::{MAX_COORDINATE, Point3, PointCloud, Positions, show};
+use crate::note::{Code, Note};
 
 /// Largest image width or height accepted, in pixels (a gigapixel panorama is 10⁵ wide); 0 means
 /// unknown (NVM and Bundler store no size) and is allowed.
@@ -372,8 +373,17 @@ pub enum CameraWarning {
 }
 
 impl CameraWarning {
-    /// The warning for the cameras named in `items` (at most five are listed).
-    pub(crate) fn message(self, items: &[String]) -> String {
+    /// The note for the cameras named in `items` (at most five are listed).
+    pub(crate) fn note(self, items: &[String]) -> Note {
+        let code = match self {
+            CameraWarning::UnknownSize => Code::UnknownImageSize,
+            CameraWarning::PrincipalPointOutside => Code::PrincipalPointOutside,
+        };
+        Note::new(code, self.message(items)).with("cameras", items.len())
+    }
+
+    /// The words of [`CameraWarning::note`].
+    fn message(self, items: &[String]) -> String {
         let mut list = items.iter().take(5).cloned().collect::<Vec<_>>().join(", ");
         if items.len() > 5 {
             list.push_str(&format!(" and {} more", items.len() - 5));
@@ -470,7 +480,7 @@ pub struct Reconstruction {
     /// `cameras_json`).
     pub format: &'static str,
     /// Things a user should know (dropped references, other sub-models, ...).
-    pub warnings: Vec<String>,
+    pub notes: Vec<Note>,
     /// The other sub-models found beside this one (this one is the largest).
     pub sub_models: Vec<SubModel>,
 }
@@ -560,10 +570,7 @@ impl Reconstruction {
                 noted.entry(w).or_default().push(item.clone());
             }
         }
-        let warnings: Vec<String> = noted
-            .into_iter()
-            .map(|(w, items)| w.message(&items))
-            .collect();
+        let notes: Vec<Note> = noted.into_iter().map(|(w, items)| w.note(&items)).collect();
         for im in &self.images {
             let item = || format!("image '{}' (id {})", text::clip(&im.name), im.id);
             if let Some(defect) = rotation_defect(&im.cam_from_world.rotation) {
@@ -606,7 +613,7 @@ impl Reconstruction {
             }
         }
         self.check_finite(format)?;
-        self.warnings.extend(warnings);
+        self.notes.extend(notes);
         Ok(())
     }
 
@@ -663,14 +670,20 @@ pub(crate) fn choose_largest(models: Vec<(String, Reconstruction)>) -> Result<Re
             .iter()
             .map(|s| format!("{} ({} images, {} points)", s.name, s.images, s.points))
             .collect();
-        chosen.warnings.push(format!(
-            "{} separate models; using the largest, {} ({} images, {} points); not used: {}",
-            summaries.len() + 1,
-            name,
-            chosen.images.len(),
-            chosen.points.len(),
-            others.join(", ")
-        ));
+        let note = Note::new(
+            Code::SeveralModels,
+            format!(
+                "{} separate models; using the largest, {} ({} images, {} points); not used: {}",
+                summaries.len() + 1,
+                name,
+                chosen.images.len(),
+                chosen.points.len(),
+                others.join(", ")
+            ),
+        )
+        .with("models", summaries.len() + 1)
+        .with("used", name.as_str());
+        chosen.notes.push(note);
     }
     chosen.sub_models.extend(summaries);
     Ok(chosen)
@@ -775,11 +788,18 @@ pub fn read_model_files(
         ModelFormat::Colmap => colmap::read_colmap_folder(files)?,
     };
     if detected.len() > 1 {
-        rec.warnings.push(format!(
-            "{} model files found; read '{}'",
-            detected.len(),
-            text::clip(name)
-        ));
+        rec.notes.push(
+            Note::new(
+                Code::SeveralModelFiles,
+                format!(
+                    "{} model files found; read '{}'",
+                    detected.len(),
+                    text::clip(name)
+                ),
+            )
+            .with("files", detected.len())
+            .with("read", name.as_str()),
+        );
     }
     Ok(rec)
 }
@@ -835,7 +855,7 @@ mod tests {
         assert_eq!(chosen.images.len(), 1);
         assert_eq!(chosen.num_models(), 2);
         assert_eq!(chosen.sub_models[0].name, "sparse/0");
-        assert!(chosen.warnings[0].contains("sparse/1"));
+        assert!(chosen.notes[0].message.contains("sparse/1"));
         assert!(matches!(choose_largest(vec![]), Err(Error::Empty { .. })));
     }
 

@@ -8,6 +8,7 @@ use super::text::{self, clip};
 use super::{Camera, Image, Point3D, Reconstruction, Rigid};
 use crate::error::{Error, Result};
 use crate::geometry::{MAX_COORDINATE, show};
+use crate::note::{Code, Note};
 
 const FMT: &str = "NVM";
 
@@ -53,10 +54,13 @@ pub(crate) fn read_nvm_models(bytes: &[u8]) -> Result<Vec<(String, Reconstructio
         let n_cams: usize = match toks.next().map(str::parse::<usize>) {
             Some(Ok(n)) if toks.next().is_none() => n,
             _ => {
-                trailing_note = Some(format!(
-                    "NVM: stopped reading at line {line} ('{}')",
-                    clip(l)
-                ));
+                trailing_note = Some(
+                    Note::new(
+                        Code::TrailingContent,
+                        format!("NVM: stopped reading at line {line} ('{}')", clip(l)),
+                    )
+                    .with("line", line),
+                );
                 break;
             }
         };
@@ -147,15 +151,19 @@ pub(crate) fn read_nvm_models(bytes: &[u8]) -> Result<Vec<(String, Reconstructio
             });
         }
         if bad_refs > 0 {
-            rec.warnings.push(format!(
-                "{bad_refs} measurement(s) refer to cameras not in the model; dropped"
-            ));
+            rec.notes.push(
+                Note::new(
+                    Code::DanglingReferences,
+                    format!("{bad_refs} measurement(s) refer to cameras not in the model; dropped"),
+                )
+                .with("count", bad_refs),
+            );
         }
         if fixed_pp.is_none() {
-            rec.warnings.push(
-                "NVM stores no image size and no principal point (FixedK absent): cx, cy unknown"
-                    .into(),
-            );
+            rec.notes.push(Note::new(
+                Code::NoPrincipalPoint,
+                "NVM stores no image size and no principal point (FixedK absent): cx, cy unknown",
+            ));
         }
         rec.validate(FMT, false)?;
         models.push((format!("model {}", models.len() + 1), rec));
@@ -166,7 +174,7 @@ pub(crate) fn read_nvm_models(bytes: &[u8]) -> Result<Vec<(String, Reconstructio
         });
     }
     if let (Some(note), Some((_, first))) = (trailing_note, models.first_mut()) {
-        first.warnings.push(note);
+        first.notes.push(note);
     }
     Ok(models)
 }

@@ -13,6 +13,7 @@ use serde_json::Value;
 use super::{Camera, Image, Point3D, Reconstruction, Rigid};
 use crate::error::{Error, Result};
 use crate::geometry::{MAX_COORDINATE, show};
+use crate::note::{Code, Note};
 
 const FMT: &str = "OpenMVG sfm_data";
 
@@ -270,20 +271,37 @@ pub fn read_openmvg_json(bytes: &[u8]) -> Result<Reconstruction> {
     }
     rec.validate(FMT, true)?;
     if missing_intrinsic > 0 {
-        rec.warnings.push(format!(
-            "{missing_intrinsic} posed view(s) have no valid intrinsic; counted as unregistered"
-        ));
+        rec.notes.push(
+            Note::new(
+                Code::MissingIntrinsics,
+                format!(
+                    "{missing_intrinsic} posed view(s) have no valid intrinsic; counted as unregistered"
+                ),
+            )
+            .with("count", missing_intrinsic),
+        );
     }
     if bad_refs > 0 {
-        rec.warnings.push(format!(
-            "{bad_refs} landmark observation(s) refer to views without a pose; dropped"
-        ));
+        rec.notes.push(
+            Note::new(
+                Code::DanglingReferences,
+                format!(
+                    "{bad_refs} landmark observation(s) refer to views without a pose; dropped"
+                ),
+            )
+            .with("count", bad_refs),
+        );
     }
     if !rec.unregistered.is_empty() {
-        rec.warnings.push(format!(
-            "{} view(s) have no pose (unregistered)",
-            rec.unregistered.len()
-        ));
+        let note = Note::new(
+            Code::UnregisteredImages,
+            format!(
+                "{} view(s) have no pose (unregistered)",
+                rec.unregistered.len()
+            ),
+        )
+        .with("count", rec.unregistered.len());
+        rec.notes.push(note);
     }
     Ok(rec)
 }

@@ -9,6 +9,7 @@
 //! runs of points in one of the pure marker colours. [`strip_camera_points`] picks the method.
 
 use crate::geometry::{Aabb, Point3, PointCloud};
+use crate::note::{Code, Note};
 
 /// What [`strip_camera_points`] removed.
 #[derive(Debug, Clone, PartialEq)]
@@ -17,8 +18,8 @@ pub(crate) struct Stripped {
     pub cloud: PointCloud,
     /// How many points were removed.
     pub removed: usize,
-    /// A message for the report's warnings when points were removed.
-    pub warning: Option<String>,
+    /// The report's note when points were removed.
+    pub note: Option<Note>,
     /// Whether the points were found at the given camera centres (else: by marker colour, or
     /// nothing removed).
     pub by_centers: bool,
@@ -150,10 +151,17 @@ pub(crate) fn strip_camera_points(
                 cloud: keep(cloud, &marks),
                 removed: n,
                 by_centers: true,
-                warning: Some(format!(
-                    "{source}: removed {n} point(s) at the {} known camera centre(s) (written by the SfM tool)",
-                    centers.len()
-                )),
+                note: Some(
+                    Note::new(
+                        Code::CameraCentresRemoved,
+                        format!(
+                            "{source}: removed {n} point(s) at the {} known camera centre(s) (written by the SfM tool)",
+                            centers.len()
+                        ),
+                    )
+                    .with("removed", n)
+                    .with("cameras", centers.len()),
+                ),
             };
         }
     }
@@ -162,8 +170,12 @@ pub(crate) fn strip_camera_points(
         cloud: c,
         removed: n,
         by_centers: false,
-        warning: (n > 0).then(|| {
-            format!("{source}: removed {n} point(s) in camera-marker colours at the start/end of the cloud (camera centres written by OpenMVG/Theia)")
+        note: (n > 0).then(|| {
+            Note::new(
+                Code::CameraCentresRemoved,
+                format!("{source}: removed {n} point(s) in camera-marker colours at the start/end of the cloud (camera centres written by OpenMVG/Theia)"),
+            )
+            .with("removed", n)
         }),
     }
 }
@@ -196,7 +208,7 @@ mod tests {
         let s = strip_camera_points(c.clone(), Some(&model.camera_centers()), "openmvg.ply");
         assert_eq!(s.removed, 6);
         assert_eq!(s.cloud.points.len(), model.points.len());
-        assert!(s.warning.unwrap().contains("6 point"));
+        assert!(s.note.unwrap().message.contains("6 point"));
         let s = strip_camera_points(c.clone(), None, "openmvg.ply");
         assert_eq!(s.removed, 6);
         assert!(!s.by_centers);

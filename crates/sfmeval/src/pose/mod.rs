@@ -20,6 +20,7 @@ use crate::error::{Error, Result};
 use crate::geometry::{Point3, norm, sub};
 use crate::model::matching::{ImageMatches, match_images};
 use crate::model::{Mat3, Reconstruction, mat_mul, rotation_angle_deg, transpose};
+use crate::note::{Code, Note};
 use crate::stats::{DEFAULT_BINS, Statistics};
 use crate::transform::Similarity;
 
@@ -141,7 +142,7 @@ pub struct CamerasReport {
     /// Per matched image.
     pub images: Vec<ImagePoseError>,
     /// Problems worth a line in the report.
-    pub warnings: Vec<String>,
+    pub notes: Vec<Note>,
 }
 
 /// Mean distance of points from their centroid (0 for fewer than 2 points).
@@ -260,7 +261,7 @@ pub(crate) fn evaluate_cameras_matched(
             "gt_from_recon has scale {scale}, not a similarity"
         )));
     }
-    let mut warnings = matches.warnings.clone();
+    let mut warnings = matches.notes.clone();
     // Drop matches with non-finite estimated poses.
     let mut pairs: Vec<(usize, usize)> = Vec::with_capacity(matches.pairs.len());
     let mut non_finite = 0usize;
@@ -272,9 +273,13 @@ pub(crate) fn evaluate_cameras_matched(
         }
     }
     if non_finite > 0 {
-        warnings.push(format!(
-            "{non_finite} estimated pose(s) are NaN/infinite; counted as unregistered"
-        ));
+        warnings.push(
+            Note::new(
+                Code::NonFinitePoses,
+                format!("{non_finite} estimated pose(s) are NaN/infinite; counted as unregistered"),
+            )
+            .with("count", non_finite),
+        );
     }
     if pairs.is_empty() {
         let example = match (gt.images.first(), est.images.first()) {
@@ -292,23 +297,39 @@ pub(crate) fn evaluate_cameras_matched(
         });
     }
     if pairs.len() < 3 {
-        warnings.push(format!(
-            "only {} camera(s) matched the ground truth: pose statistics are not meaningful",
-            pairs.len()
-        ));
+        warnings.push(
+            Note::new(
+                Code::FewMatchedCameras,
+                format!(
+                    "only {} camera(s) matched the ground truth: pose statistics are not meaningful",
+                    pairs.len()
+                ),
+            )
+            .with("matched", pairs.len()),
+        );
     }
     if !matches.unmatched_est.is_empty() {
-        warnings.push(format!(
-            "{} estimated image(s) have no ground-truth image of the same name",
-            matches.unmatched_est.len()
-        ));
+        warnings.push(
+            Note::new(
+                Code::UnmatchedEstimatedImages,
+                format!(
+                    "{} estimated image(s) have no ground-truth image of the same name",
+                    matches.unmatched_est.len()
+                ),
+            )
+            .with("count", matches.unmatched_est.len()),
+        );
     }
 
     let gt_centers = gt.camera_centers();
     let radius = scene_radius(&gt_centers);
     if radius <= 0.0 {
         warnings.push(
-            "scene radius is 0 (one ground-truth camera): centre errors in % are not given".into(),
+            Note::new(
+                Code::SceneRadiusDegenerate,
+                "scene radius is 0 (one ground-truth camera): centre errors in % are not given",
+            )
+            .with_number("scene_radius", radius),
         );
     }
     let rs = gt_from_recon.rotation();
@@ -350,16 +371,28 @@ pub(crate) fn evaluate_cameras_matched(
         });
     }
     if unusable > 0 {
-        warnings.push(format!(
-            "{unusable} estimated camera centre(s) leave the f64 range once aligned; counted as unregistered"
-        ));
+        warnings.push(
+            Note::new(
+                Code::CentresOutOfRange,
+                format!(
+                    "{unusable} estimated camera centre(s) leave the f64 range once aligned; counted as unregistered"
+                ),
+            )
+            .with("count", unusable),
+        );
     }
     // A scene radius so small that a centre error in % of it leaves the f64 range.
     let pct_usable = radius > 0.0 && images.iter().all(|i| i.center_error_percent.is_finite());
     if radius > 0.0 && !pct_usable {
-        warnings.push(format!(
-            "scene radius is {radius:e}: centre errors in % of it are out of range and not given"
-        ));
+        warnings.push(
+            Note::new(
+                Code::SceneRadiusDegenerate,
+                format!(
+                    "scene radius is {radius:e}: centre errors in % of it are out of range and not given"
+                ),
+            )
+            .with_number("scene_radius", radius),
+        );
         for i in &mut images {
             i.center_error_percent = 0.0;
         }
@@ -391,7 +424,7 @@ pub(crate) fn evaluate_cameras_matched(
         relative,
         focal,
         images,
-        warnings,
+        notes: warnings,
     })
 }
 
@@ -399,15 +432,20 @@ fn relative_errors(
     gt: &Reconstruction,
     est_in_gt: &[Option<(Mat3, Point3)>],
     options: &PoseOptions,
-    warnings: &mut Vec<String>,
+    warnings: &mut Vec<Note>,
 ) -> RelativePoseReport {
     let n = gt.images.len();
     let total = n.saturating_mul(n.saturating_sub(1)) / 2;
     let step = if options.max_pairs > 0 && total > options.max_pairs {
         let s = total.div_ceil(options.max_pairs);
-        warnings.push(format!(
-            "{total} image pairs: relative errors use every {s}-th pair"
-        ));
+        warnings.push(
+            Note::new(
+                Code::RelativePairsSubsampled,
+                format!("{total} image pairs: relative errors use every {s}-th pair"),
+            )
+            .with("pairs", total)
+            .with("every", s),
+        );
         s
     } else {
         1

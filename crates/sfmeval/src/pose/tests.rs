@@ -79,7 +79,7 @@ fn exact_estimate_has_zero_error() {
     assert!((r.relative.auc - 1.0).abs() < 1e-12);
     assert_eq!(r.focal.len(), 1);
     assert_eq!(r.focal[0].error_percent, 0.0);
-    assert!(r.warnings.is_empty(), "{:?}", r.warnings);
+    assert!(r.notes.is_empty(), "{:?}", r.notes);
     // Scene radius: cameras on a 4.5 m arc.
     assert!(r.scene_radius > 0.5 && r.scene_radius < 4.5);
     // Identity alignment on the same data gives large errors (the check can fail).
@@ -179,7 +179,7 @@ fn bad_inputs_are_errors_or_warnings() {
     two.images.truncate(2);
     let r = evaluate_cameras(&gt, &two, &s, &o).unwrap();
     assert_eq!(r.matched, 2);
-    assert!(r.warnings.iter().any(|w| w.contains("only 2")));
+    assert!(r.notes.iter().any(|w| w.message.contains("only 2")));
     assert_eq!(r.relative.pairs_unregistered, 14);
     // One match: scene radius exists (GT), relative pairs all 180.
     let mut one = est.clone();
@@ -191,7 +191,7 @@ fn bad_inputs_are_errors_or_warnings() {
     nan.images[0].cam_from_world.translation[0] = f64::NAN;
     let r = evaluate_cameras(&gt, &nan, &s, &o).unwrap();
     assert_eq!(r.matched, 5);
-    assert!(r.warnings.iter().any(|w| w.contains("NaN")));
+    assert!(r.notes.iter().any(|w| w.message.contains("NaN")));
     assert!(r.rotation_error_deg.max.is_finite());
     // All NaN: no usable match.
     let mut all_nan = est.clone();
@@ -227,7 +227,7 @@ fn bad_inputs_are_errors_or_warnings() {
     };
     dup.images.push(extra);
     let r = evaluate_cameras(&gt, &dup, &s, &o).unwrap();
-    assert!(r.warnings.iter().any(|w| w.contains("repeat")));
+    assert!(r.notes.iter().any(|w| w.message.contains("repeat")));
 }
 
 #[test]
@@ -241,7 +241,7 @@ fn many_pairs_are_subsampled() {
     };
     let r = evaluate_cameras(&gt, &est, &s, &o).unwrap();
     assert_eq!(r.relative.pairs, 4);
-    assert!(r.warnings.iter().any(|w| w.contains("every 4-th")));
+    assert!(r.notes.iter().any(|w| w.message.contains("every 4-th")));
 }
 
 /// Umeyama similarity `dst ≈ s·R·src + t` (test-only; the alignment stages have their own).
