@@ -14,6 +14,9 @@ use crate::prepared::PreparedGroundTruth;
 use crate::report::{AlignmentReport, AlignmentStage};
 use crate::transform::Similarity;
 
+/// Most runs of `icp` alone while it looks for its fixed point (`IcpOptions::max_restarts`).
+pub const ICP_ALONE_RUNS: usize = 8;
+
 /// Which alignment to run.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum AlignMethod {
@@ -204,7 +207,16 @@ pub fn align(
     };
     let run_icp = matches!(method, AlignMethod::Auto | AlignMethod::Icp) || opts.refine;
     if run_icp {
-        let (t2, mut stage) = refine_icp(gt, input.recon, &t, &opts.icp)?;
+        // ICP alone refines a placement given by hand or by another tool: it runs to its fixed
+        // point, so that refining its own answer again leaves it where it is.
+        let icp = match method {
+            AlignMethod::Icp => IcpOptions {
+                max_restarts: opts.icp.max_restarts.max(ICP_ALONE_RUNS),
+                ..opts.icp.clone()
+            },
+            _ => opts.icp.clone(),
+        };
+        let (t2, mut stage) = refine_icp(gt, input.recon, &t, &icp)?;
         add_notes(&mut stage, std::mem::take(&mut pending));
         t = t2;
         stages.push(stage);

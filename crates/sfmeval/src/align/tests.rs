@@ -400,3 +400,43 @@ fn partial_cloud_extrapolation_does_not_slide() {
     );
     assert!(stage.converged);
 }
+
+/// `icp` alone runs to its fixed point: refining its own answer once more (one plain run, as
+/// the Blender panel's Refine used to restart it) leaves it where it is, within the tolerance.
+#[test]
+fn icp_alone_ends_at_its_fixed_point() {
+    let mesh = blob(48, 96);
+    let gt = prepared(&mesh);
+    let truth = random_truth(11, 0.3, [0.5, -1.0, 2.0]);
+    // a sparse cloud, as an SfM tool writes it, and a hand placement a few degrees off
+    let recon = make_recon(&mesh, &truth, 1500, 0.01, 0.05, 11, &|_| true);
+    let hand = Similarity::from_parts(
+        1.08,
+        from_m(nalgebra::Rotation3::from_euler_angles(0.15, -0.1, 0.12).matrix()),
+        [0.1, -0.05, 0.04],
+    )
+    .compose(&truth);
+    let input = AlignInput {
+        recon: &recon,
+        start: Some(hand),
+        ..Default::default()
+    };
+    let (t, report) = align(&gt, &input, AlignMethod::Icp, &AlignOptions::default()).unwrap();
+    assert!(report.converged, "{report:?}");
+    let once = IcpOptions::default();
+    assert_eq!(once.max_restarts, 1);
+    let (again, _) = refine_icp(&gt, &recon, &t, &once).unwrap();
+    let (pts, _) = super::icp::finite_subsample(&recon, once.max_points, once.seed);
+    let corners = super::icp::box_corners(&pts);
+    let moved = super::icp::motion(&t, &again, &corners) / gt.aabb.diagonal();
+    assert!(
+        moved < once.tolerance,
+        "a restart moved it by {moved:e} of the diagonal"
+    );
+    // one plain run from the hand placement is not there yet: restarting it moves it
+    let (first, _) = refine_icp(&gt, &recon, &hand, &once).unwrap();
+    let (second, _) = refine_icp(&gt, &recon, &first, &once).unwrap();
+    let first_moved = super::icp::motion(&first, &second, &corners) / gt.aabb.diagonal();
+    eprintln!("one run: a restart moved it by {first_moved:e}; fixed point: {moved:e}");
+    assert!(first_moved > moved, "{first_moved:e} vs {moved:e}");
+}
