@@ -23,6 +23,7 @@ use sfmeval_fs::{Disk, name_of, path_str, read, read_input_files, write_atomic};
 use crate::concurrent::side_by_side;
 use crate::progress::Bars;
 use crate::summary;
+use crate::table::{TableArgs, table_cmd};
 use crate::tanksandtemples::{LogArgs, TntArgs, log_cmd, tnt_cmd};
 
 /// Measure Structure-from-Motion reconstructions against ground truth.
@@ -82,6 +83,9 @@ enum Command {
     Tnt(Box<TntArgs>),
     /// Write a model's cameras as a Tanks and Temples .log trajectory (one frame per image).
     Log(LogArgs),
+    /// Table I and the comparison table of evaluation reports, as `sfmeval-runner report`
+    /// writes them for its runs.
+    Table(TableArgs),
     /// Evaluate the demo pair shipped with sfmeval and print the summary.
     Demo {
         /// Print the report JSON instead of the summary.
@@ -257,6 +261,7 @@ pub fn run(cli: Cli) -> Result<()> {
         } => info(&file, &ReadLimits::triangles(max_triangles)),
         Command::Tnt(args) => tnt_cmd(&args),
         Command::Log(args) => log_cmd(&args),
+        Command::Table(args) => table_cmd(&args),
         Command::Demo { json, report } => demo(json, report.as_deref()),
     }
 }

@@ -4,6 +4,7 @@ mod commands;
 mod concurrent;
 mod progress;
 mod summary;
+mod table;
 mod tanksandtemples;
 
 use std::process::ExitCode;

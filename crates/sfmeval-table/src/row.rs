@@ -67,4 +67,9 @@ pub struct Row {
     pub cdf: Vec<(f64, f64)>,
     /// The report file, relative to the table folder.
     pub report: Option<String>,
+    /// How the reconstruction was aligned before it was measured: the requested mode of its
+    /// report (`auto`, `given`, ...) or `tanksandtemples` (the protocol's registration); none
+    /// for a run that was not evaluated. Table I's caption names it.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub alignment: Option<String>,
 }

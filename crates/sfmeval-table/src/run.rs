@@ -73,6 +73,53 @@ impl RunFacts {
     }
 }
 
+/// The alignment of a row measured by the Tanks and Temples protocol (its own registration).
+pub const TNT_ALIGNMENT: &str = "tanksandtemples";
+
+/// The row of a reconstruction measured outside a runner's runs folder (the Blender panel, a
+/// script): `pipeline` on `dataset`, evaluated by `report` (its images, points and numbers);
+/// `report_file` is the report's path as the tables should name it. No run record: tool,
+/// version and resources are unknown (empty, 0).
+pub fn report_row(dataset: &str, pipeline: &str, report: &Report, report_file: &str) -> Row {
+    let mut row = base_row(&RunFacts {
+        dataset: dataset.to_string(),
+        pipeline: pipeline.to_string(),
+        tool: String::new(),
+        version: None,
+        status: Status::Ok,
+        reason: None,
+        wall_seconds: 0.0,
+        cpu_seconds: 0.0,
+        peak_memory_bytes: 0,
+        images_total: report.cameras.as_ref().map_or(0, |c| c.errors.ground_truth),
+        images_registered: report.inputs.reconstruction.images as usize,
+        points: report.inputs.reconstruction.points as usize,
+    });
+    fill_row(&mut row, report);
+    row.report = Some(report_file.to_string());
+    row
+}
+
+/// The row of a reconstruction that has no evaluation: `status` (`failed`, ...) and why.
+pub fn failed_row(dataset: &str, pipeline: &str, status: &str, reason: &str) -> Row {
+    let mut row = base_row(&RunFacts {
+        dataset: dataset.to_string(),
+        pipeline: pipeline.to_string(),
+        tool: String::new(),
+        version: None,
+        status: Status::Failed,
+        reason: Some(reason.to_string()),
+        wall_seconds: 0.0,
+        cpu_seconds: 0.0,
+        peak_memory_bytes: 0,
+        images_total: 0,
+        images_registered: 0,
+        points: 0,
+    });
+    row.status = status.to_string();
+    row
+}
+
 /// The report file of a run, relative to the table folder: `reports/<dataset>/<pipeline>.json`.
 pub fn report_path(dataset: &str, pipeline: &str) -> String {
     format!("reports/{dataset}/{pipeline}.json")
@@ -104,12 +151,14 @@ pub fn base_row(rec: &RunFacts) -> Row {
         center_max_percent: None,
         cdf: Vec::new(),
         report: None,
+        alignment: None,
     }
 }
 
 /// Adds an evaluation's numbers to a row: accuracy, completeness, P/R/F, camera errors.
 pub fn fill_row(row: &mut Row, r: &Report) {
     let a = &r.accuracy.stats;
+    row.alignment = Some(r.options.align.clone());
     row.points = r.inputs.reconstruction.points;
     row.mean = Some(a.mean);
     row.median = Some(a.median);
@@ -179,6 +228,7 @@ pub fn tnt_row(
 ) -> Row {
     let mut row = base_row(rec);
     let tau = report.protocol.tau;
+    row.alignment = Some(TNT_ALIGNMENT.to_string());
     row.points = report.inputs.reconstruction.points as u64;
     row.mean = Some(report.precision.mean_distance);
     row.median = Some(report.precision.median_distance);

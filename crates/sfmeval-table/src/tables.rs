@@ -41,7 +41,8 @@ pub fn tables(rows: &[Row]) -> Tables {
         t1.push('\n');
     }
     let t1_md = format!(
-        "# Table I: mean distance to the ground truth (m) and number of points\n\nEach cell: mean reconstruction → ground-truth distance in metres (after `auto` alignment), and in parentheses the number of points; failed runs show why.\n\n{t1}"
+        "# Table I: mean distance to the ground truth (m) and number of points\n\nEach cell: mean reconstruction → ground-truth distance in metres (after {}), and in parentheses the number of points; failed runs show why.\n\n{t1}",
+        alignment_caption(rows)
     );
     let mut csv = CsvWriter::new();
     let mut header = vec!["dataset".to_string()];
@@ -100,6 +101,28 @@ pub fn tables(rows: &[Row]) -> Tables {
         table1_csv,
         runs_csv: wcsv.finish(),
         table_md,
+    }
+}
+
+/// How Table I's caption names the alignment of its rows: the one mode they all used, or each
+/// run's own when they differ (`auto` when no row was evaluated: the runner's default).
+pub fn alignment_caption(rows: &[Row]) -> String {
+    let modes: std::collections::BTreeSet<&str> =
+        rows.iter().filter_map(|r| r.alignment.as_deref()).collect();
+    let name = |m: &str| match m {
+        crate::run::TNT_ALIGNMENT => "the Tanks and Temples protocol's registration".to_string(),
+        m => format!("`{m}` alignment"),
+    };
+    match modes.iter().collect::<Vec<_>>().as_slice() {
+        [] => name("auto"),
+        [m] => name(m),
+        more => format!(
+            "each run's own alignment: {}",
+            more.iter()
+                .map(|m| name(m))
+                .collect::<Vec<_>>()
+                .join(" or ")
+        ),
     }
 }
 
@@ -186,6 +209,22 @@ mod tests {
             t.table_md
                 .contains("| b | zz | ok | 100 | 30/36 | 0.500000 |")
         );
+    }
+
+    #[test]
+    fn the_caption_names_the_alignment_used() {
+        let mut rows = vec![row("a", "zz", Some(0.5)), row("a", "colmap", None)];
+        assert!(tables(&rows).table1_md.contains("(after `auto` alignment)"));
+        rows[0].alignment = Some("given".into());
+        assert!(
+            tables(&rows)
+                .table1_md
+                .contains("(after `given` alignment)")
+        );
+        rows[1].alignment = Some(crate::run::TNT_ALIGNMENT.into());
+        assert!(tables(&rows).table1_md.contains(
+            "(after each run's own alignment: `given` alignment or the Tanks and Temples protocol's registration)"
+        ));
     }
 
     #[test]
