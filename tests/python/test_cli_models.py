@@ -335,8 +335,11 @@ def test_no_name_match_skips_cameras_with_a_warning(sfmeval_bin, scene, tmp_path
     assert rep.get("cameras") is None
     assert any(w.startswith("cameras: none of the 6 estimated image(s) matches")
                and "estimate 'x_" in w for w in [n["message"] for n in rep["notes"]]), [n["message"] for n in rep["notes"]]
-    assert any(w.startswith("alignment (global): cameras stage skipped")
-               for w in [n["message"] for n in rep["notes"]]), [n["message"] for n in rep["notes"]]
+    notes = rep["notes"]
+    assert any(n["code"] == "alignment.stage_failed" and n["values"]["stage"] == "cameras"
+               and "skipped" in n["message"] for n in notes), notes
+    assert any(n["code"] == "alignment.fell_back" and n["values"]["to"] == "global"
+               for n in notes), notes
     assert rep["alignment"]["method"] == "global+icp"
     p, rep = run_bad(sfmeval_bin, scene, d, "cameras", tmp_path)
     assert rep is None and "none of the 6 estimated image(s) matches" in p.stderr, p.stderr

@@ -176,7 +176,7 @@ fn main() -> Res<()> {
             let (sim, stage) = refine_icp(&gt, &c, &start, &IcpOptions::default())?;
             let s = t.elapsed().as_secs_f64();
             let r = json!({"matrix": sim.matrix, "iterations": stage.iterations,
-                           "note": stage.note, "index_seconds": index_s});
+                           "notes": stage.notes, "index_seconds": index_s});
             (s, r)
         }
         "cost" => cost(&read_mesh(mesh_path()?)?, &read_cloud(cloud_path()?)?)?,
