@@ -5,9 +5,6 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result, bail};
 
-/// Image extensions the tools read.
-pub const IMAGE_EXT: [&str; 5] = ["jpg", "jpeg", "png", "tif", "tiff"];
-
 /// A dataset to run pipelines on.
 #[derive(Debug, Clone)]
 pub struct Dataset {
@@ -40,7 +37,9 @@ impl Dataset {
                 e.path()
                     .extension()
                     .and_then(|x| x.to_str())
-                    .is_some_and(|x| IMAGE_EXT.contains(&x.to_ascii_lowercase().as_str()))
+                    .is_some_and(|x| {
+                        sfmeval_fs::IMAGE_EXTENSIONS.contains(&x.to_ascii_lowercase().as_str())
+                    })
             })
             .count();
         if image_count == 0 {
