@@ -150,7 +150,7 @@ fn report_tnt_dataset(
                 dir,
                 rec,
                 &args.out,
-                sfmeval::tanksandtemples::scene_tau(ds).or(args.eval.tau.first().copied()),
+                sfmeval_tnt::scene_tau(ds).or(args.eval.tau.first().copied()),
             ),
             Err(e) => Err(anyhow::anyhow!(
                 "Tanks and Temples scene {}: {e}",

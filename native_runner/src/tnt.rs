@@ -1,6 +1,6 @@
 //! Runs on a Tanks and Temples scene (a folder with `images/` and the benchmark's files:
 //! `<scene>.ply`, `<scene>.json`, `<scene>_trans.txt`, `<scene>_COLMAP_SfM.log`), evaluated
-//! with the benchmark's protocol (`sfmeval::tanksandtemples`) instead of the synthetic datasets'
+//! with the benchmark's protocol (`sfmeval_tnt`) instead of the synthetic datasets'
 //! evaluation: each run's cameras become its `.log` trajectory (one frame per image of
 //! `images/`, sorted by name), and its sparse cloud is measured after the protocol's registration.
 
@@ -9,12 +9,12 @@ use std::path::Path;
 use anyhow::{Context, Result};
 use sfmeval::geometry::Aabb;
 use sfmeval::progress::NoProgress;
-use sfmeval::tanksandtemples::{
-    self as tnt, IcpCriteria, Registration, Scene, TntRequest, TrajectoryAlignmentOptions,
-};
 use sfmeval_fs::{Disk, image_names, path_str, read_input_files, write_atomic};
 use sfmeval_table::Row;
 use sfmeval_table::run::{report_path, tnt_row};
+use sfmeval_tnt::{
+    self as tnt, IcpCriteria, Registration, Scene, TntRequest, TrajectoryAlignmentOptions,
+};
 
 use crate::run::RunRecord;
 
@@ -77,21 +77,9 @@ pub fn evaluate_run(
         &request,
         &NoProgress,
     )?;
-    let json = serde_json::to_string_pretty(&evaluation.report)? + "\n";
-    write_atomic(&out.join(&rel), json.as_bytes())?;
-    write_atomic(
-        &files.join(format!("{}.precision.ply", scene.name)),
-        &evaluation.precision_ply(),
-    )?;
-    write_atomic(
-        &files.join(format!("{}.recall.ply", scene.name)),
-        &evaluation.recall_ply(),
-    )?;
-    for (suffix, text) in evaluation.toolbox_texts() {
-        write_atomic(
-            &files.join(format!("{}{suffix}", scene.name)),
-            text.as_bytes(),
-        )?;
+    write_atomic(&out.join(&rel), evaluation.report_json().as_bytes())?;
+    for (file, bytes) in evaluation.output_files() {
+        write_atomic(&files.join(file), &bytes)?;
     }
     Ok(tnt_row(
         &rec.facts(),

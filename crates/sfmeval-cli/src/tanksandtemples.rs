@@ -5,10 +5,10 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{Context as _, Result, bail};
 use clap::Args;
-use sfmeval::tanksandtemples::{
+use sfmeval_fs::{Disk, image_names, name_of, path_str, read, read_input_files, write_atomic};
+use sfmeval_tnt::{
     self as tnt, IcpCriteria, Registration, Scene, TntRequest, TrajectoryAlignmentOptions,
 };
-use sfmeval_fs::{Disk, image_names, name_of, path_str, read, read_input_files, write_atomic};
 
 use crate::concurrent::side_by_side;
 use crate::progress::Bars;
@@ -125,36 +125,21 @@ pub fn tnt_cmd(args: &TntArgs) -> Result<()> {
             .join("evaluation"),
     };
     std::fs::create_dir_all(&out).with_context(|| format!("cannot create '{}'", out.display()))?;
-    let mut report = evaluation.report.clone();
-    report
+    let mut evaluation = evaluation;
+    evaluation
+        .report
         .warnings
         .extend(recon.notes.into_iter().map(|n| n.message));
-    let json = serde_json::to_string_pretty(&report)? + "\n";
+    let report = &evaluation.report;
+    let json = evaluation.report_json();
     write_atomic(&out.join("report.json"), json.as_bytes())?;
-    let name = &scene.name;
-    // The two coloured clouds are encoded and written side by side.
-    let (recall, precision) = side_by_side(
-        || {
-            write_atomic(
-                &out.join(format!("{name}.recall.ply")),
-                &evaluation.recall_ply(),
-            )
-        },
-        || {
-            write_atomic(
-                &out.join(format!("{name}.precision.ply")),
-                &evaluation.precision_ply(),
-            )
-        },
-    );
-    precision.and(recall)?;
-    for (suffix, text) in evaluation.toolbox_texts() {
-        write_atomic(&out.join(format!("{name}{suffix}")), text.as_bytes())?;
+    for (name, bytes) in evaluation.output_files() {
+        write_atomic(&out.join(name), &bytes)?;
     }
     if args.json {
         print!("{json}");
     } else if !args.quiet {
-        print!("{}", summary(&report, &out));
+        print!("{}", summary(report, &out));
     }
     Ok(())
 }

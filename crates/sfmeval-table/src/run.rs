@@ -222,7 +222,7 @@ pub fn evaluated_row(rec: &RunFacts, report: &Report, kept_distances: &[f64]) ->
 /// no ground-truth cameras).
 pub fn tnt_row(
     rec: &RunFacts,
-    report: &sfmeval::tanksandtemples::TntReport,
+    report: &sfmeval_tnt::TntReport,
     precision_distances: &[f64],
     gt_diagonal: f64,
 ) -> Row {

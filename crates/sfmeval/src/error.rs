@@ -221,7 +221,7 @@ impl Error {
     }
 
     /// This error, as an error in the file `file` playing `role`.
-    pub(crate) fn in_file(self, role: &'static str, file: impl Into<String>) -> Self {
+    pub fn in_file(self, role: &'static str, file: impl Into<String>) -> Self {
         Error::InFile {
             role,
             file: file.into(),

@@ -14,7 +14,7 @@ pub type Point3 = [f64; 3];
 /// to four or six coordinates (`(2·10⁵⁰)⁶ ≈ 6·10³⁰¹` still fits an `f64`), and sums of squares
 /// over a billion points stay finite, so no derived quantity overflows. Every finite `f32` value
 /// (≤ 3.4·10³⁸) is accepted, and no physical scene comes near: 10⁵⁰ m is 10²⁴ light years.
-pub(crate) const MAX_COORDINATE: f64 = 1e50;
+pub const MAX_COORDINATE: f64 = 1e50;
 
 /// `v` for an error message: plain for ordinary magnitudes, in exponent form otherwise.
 pub(crate) fn show(v: f64) -> String {

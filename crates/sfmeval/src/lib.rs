@@ -62,7 +62,6 @@ pub mod report;
 pub mod sampling;
 mod spatial_order;
 pub mod stats;
-pub mod tanksandtemples;
 mod track_error;
 pub mod transform;
 pub mod visibility;

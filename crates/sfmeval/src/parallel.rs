@@ -20,7 +20,7 @@ where
 
 /// The `Some` results of `f` over `items`, in input order (a filter that keeps or maps each
 /// item on its own), in parallel where threads are available.
-pub(crate) fn filter_map<T, R, F>(items: &[T], f: F) -> Vec<R>
+pub fn filter_map<T, R, F>(items: &[T], f: F) -> Vec<R>
 where
     T: Sync,
     R: Send,
@@ -99,7 +99,7 @@ where
 }
 
 /// Maps `f` over `0..n`, keeping order (no progress).
-pub(crate) fn map_range<R, F>(n: usize, f: F) -> Vec<R>
+pub fn map_range<R, F>(n: usize, f: F) -> Vec<R>
 where
     R: Send,
     F: Fn(usize) -> R + Sync + Send,
@@ -118,7 +118,7 @@ where
 /// `f` over `0..n` cut into one contiguous range per thread (a single range without threads),
 /// the results in range order: for reductions whose partial results are large (histograms,
 /// counters), where a range per work unit would multiply them.
-pub(crate) fn map_ranges<R, F>(n: usize, f: F) -> Vec<R>
+pub fn map_ranges<R, F>(n: usize, f: F) -> Vec<R>
 where
     R: Send,
     F: Fn(std::ops::Range<usize>) -> R + Sync + Send,
@@ -165,7 +165,7 @@ where
 
 /// `slice.sort_unstable()`, in parallel where threads are available (the same result: equal
 /// elements are indistinguishable).
-pub(crate) fn sort_unstable<T: Ord + Send>(slice: &mut [T]) {
+pub fn sort_unstable<T: Ord + Send>(slice: &mut [T]) {
     #[cfg(feature = "parallel")]
     {
         use rayon::prelude::*;
@@ -192,7 +192,7 @@ pub(crate) fn sort_floats(values: &mut [f64]) {
 
 /// Runs `a` and `b`, in parallel where threads are available.
 #[cfg(feature = "parallel")]
-pub(crate) fn join<RA: Send, RB: Send>(
+pub fn join<RA: Send, RB: Send>(
     a: impl FnOnce() -> RA + Send,
     b: impl FnOnce() -> RB + Send,
 ) -> (RA, RB) {
@@ -201,7 +201,7 @@ pub(crate) fn join<RA: Send, RB: Send>(
 
 /// Runs `a` and `b`, in parallel where threads are available.
 #[cfg(not(feature = "parallel"))]
-pub(crate) fn join<RA, RB>(a: impl FnOnce() -> RA, b: impl FnOnce() -> RB) -> (RA, RB) {
+pub fn join<RA, RB>(a: impl FnOnce() -> RA, b: impl FnOnce() -> RB) -> (RA, RB) {
     (a(), b())
 }
 
@@ -233,7 +233,7 @@ where
 /// parallel where threads are available); each run starts from `S::default()` and `init()`,
 /// goes through its items in order, and its accumulator comes back in run order. The runs do
 /// not depend on the thread count, so neither does any reduction of the accumulators in order.
-pub(crate) fn fold_runs_mut<T, S, A, I, F>(items: &mut [T], size: usize, init: I, f: F) -> Vec<A>
+pub fn fold_runs_mut<T, S, A, I, F>(items: &mut [T], size: usize, init: I, f: F) -> Vec<A>
 where
     T: Send,
     A: Send,
@@ -305,7 +305,7 @@ where
 /// Indices of `points` in Morton order (`spatial_order::morton_keys`, sorted in parallel): ties
 /// by index, non-finite points last. A permutation of `0..points.len()`, the same for any
 /// thread count.
-pub(crate) fn morton_order(points: &[Point3]) -> Vec<u32> {
+pub fn morton_order(points: &[Point3]) -> Vec<u32> {
     let mut keyed = morton_keys(points);
     sort_unstable(&mut keyed);
     map_range(keyed.len(), |k| keyed[k].1)

@@ -37,7 +37,7 @@ pub use points::{PointPair, align_points, parse_point_pairs};
 pub use ransac::{CameraPair, CamerasOptions, align_cameras};
 pub use request::{AlignMode, AlignRequest};
 pub use umeyama::umeyama;
-pub(crate) use umeyama::{PairSums, umeyama_pairs};
+pub use umeyama::{PairSums, umeyama_pairs};
 
 use nalgebra::{Matrix3, Vector3};
 use rand::{Rng as _, SeedableRng as _};

@@ -152,10 +152,10 @@ impl CentredSums {
 const PAIRS_PER_SUM: usize = 4096;
 
 /// [`umeyama`] (with scale) of `n` pairs `(src(i), dst(i))`, read in place and summed in
-/// parallel: partial sums over fixed runs of [`PAIRS_PER_SUM`] pairs, added in run order, so
+/// parallel: partial sums over fixed runs of `PAIRS_PER_SUM` (4096) pairs, added in run order, so
 /// the result does not depend on the thread count (its last bits differ from [`umeyama`]'s,
 /// which adds the pairs one by one). For ICP's fits over a million matches.
-pub(crate) fn umeyama_pairs(
+pub fn umeyama_pairs(
     n: usize,
     src: impl Fn(usize) -> Point3 + Sync,
     dst: impl Fn(usize) -> Point3 + Sync,
@@ -221,7 +221,7 @@ pub(crate) fn umeyama_pairs(
 /// passes. Partial sums over fixed runs merged in run order give the same bits for any thread
 /// count.
 #[derive(Clone, Copy)]
-pub(crate) struct PairSums {
+pub struct PairSums {
     shift_src: [f64; 3],
     shift_dst: [f64; 3],
     n: u64,
@@ -238,7 +238,7 @@ pub(crate) struct PairSums {
 
 impl PairSums {
     /// No pairs yet, each side relative to its shift.
-    pub(crate) fn new(shift_src: Point3, shift_dst: Point3) -> PairSums {
+    pub fn new(shift_src: Point3, shift_dst: Point3) -> PairSums {
         PairSums {
             shift_src,
             shift_dst,
@@ -253,7 +253,7 @@ impl PairSums {
 
     /// Adds the pair (`src`, `dst`).
     #[inline]
-    pub(crate) fn add(&mut self, src: Point3, dst: Point3) {
+    pub fn add(&mut self, src: Point3, dst: Point3) {
         let a = [0, 1, 2].map(|k| src[k] - self.shift_src[k]);
         let b = [0, 1, 2].map(|k| dst[k] - self.shift_dst[k]);
         self.n += 1;
@@ -277,7 +277,7 @@ impl PairSums {
     }
 
     /// Adds the pairs summed in `other` (same shifts).
-    pub(crate) fn merge(&mut self, other: &PairSums) {
+    pub fn merge(&mut self, other: &PairSums) {
         self.n += other.n;
         for k in 0..3 {
             self.sum_a[k] += other.sum_a[k];
@@ -293,15 +293,20 @@ impl PairSums {
     }
 
     /// Pairs added.
-    pub(crate) fn len(&self) -> u64 {
+    pub fn len(&self) -> u64 {
         self.n
+    }
+
+    /// Whether no pair was added.
+    pub fn is_empty(&self) -> bool {
+        self.n == 0
     }
 
     /// The scaled fit, or `None` when the one-pass sums cannot be trusted: a spread outside
     /// [1e-90, 1e90] (where squares lose range; [`umeyama_pairs`] divides the points first) or
     /// a sum that is not finite. Errors as [`umeyama`]'s for fewer than 3 pairs or degenerate
     /// points.
-    pub(crate) fn similarity(&self) -> Option<Result<Similarity>> {
+    pub fn similarity(&self) -> Option<Result<Similarity>> {
         if self.n < 3 {
             return Some(Err(Error::InvalidOption(format!(
                 "a similarity needs at least 3 point pairs, got {}",

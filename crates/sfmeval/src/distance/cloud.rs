@@ -34,7 +34,7 @@ impl CloudIndex {
     }
 
     /// Squared distance from `p` to its nearest neighbour, and that neighbour's index.
-    pub(crate) fn nearest_squared(&self, p: Point3) -> (f64, usize) {
+    pub fn nearest_squared(&self, p: Point3) -> (f64, usize) {
         let r = self
             .tree
             .query(&p)
@@ -45,7 +45,7 @@ impl CloudIndex {
 
     /// Squared distance from `p` to its second-nearest point (+∞ for a one-point cloud): for a
     /// point of the cloud, the distance to its nearest other point.
-    pub(crate) fn second_nearest_squared(&self, p: Point3) -> f64 {
+    pub fn second_nearest_squared(&self, p: Point3) -> f64 {
         let two = std::num::NonZeroUsize::MIN.saturating_add(1);
         let found = self
             .tree

@@ -12,17 +12,17 @@ use crate::error::{Error, Result};
 use crate::geometry::Point3;
 
 /// A slot that names no point: the bound given to [`KdCloud::nearest_below`] was a radius.
-pub(crate) const NO_POINT: usize = usize::MAX;
+pub const NO_POINT: usize = usize::MAX;
 
 /// The cloud in tree order and its boxes; answers name points by their slot in that order.
-pub(crate) struct KdCloud {
+pub struct KdCloud {
     points: Vec<Point3>,
     tree: SlotTree,
 }
 
 impl KdCloud {
     /// Copies `points` into tree order and builds the boxes; fails on an empty cloud.
-    pub(crate) fn new(points: &[Point3]) -> Result<KdCloud> {
+    pub fn new(points: &[Point3]) -> Result<KdCloud> {
         if points.is_empty() {
             return Err(Error::Empty {
                 what: "point cloud".into(),
@@ -35,18 +35,23 @@ impl KdCloud {
     }
 
     /// Number of points.
-    pub(crate) fn len(&self) -> usize {
+    pub fn len(&self) -> usize {
         self.points.len()
     }
 
+    /// Whether the cloud has no point.
+    pub fn is_empty(&self) -> bool {
+        self.points.is_empty()
+    }
+
     /// The point in slot `k`.
-    pub(crate) fn point(&self, k: usize) -> Point3 {
+    pub fn point(&self, k: usize) -> Point3 {
         self.points[k]
     }
 
     /// Distance from `p` to its nearest point (kiddo's squared sum, bit for bit, then the
     /// square root), and that point's slot; `(+∞, NO_POINT)` for a non-finite `p`.
-    pub(crate) fn nearest(&self, p: Point3) -> (f64, usize) {
+    pub fn nearest(&self, p: Point3) -> (f64, usize) {
         match self.tree.nearest(p, |k| self.points[k], |_| true) {
             Some((d2, k)) => (d2.sqrt(), k),
             None => (f64::INFINITY, NO_POINT),
@@ -57,7 +62,7 @@ impl KdCloud {
     /// point in slot `start` (a neighbouring query's answer; [`NO_POINT`] for none). The slot
     /// returned is a nearest point's, not necessarily the one `nearest` names among equally
     /// near points.
-    pub(crate) fn nearest_from(&self, p: Point3, start: usize) -> (f64, usize) {
+    pub fn nearest_from(&self, p: Point3, start: usize) -> (f64, usize) {
         if start >= self.points.len() || !p.iter().all(|v| v.is_finite()) {
             return self.nearest(p);
         }
@@ -71,7 +76,7 @@ impl KdCloud {
     /// The nearest point strictly closer to `p` than `bound.0` (squared distance), with its
     /// slot; `bound` when there is none. `bound` is `(d², slot)` of a known point or
     /// `(r², NO_POINT)` for a radius `r`.
-    pub(crate) fn nearest_below(&self, p: Point3, bound: (f64, usize)) -> (f64, usize) {
+    pub fn nearest_below(&self, p: Point3, bound: (f64, usize)) -> (f64, usize) {
         if !p.iter().all(|v| v.is_finite()) {
             return bound;
         }
@@ -83,7 +88,7 @@ impl KdCloud {
     /// as `(d², slot)` into `out`; returns how many, and the squared radius below which every
     /// point is among them (`radius2`, or the `K`-th distance when `K` were found). `p` must be
     /// finite.
-    pub(crate) fn nearest_k_below<const K: usize>(
+    pub fn nearest_k_below<const K: usize>(
         &self,
         p: Point3,
         radius2: f64,
@@ -95,14 +100,14 @@ impl KdCloud {
 
     /// Whether [`KdCloud::nearest_below`] for `p` reaches slot `a` before slot `b`: of two
     /// points at the same distance it answers the first.
-    pub(crate) fn visits_before(&self, p: &Point3, a: usize, b: usize) -> bool {
+    pub fn visits_before(&self, p: &Point3, a: usize, b: usize) -> bool {
         self.tree.visits_before(p, a, b)
     }
 }
 
 /// `(a₀−b₀)² + (a₁−b₁)² + (a₂−b₂)²` summed in that order, the squared distance every tree here
 /// computes.
-pub(crate) fn distance2(a: Point3, b: Point3) -> f64 {
+pub fn distance2(a: Point3, b: Point3) -> f64 {
     (a[0] - b[0]) * (a[0] - b[0]) + (a[1] - b[1]) * (a[1] - b[1]) + (a[2] - b[2]) * (a[2] - b[2])
 }
 

@@ -2,16 +2,18 @@
 
 mod bvh;
 mod cloud;
-pub(crate) mod kd_cloud;
+mod kd_cloud;
 mod leaf_bound;
 mod median_split;
 mod mesh;
-pub(crate) mod neighbour_list;
+mod neighbour_list;
 mod oriented;
 pub(crate) mod slot_tree;
 
 pub use cloud::CloudIndex;
+pub use kd_cloud::{KdCloud, NO_POINT, distance2};
 pub use mesh::{MeshHint, MeshHit, MeshIndex};
+pub use neighbour_list::{LIST_LEN, NeighbourList};
 
 /// `f32` not above `v` (rounds towards −∞): the lower corner of a box that must contain `v`
 /// (the BVH's and the slot tree's `f32` boxes).

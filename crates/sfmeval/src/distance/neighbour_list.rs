@@ -17,7 +17,7 @@ use super::kd_cloud::{KdCloud, distance2};
 use crate::geometry::Point3;
 
 /// Points a list holds.
-pub(crate) const LIST_LEN: usize = 8;
+pub const LIST_LEN: usize = 8;
 
 /// Relative margin on the coverage, far above the rounding of the distances.
 const MARGIN: f64 = 1e-9;
@@ -28,7 +28,7 @@ const TINY2: f64 = 1e-280;
 
 /// One query point's list (frame: the cloud's).
 #[derive(Debug, Clone, Copy)]
-pub(crate) struct NeighbourList {
+pub struct NeighbourList {
     /// Where the list was made.
     centre: Point3,
     /// Every point nearer to `centre` than this (squared) is in `slots`; negative for no list.
@@ -47,12 +47,12 @@ impl Default for NeighbourList {
 
 impl NeighbourList {
     /// Whether the list holds `LIST_LEN` points.
-    pub(crate) fn is_full(&self) -> bool {
+    pub fn is_full(&self) -> bool {
         self.len as usize == LIST_LEN
     }
 
     /// No list yet: the first query walks the tree.
-    pub(crate) const NONE: NeighbourList = NeighbourList {
+    pub const NONE: NeighbourList = NeighbourList {
         centre: [0.0; 3],
         radius2: -1.0,
         len: 0,
@@ -67,7 +67,7 @@ impl NeighbourList {
     /// `q`: this list's old points, or `hint`'s (a list of the same cloud, e.g. the previous
     /// query's in the visiting order) when this one is not full. The points found are the same
     /// (only nodes with no nearer point are skipped); the walk opens fewer nodes.
-    pub(crate) fn nearest_below(
+    pub fn nearest_below(
         &mut self,
         cloud: &KdCloud,
         q: Point3,

@@ -55,7 +55,7 @@ struct JsonPose {
     translation: [f64; 3],
 }
 
-/// Reads a `cameras.json`. The result's [`Reconstruction::warnings`] mention a `frame` other
+/// Reads a `cameras.json`. The result's [`Reconstruction::notes`] mention a `frame` other
 /// than `gltf` or `reconstruction`; rotations are checked to be rotations (orthonormal,
 /// determinant +1, within a tolerance of 1e-4) and cameras and poses for sense
 /// ([`Reconstruction::validate`]).

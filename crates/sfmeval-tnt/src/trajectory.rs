@@ -6,9 +6,9 @@
 use std::fmt::Write as _;
 
 use super::matrix::{IDENTITY, Matrix4};
-use crate::error::{Error, Result};
-use crate::geometry::Point3;
-use crate::model::Reconstruction;
+use sfmeval::geometry::Point3;
+use sfmeval::model::Reconstruction;
+use sfmeval::{Error, Result};
 
 const LOG: &str = ".log trajectory";
 const MAPPING: &str = "mapping reference";

@@ -15,11 +15,11 @@
 //! iteration counts are those of a plain nearest-neighbour query.
 
 use super::matrix::{self, IDENTITY, Matrix4};
-use crate::align::{PairSums, umeyama_pairs};
-use crate::distance::kd_cloud::{KdCloud, NO_POINT, distance2};
-use crate::distance::neighbour_list::NeighbourList;
-use crate::geometry::Point3;
-use crate::parallel::{self, morton_order};
+use sfmeval::align::{PairSums, umeyama_pairs};
+use sfmeval::distance::NeighbourList;
+use sfmeval::distance::{KdCloud, NO_POINT, distance2};
+use sfmeval::geometry::Point3;
+use sfmeval::parallel::{self, morton_order};
 
 /// When ICP stops.
 #[derive(Debug, Clone, Copy, PartialEq)]

@@ -20,13 +20,13 @@ use super::scene::{Scene, scene_tau};
 use super::trajectory::{LogFrame, MAPPING_ABOVE_FRAMES};
 use super::trajectory_alignment::{TrajectoryAlignmentOptions, align_trajectories};
 use super::voxel::voxel_down_sample;
-use crate::crop::{Axis, Volume};
-use crate::distance::kd_cloud::{KdCloud, NO_POINT};
-use crate::error::{Error, Result};
-use crate::geometry::Point3;
-use crate::parallel;
-use crate::progress::{Progress, Stage};
-use crate::report::Tool;
+use sfmeval::crop::{Axis, Volume};
+use sfmeval::distance::{KdCloud, NO_POINT};
+use sfmeval::geometry::Point3;
+use sfmeval::parallel;
+use sfmeval::progress::{Progress, Stage};
+use sfmeval::report::Tool;
+use sfmeval::{Error, Result};
 
 /// The toolbox's point budget of the last refinement (`MAX_POINT_NUMBER`).
 pub const UNIFORM_MAX_POINTS: u64 = 4_000_000;
@@ -93,6 +93,30 @@ impl TntEvaluation {
             &self.recall_distances,
             self.report.protocol.evaluation.color_max_distance,
         )
+    }
+
+    /// The report as written: pretty JSON with a trailing newline.
+    pub fn report_json(&self) -> String {
+        let mut json = serde_json::to_string_pretty(&self.report).unwrap_or_default();
+        json.push('\n');
+        json
+    }
+
+    /// Every file the toolbox writes beside the report, by file name, encoded (the two clouds
+    /// side by side): `<scene>.precision.ply`, `<scene>.recall.ply`, the curves and
+    /// `<scene>.prf_tau_plotstr.txt`. What `sfmeval tnt` writes into its output folder and the
+    /// runner into a run's report folder.
+    pub fn output_files(&self) -> Vec<(String, Vec<u8>)> {
+        let name = &self.report.protocol.scene;
+        let (precision, recall) = parallel::join(|| self.precision_ply(), || self.recall_ply());
+        let mut files = vec![
+            (format!("{name}.precision.ply"), precision),
+            (format!("{name}.recall.ply"), recall),
+        ];
+        for (suffix, text) in self.toolbox_texts() {
+            files.push((format!("{name}{suffix}"), text.into_bytes()));
+        }
+        files
     }
 
     /// The toolbox's text outputs by file suffix: `.precision.txt`, `.recall.txt` (the curves)

@@ -12,9 +12,9 @@
 use std::collections::HashMap;
 use std::hash::{BuildHasherDefault, Hasher};
 
-use crate::error::{Error, Result};
-use crate::geometry::Point3;
-use crate::parallel;
+use sfmeval::geometry::Point3;
+use sfmeval::parallel;
+use sfmeval::{Error, Result};
 
 /// The voxel means of `points` for voxels of edge `size`.
 pub fn voxel_down_sample(points: &[Point3], size: f64) -> Result<Vec<Point3>> {

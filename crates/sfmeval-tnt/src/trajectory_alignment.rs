@@ -18,12 +18,12 @@ use rand_chacha::ChaCha8Rng;
 use serde::{Deserialize, Serialize};
 
 use super::matrix::{self, IDENTITY, Matrix4};
-use crate::align::umeyama;
-use crate::distance::CloudIndex;
-use crate::error::{Error, Result};
-use crate::geometry::Point3;
-use crate::parallel;
-use crate::progress::NoProgress;
+use sfmeval::align::umeyama;
+use sfmeval::distance::CloudIndex;
+use sfmeval::geometry::Point3;
+use sfmeval::parallel;
+use sfmeval::progress::NoProgress;
+use sfmeval::{Error, Result};
 
 /// Parameters of the trajectory alignment.
 #[derive(Debug, Clone, Copy, PartialEq)]

@@ -6,7 +6,7 @@
 
 use std::sync::OnceLock;
 
-use crate::geometry::Point3;
+use sfmeval::geometry::Point3;
 
 /// Lookup-table size (matplotlib's default `N`).
 const N: usize = 256;

@@ -6,11 +6,11 @@
 
 use super::matrix::{self, Matrix4};
 use super::trajectory::{LogFrame, Mapping, read_log, read_mapping};
-use crate::crop::{Crop, Volume};
-use crate::error::{Error, Result};
-use crate::files::{FileSource, file_name, join};
-use crate::geometry::Point3;
-use crate::io;
+use sfmeval::crop::{Crop, Volume};
+use sfmeval::files::{FileSource, file_name, join};
+use sfmeval::geometry::Point3;
+use sfmeval::io;
+use sfmeval::{Error, Result};
 
 /// The toolbox's τ per scene (`config.py`'s `scenes_tau_dict`), in the scene's units (metres).
 pub const SCENE_TAU: [(&str, f64); 7] = [

@@ -1,8 +1,8 @@
 //! Row-major 4×4 matrices as the Tanks and Temples files and Open3D use them: a transform is
 //! applied as a homogeneous product and divided by `w`, products run in Eigen's order.
 
-use crate::error::{Error, Result};
-use crate::geometry::{MAX_COORDINATE, Point3};
+use sfmeval::geometry::{MAX_COORDINATE, Point3};
+use sfmeval::{Error, Result};
 
 /// A row-major 4×4 matrix.
 pub type Matrix4 = [[f64; 4]; 4];

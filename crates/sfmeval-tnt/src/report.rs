@@ -7,7 +7,7 @@ use serde::{Deserialize, Serialize};
 use super::icp::{IcpCriteria, IcpResult};
 use super::matrix::Matrix4;
 use super::trajectory_alignment::{TrajectoryAlignment, TrajectoryAlignmentOptions};
-use crate::report::Tool;
+use sfmeval::report::Tool;
 
 /// Schema id of the report.
 pub const TNT_SCHEMA: &str = "sfmeval.tanksandtemples/1";
