@@ -1,6 +1,6 @@
 //! `sfmeval-runner report`: evaluates every finished run with the sfmeval core (the dataset's
 //! ground truth prepared once, `auto` alignment with its cameras.json, optional crop), writes
-//! one `sfmeval.report/2` per run and the comparison tables (Markdown, CSV, HTML).
+//! one `sfmeval.report/3` per run and the comparison tables (Markdown, CSV, HTML).
 
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};

@@ -195,7 +195,7 @@ struct EvalArgs {
     /// Histogram bins.
     #[arg(long, value_name = "N", default_value_t = sfmeval::stats::DEFAULT_BINS)]
     bins: usize,
-    /// Write the report (sfmeval.report/2 JSON) here.
+    /// Write the report (sfmeval.report/3 JSON) here.
     #[arg(long, value_name = "OUT.json")]
     report: Option<PathBuf>,
     /// Write the kept points coloured by error here (binary PLY).

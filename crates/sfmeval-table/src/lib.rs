@@ -1,5 +1,5 @@
 //! The comparison tables of `sfmeval-runner report` as text, with no filesystem: a run's
-//! record (`run.json`), its row built from the record and its `sfmeval.report/2`, and Table I
+//! record (`run.json`), its row built from the record and its `sfmeval.report/3`, and Table I
 //! and the wide table as Markdown and CSV. The runner writes these strings to files; the page
 //! (through the wasm bindings) builds the same strings from the same runs, so both say the same
 //! thing byte for byte.

@@ -2,7 +2,7 @@
 //!
 //! Thin wasm-bindgen bindings over the sfmeval core, for the npm package `sfmeval` and the
 //! browser page. Bytes go in (`Uint8Array`), options go in as plain JS objects (deserialised with
-//! serde-wasm-bindgen into the core's own option types), and the `sfmeval.report/2` JSON plus
+//! serde-wasm-bindgen into the core's own option types), and the `sfmeval.report/3` JSON plus
 //! typed arrays come out. Every number is computed by the core (`crates/sfmeval`) exactly as the
 //! CLI computes it; errors become JS `Error`s carrying the core's message.
 
@@ -524,7 +524,7 @@ pub struct Evaluation {
 
 #[wasm_bindgen]
 impl Evaluation {
-    /// The `sfmeval.report/2` JSON, byte for byte what `sfmeval eval --report` writes.
+    /// The `sfmeval.report/3` JSON, byte for byte what `sfmeval eval --report` writes.
     #[wasm_bindgen(js_name = reportJson)]
     pub fn report_json(&self) -> String {
         self.inner.report.to_json()

@@ -47,7 +47,7 @@ fn evaluates_the_demo_with_its_transform() {
     )
     .unwrap();
     let report: serde_json::Value = serde_json::from_str(&e.report_json()).unwrap();
-    assert_eq!(report["schema"], "sfmeval.report/2");
+    assert_eq!(report["schema"], "sfmeval.report/3");
     assert_eq!(report["alignment"]["method"], "given");
     assert_eq!(report["options"]["samples"], 20_000);
     let n = recon.point_count() as u32;

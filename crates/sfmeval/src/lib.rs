@@ -4,7 +4,7 @@
 //! OBJ, SfM models) from bytes, align (a given similarity, camera centres, point pairs, a global
 //! search, scaled ICP: [`align`]), crop, compute exact
 //! point-to-triangle (or nearest-neighbour) accuracy and sampled completeness, statistics,
-//! precision/recall/F-score, and the `sfmeval.report/2` report.
+//! precision/recall/F-score, and the `sfmeval.report/3` report.
 //!
 //! No filesystem, no printing, no threads unless the `parallel` feature is on; compiles to
 //! `wasm32-unknown-unknown`. Errors are typed ([`Error`]); input never causes a panic.

@@ -1,4 +1,4 @@
-//! What a sweep plots: metrics as JSON paths into `{"report": <sfmeval.report/2>, "run": <the
+//! What a sweep plots: metrics as JSON paths into `{"report": <sfmeval.report/3>, "run": <the
 //! run's row>}`, the defaults, `[*]` expansion, lookup, and chart file names. A new report
 //! field is one more line in [`DEFAULT_METRICS`] (or `--metric PATH`).
 
@@ -7,7 +7,7 @@ use serde_json::Value as Json;
 use crate::sweep::cells::Cell;
 
 /// Metrics plotted by default: `(path, label)`. `[*]` expands to one metric per element
-/// (the report's thresholds). Paths start at `report.` (the run's `sfmeval.report/2`) or `run.`
+/// (the report's thresholds). Paths start at `report.` (the run's `sfmeval.report/3`) or `run.`
 /// (its row in `runs.csv`, plus `registered_fraction`).
 pub const DEFAULT_METRICS: &[(&str, &str)] = &[
     ("report.thresholds[*].recall", "completeness (recall)"),

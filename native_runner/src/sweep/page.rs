@@ -24,7 +24,7 @@ pub fn page(
     let mut h = String::new();
     let _ = writeln!(
         h,
-        "<h1>Where does each pipeline break? Sweep over <code>{}</code></h1>\n<p><b>{}</b>: {}.</p>\n<p>Command: <code>{}</code></p>\n<p>Pipelines: {}. Each chart plots one metric against the factor, one line per pipeline; a red × in the band under the axis is a run that failed or was not run (hover for the reason), a grey ○ a successful run without that metric. Metrics are read from each run's <code>sfmeval.report/2</code> (<code>report.…</code>) or its row in <code>table/runs.csv</code> (<code>run.…</code>); every value is in <code>sweep.csv</code>.</p>",
+        "<h1>Where does each pipeline break? Sweep over <code>{}</code></h1>\n<p><b>{}</b>: {}.</p>\n<p>Command: <code>{}</code></p>\n<p>Pipelines: {}. Each chart plots one metric against the factor, one line per pipeline; a red × in the band under the axis is a run that failed or was not run (hover for the reason), a grey ○ a successful run without that metric. Metrics are read from each run's <code>sfmeval.report/3</code> (<code>report.…</code>) or its row in <code>table/runs.csv</code> (<code>run.…</code>); every value is in <code>sweep.csv</code>.</p>",
         esc(factor.name()),
         esc(factor.name()),
         esc(factor.description()),

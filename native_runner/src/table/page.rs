@@ -20,7 +20,7 @@ pub fn page(rows: &[Row], datasets: &[String], pipes: &[String]) -> String {
     let mut h = String::from("<h1>SfM pipelines compared with sfmeval</h1>\n");
     let _ = writeln!(
         h,
-        "<p>{} datasets × {} pipelines. Distances in metres, after <code>auto</code> alignment to the ground truth; one <code>sfmeval.report/2</code> per run under <code>reports/</code>.</p>",
+        "<p>{} datasets × {} pipelines. Distances in metres, after <code>auto</code> alignment to the ground truth; one <code>sfmeval.report/3</code> per run under <code>reports/</code>.</p>",
         datasets.len(),
         pipes.len()
     );
