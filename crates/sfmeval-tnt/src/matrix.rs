@@ -43,12 +43,12 @@ pub fn validate(m: &Matrix4, what: &str) -> Result<()> {
         .flatten()
         .find(|v| !(v.is_finite() && v.abs() <= MAX_COORDINATE))
     {
-        return Err(Error::InvalidOption(format!(
+        return Err(Error::InvalidContent(format!(
             "{what}: entry {v} is not a finite number within ±1e50"
         )));
     }
     if m[3] != [0.0, 0.0, 0.0, 1.0] {
-        return Err(Error::InvalidOption(format!(
+        return Err(Error::InvalidContent(format!(
             "{what}: the last row is {:?}, expected [0, 0, 0, 1]",
             m[3]
         )));
@@ -57,7 +57,7 @@ pub fn validate(m: &Matrix4, what: &str) -> Result<()> {
         - m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0])
         + m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0]);
     if !(det.is_finite() && det != 0.0) {
-        return Err(Error::InvalidOption(format!(
+        return Err(Error::InvalidContent(format!(
             "{what}: the 3×3 part is singular"
         )));
     }

@@ -208,13 +208,15 @@ pub fn evaluate(
             trajectory_name,
             options,
         } => {
-            let (centers, mapped) = trajectory_centers(scene, trajectory)?;
+            let (centers, mapped) = trajectory_centers(scene, trajectory)
+                .map_err(|e| e.in_file("trajectory", trajectory_name.as_str()))?;
             let reference: Vec<Point3> = scene
                 .reference_trajectory
                 .iter()
                 .map(|f| matrix::apply(&scene.gt_from_reference, f.center()))
                 .collect();
-            let aligned = align_trajectories(&centers, &reference, options)?;
+            let aligned = align_trajectories(&centers, &reference, options)
+                .map_err(|e| e.in_file("trajectory", trajectory_name.as_str()))?;
             progress.advance(1);
             let mut t = aligned.gt_from_recon;
             // Two voxel refinements, then the uniform one.
@@ -441,7 +443,7 @@ fn trajectory_centers(scene: &Scene, trajectory: &[LogFrame]) -> Result<(Vec<Poi
                 .get(k as usize - 1)
                 .map(LogFrame::center)
                 .ok_or_else(|| {
-                    Error::InvalidOption(format!(
+                    Error::InvalidContent(format!(
                         "the mapping reference names video frame {k}, the trajectory has {}",
                         trajectory.len()
                     ))

@@ -81,9 +81,10 @@ impl Scene {
         let crop =
             Crop::parse(&need(&crop_path, "crop")?).map_err(|e| e.in_file("crop", &crop_path))?;
         let Some(crop) = crop.volume else {
-            return Err(Error::InvalidOption(format!(
-                "crop '{crop_path}' has no volume"
-            )));
+            return Err(Error::InvalidContent(
+                "a crop file without a volume (the scene's crop must be an Open3D SelectionPolygonVolume or an sfmeval.crop/1 with a volume)".into(),
+            )
+            .in_file("crop", crop_path));
         };
 
         let trans_path = file("_trans.txt");

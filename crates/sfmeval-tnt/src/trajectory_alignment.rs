@@ -70,7 +70,7 @@ pub fn align_trajectories(
 ) -> Result<TrajectoryAlignment> {
     let n = reference_in_gt.len();
     if recon_centers.len() != n {
-        return Err(Error::InvalidOption(format!(
+        return Err(Error::InvalidContent(format!(
             "the trajectory has {} frames and the reference trajectory {n}: the .log needs one frame per reference image, in the reference's order",
             recon_centers.len()
         )));

@@ -281,10 +281,10 @@ impl Crop {
     /// Tanks and Temples `<scene>.json`), which becomes a [`Volume::PolygonPrism`] crop.
     pub fn parse(bytes: &[u8]) -> Result<Crop> {
         let value: serde_json::Value = serde_json::from_slice(bytes)
-            .map_err(|e| Error::InvalidOption(format!("crop file: {e}")))?;
+            .map_err(|e| Error::InvalidContent(format!("crop file: {e}")))?;
         if value.get("class_name").is_some() {
             let o3d: Open3dPolygonVolume = serde_json::from_value(value).map_err(|e| {
-                Error::InvalidOption(format!("crop file (Open3D SelectionPolygonVolume): {e}"))
+                Error::InvalidContent(format!("crop file (Open3D SelectionPolygonVolume): {e}"))
             })?;
             let crop = Crop {
                 schema: None,
@@ -295,9 +295,9 @@ impl Crop {
             return Ok(crop);
         }
         let crop: Crop = serde_json::from_value(value)
-            .map_err(|e| Error::InvalidOption(format!("crop file: {e}")))?;
+            .map_err(|e| Error::InvalidContent(format!("crop file: {e}")))?;
         if let Some(s) = crop.schema.as_ref().filter(|s| *s != CROP_SCHEMA) {
-            return Err(Error::InvalidOption(format!(
+            return Err(Error::InvalidContent(format!(
                 "crop file schema is '{s}', expected '{CROP_SCHEMA}'"
             )));
         }

@@ -66,6 +66,11 @@ pub enum Error {
     /// An option value is out of its valid range or inconsistent.
     #[error("invalid option: {0}")]
     InvalidOption(String),
+    /// What a file or a field holds is wrong (a transform that is no similarity, a crop file
+    /// that does not parse, a trajectory with the wrong number of frames): the message names
+    /// the content and says what is wrong; front ends add the file ([`Error::in_file`]).
+    #[error("{0}")]
+    InvalidContent(String),
     /// Geometry that cannot be used (all triangles degenerate, zero-size scene, ...).
     #[error("unusable geometry: {0}")]
     Geometry(String),
@@ -178,6 +183,7 @@ impl Error {
             Error::Empty { .. } => "empty",
             Error::UnknownFormat(_) => "unknown_format",
             Error::InvalidOption(_) => "invalid_option",
+            Error::InvalidContent(_) => "invalid_content",
             Error::Geometry(_) => "geometry",
             Error::Io { .. } => "io",
             Error::Missing { .. } => "missing",

@@ -52,14 +52,14 @@ impl Similarity {
     /// in `[MIN_SCALE, MAX_SCALE]`.
     pub fn from_matrix(m: [[f64; 4]; 4]) -> Result<Similarity> {
         if m.iter().flatten().any(|v| !v.is_finite()) {
-            return Err(Error::InvalidOption(
+            return Err(Error::InvalidContent(
                 "transform has non-finite entries".into(),
             ));
         }
         for (r, row) in m.iter().enumerate() {
             for (c, v) in row.iter().enumerate() {
                 if !(v.abs() <= MAX_COORDINATE) {
-                    return Err(Error::InvalidOption(format!(
+                    return Err(Error::InvalidContent(format!(
                         "transform entry [{r}][{c}] is {}, beyond ±{} (the largest coordinate measured)",
                         show(*v),
                         show(MAX_COORDINATE)
@@ -73,17 +73,17 @@ impl Similarity {
             || last[2].abs() > 1e-9
             || (last[3] - 1.0).abs() > 1e-9
         {
-            return Err(Error::InvalidOption(format!(
+            return Err(Error::InvalidContent(format!(
                 "transform's last row is {last:?}, expected [0, 0, 0, 1]"
             )));
         }
         let s = Similarity { matrix: m };
         let scale = s.scale();
         if !(scale > 0.0) {
-            return Err(Error::InvalidOption("transform has a non-positive determinant (a reflection or a collapse), not a similarity".into()));
+            return Err(Error::InvalidContent("transform has a non-positive determinant (a reflection or a collapse), not a similarity".into()));
         }
         if !(MIN_SCALE..=MAX_SCALE).contains(&scale) {
-            return Err(Error::InvalidOption(format!(
+            return Err(Error::InvalidContent(format!(
                 "transform's scale is {}, outside [{}, {}]",
                 show(scale),
                 show(MIN_SCALE),
@@ -97,7 +97,7 @@ impl Similarity {
                 let d: f64 = (0..3).map(|k| r[k][i] * r[k][j]).sum::<f64>();
                 let want = if i == j { 1.0 } else { 0.0 };
                 if !((d - want).abs() <= 1e-6) {
-                    return Err(Error::InvalidOption(format!(
+                    return Err(Error::InvalidContent(format!(
                         "transform's 3×3 part is not a scaled rotation (RᵀR differs from I by {:.2e})",
                         (d - want).abs()
                     )));
@@ -112,18 +112,18 @@ impl Similarity {
     /// (16 whitespace-separated numbers, row-major; `#` comments allowed).
     pub fn parse(bytes: &[u8]) -> Result<Similarity> {
         let text = std::str::from_utf8(bytes)
-            .map_err(|_| Error::InvalidOption("transform file is not text".into()))?;
+            .map_err(|_| Error::InvalidContent("transform file is not text".into()))?;
         let trimmed = text.trim_start();
         let numbers: Vec<f64> = if trimmed.starts_with('[') || trimmed.starts_with('{') {
             let v: serde_json::Value = serde_json::from_str(text)
-                .map_err(|e| Error::InvalidOption(format!("transform JSON: {e}")))?;
+                .map_err(|e| Error::InvalidContent(format!("transform JSON: {e}")))?;
             let v = match &v {
                 serde_json::Value::Object(o) => o
                     .get("gt_from_recon")
                     .or_else(|| o.get("alignment").and_then(|a| a.get("gt_from_recon")))
                     .or_else(|| o.get("matrix"))
                     .or_else(|| o.get("transform"))
-                    .ok_or_else(|| Error::InvalidOption("transform JSON object has no 'gt_from_recon', 'matrix' or 'transform' field".into()))?,
+                    .ok_or_else(|| Error::InvalidContent("transform JSON object has no 'gt_from_recon', 'matrix' or 'transform' field".into()))?,
                 other => other,
             };
             flatten_numbers(v)?
@@ -134,13 +134,13 @@ impl Similarity {
                 .filter(|w| !w.is_empty())
                 .map(|w| {
                     w.parse::<f64>().map_err(|_| {
-                        Error::InvalidOption(format!("transform: '{w}' is not a number"))
+                        Error::InvalidContent(format!("transform: '{w}' is not a number"))
                     })
                 })
                 .collect::<Result<_>>()?
         };
         if numbers.len() != 16 {
-            return Err(Error::InvalidOption(format!(
+            return Err(Error::InvalidContent(format!(
                 "transform needs 16 numbers (a 4×4), found {}",
                 numbers.len()
             )));
@@ -243,11 +243,11 @@ fn flatten_numbers(v: &serde_json::Value) -> Result<Vec<f64>> {
             serde_json::Value::Number(n) => {
                 out.push(
                     n.as_f64()
-                        .ok_or_else(|| Error::InvalidOption("bad number in transform".into()))?,
+                        .ok_or_else(|| Error::InvalidContent("bad number in transform".into()))?,
                 );
                 Ok(())
             }
-            _ => Err(Error::InvalidOption(
+            _ => Err(Error::InvalidContent(
                 "transform must contain only numbers".into(),
             )),
         }
