@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Tests of the browser page and the npm package: builds the wasm once (scripts/build-web.sh),
 # then runs the wasm-bindgen tests (Node and headless Chromium), the packed npm tarball in Node
-# and in a bundler-free page in Chromium (report byte for byte the CLI's), every alignment path
+# and in a bundler-free page in Chromium (report byte for byte the CLI's; the README's examples run
+# as written, its TypeScript types checked by tsc: npm-test.mjs, npm-browser.mjs), every alignment path
 # through the npm package in Node against the CLI (byte for byte), and the page end to end in
 # Chromium via playwright-core, served with the COOP/COEP headers so that it runs its threaded build
 # (tests/browser/e2e.mjs: results equal the CLI's; tests/browser/threads.mjs: the threaded build's
@@ -40,7 +41,8 @@ fi
 tail -1 "$log/build.log"
 scripts/build-release.sh >"$log/cli.log" 2>&1 || fail "cli build" "$log/cli.log"
 echo "build: $((SECONDS - t)) s"
-(cd tests/browser && [ -f node_modules/axe-core/axe.min.js ] || npm ci --no-audit --no-fund --silent)
+(cd tests/browser && [ -f node_modules/axe-core/axe.min.js ] && [ -f node_modules/typescript/bin/tsc ] ||
+  npm ci --no-audit --no-fund --silent)
 
 # wasm-bindgen-test: one build (cargo runs it in Node), then the same test module in headless
 # Chromium through the runner directly.

@@ -42,6 +42,10 @@ check fmt cargo fmt --all --check
 # bench_op; a full `cargo bench --no-run` cost 400+ s of release builds for no further check).
 check clippy cargo clippy --workspace --all-targets --locked -- -D warnings
 check doc env RUSTDOCFLAGS="-D warnings" cargo doc --workspace --no-deps --locked
+# The core's feature `ts` (ts-rs derives on the report types, off in every build above): lints,
+# and the npm package's report.d.ts is what the types generate (a debug build of the core alone).
+check clippy-ts cargo clippy -p sfmeval --all-targets --features ts --locked -- -D warnings
+check report-types scripts/gen-report-types.sh --check
 # Module import graphs without cycles (core and runner): every arrow points down.
 check import-graph-core python3 scripts/import-graph.py crates/sfmeval/src
 check import-graph-runner python3 scripts/import-graph.py native_runner/src

@@ -7,6 +7,7 @@ import { mkdtempSync, readFileSync, readdirSync, writeFileSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import { join, resolve } from 'node:path';
 import { pathToFileURL } from 'node:url';
+import { format } from 'node:util';
 
 const [tarball, cliReport] = process.argv.slice(2).map((p) => resolve(p));
 const root = resolve(new URL('../..', import.meta.url).pathname);
@@ -84,6 +85,9 @@ const rec = sfmeval.loadReconstruction(model, 'sparse');
 check('npm-camera-poses', gtObj.cameraPoses().length === 36 * sfmeval.POSE_STRIDE && rec.cameraPoses().length === 36 * sfmeval.POSE_STRIDE
   && rec.cameraNames().length === 36 && sfmeval.errorColors([0, 1], 1).length === 6);
 gtObj.free(); rec.free();
+// the camera alignment's transform as a transform file (16 numbers, row-major)
+const gtFromRecon = [...r.gtFromRecon()];
+const transformText = [0, 4, 8, 12].map((i) => gtFromRecon.slice(i, i + 4).join(' ')).join('\n') + '\n';
 r.free();
 
 try {
@@ -108,6 +112,98 @@ try {
 } catch (e) {
   check('npm-align-needs-pairs', /'points\+icp' needs point pairs/.test(e.message), String(e && e.message));
 }
+
+// The README's Node example, as the package ships it, run as written in the consumer project
+// beside the demo's files (its gt_from_recon.txt: the transform of the camera alignment above):
+// what it prints is the report's numbers, and the report.json it writes is the package's report
+// for the same inputs and options.
+const readme = readFileSync(join(dir, 'node_modules/sfmeval/README.md'), 'utf8');
+const fenced = (heading, lang) => { // the first ```lang block of a README section
+  const at = readme.indexOf(`\n## ${heading}\n`);
+  const start = at < 0 ? -1 : readme.indexOf('```' + lang + '\n', at);
+  const end = start < 0 ? -1 : readme.indexOf('\n```\n', start);
+  return end < 0 || readme.slice(at + 1, start).includes('\n## ') ? null : readme.slice(start + lang.length + 4, end + 1);
+};
+const nodeExample = fenced('Example (Node)', 'js');
+let readmeReport = null; // the report.json it writes
+check('npm-readme-node-example-found', nodeExample?.includes("from 'sfmeval'"), String(nodeExample));
+if (nodeExample) {
+  writeFileSync(join(dir, 'readme-example.mjs'), nodeExample);
+  writeFileSync(join(dir, 'ground_truth.glb'), demo('ground_truth.glb'));
+  writeFileSync(join(dir, 'sparse.ply'), demo('sparse.ply'));
+  writeFileSync(join(dir, 'gt_from_recon.txt'), transformText);
+  let stdout = '', why = '';
+  try {
+    stdout = execFileSync(process.execPath, ['readme-example.mjs'], { cwd: dir, encoding: 'utf8', maxBuffer: 1 << 28 });
+  } catch (e) { why = `${e.message}\n${e.stderr ?? ''}`; }
+  const written = why ? '' : readFileSync(join(dir, 'report.json'), 'utf8');
+  if (written) readmeReport = written;
+  const same = sfmeval.evaluate({
+    gt: { 'ground_truth.glb': demo('ground_truth.glb') },
+    recon: { 'sparse.ply': demo('sparse.ply') },
+    options: { transform: transformText, tau_percent_of_diagonal: [0.5, 1, 2] },
+  });
+  const report = same.report;
+  check('npm-readme-node-example-runs', !why && written === same.reportJson,
+    why || `report.json differs from the package's report (${written.length} vs ${same.reportJson.length} bytes)`);
+  // progress lines, then `console.log(mean, thresholds)`
+  const printed = format(report.accuracy.mean, report.thresholds) + '\n';
+  check('npm-readme-node-example-prints-the-report', !why && stdout.endsWith(printed) && stdout.length > printed.length
+    && report.options.align === 'given' && report.thresholds.length === 3 && report.accuracy.count > 0,
+    `printed ${JSON.stringify(stdout.slice(-300))}, expected the end ${JSON.stringify(printed)}`);
+  same.free();
+}
+
+// The package's declarations from TypeScript: npm-example.ts (the README's uses, with
+// @ts-expect-error lines that only type-check while the report is typed) and the README's Node
+// example as TypeScript, `tsc --noEmit --strict` in the consumer project; then the same with
+// `report: any` in the installed index.d.ts must fail (so the check can fail). And real reports
+// (the CLI's of the demo with cameras and notes, the README example's without cameras) as object
+// literals of type `Report`: tsc rejects a missing field, a field the types do not declare and a
+// value of another type, so the generated types say what reports hold. A third report has what
+// those two lack: notes with values (`auto`'s global search and ICP), signed statistics, a crop
+// volume.
+{
+  const third = sfmeval.evaluate({
+    gt: { 'ground_truth.glb': demo('ground_truth.glb') },
+    recon: { 'sparse.ply': demo('sparse.ply') },
+    options: { align: 'auto', samples: 20000, signed: true,
+      crop: { volume: { kind: 'sphere', center: [0, 0.1, 0], radius: 0.2 }, max_distance: 0.001 } },
+  });
+  const thirdJson = third.reportJson, thirdReport = third.report;
+  third.free();
+  const tsc = join(root, 'tests/browser/node_modules/typescript/bin/tsc');
+  writeFileSync(join(dir, 'example.ts'), readFileSync(join(root, 'tests/browser/npm-example.ts')));
+  writeFileSync(join(dir, 'readme-example.ts'), nodeExample ?? '');
+  writeFileSync(join(dir, 'tsconfig.json'), JSON.stringify({
+    compilerOptions: {
+      strict: true, noEmit: true, target: 'es2022', module: 'nodenext', moduleResolution: 'nodenext',
+      lib: ['esnext', 'dom'], types: ['node'], typeRoots: [join(root, 'tests/browser/node_modules/@types')],
+    },
+    files: ['example.ts', 'readme-example.ts'],
+  }));
+  writeFileSync(join(dir, 'reports.ts'), `import type { Report } from 'sfmeval';\nexport const reports: Report[] = [\n${
+    [expected, readmeReport ?? '{}', thirdJson].join(',\n')}];\n`);
+  writeFileSync(join(dir, 'tsconfig.reports.json'), JSON.stringify({ extends: './tsconfig.json', files: ['reports.ts'] }));
+  const run = (config = 'tsconfig.json') => {
+    try { execFileSync(process.execPath, [tsc, '-p', config], { cwd: dir, encoding: 'utf8' }); return { ok: true, out: '' }; }
+    catch (e) { return { ok: false, out: `${e.stdout ?? ''}${e.stderr ?? ''}${e.stdout || e.stderr ? '' : e.message}` }; }
+  };
+  const typed = run();
+  check('npm-types-tsc-example', typed.ok && nodeExample, typed.out.slice(0, 2000));
+  const literal = run('tsconfig.reports.json');
+  check('npm-types-accept-reports', literal.ok && readmeReport && thirdReport.notes.some((n) => n.values)
+    && thirdReport.accuracy.signed && thirdReport.crop.volume, literal.out.slice(0, 2000) || JSON.stringify(thirdReport.notes));
+  const indexDts = join(dir, 'node_modules/sfmeval/index.d.ts');
+  const original = readFileSync(indexDts, 'utf8');
+  const loose = original.replace('readonly report: Report;', 'readonly report: any;');
+  writeFileSync(indexDts, loose);
+  const untyped = run();
+  writeFileSync(indexDts, original);
+  check('npm-types-tsc-fails-when-report-is-any', loose !== original && !untyped.ok && /TS2578/.test(untyped.out),
+    loose === original ? 'index.d.ts has no `readonly report: Report;`' : untyped.out.slice(0, 1000));
+}
+
 const crop = sfmeval.parseCrop('{"schema":"sfmeval.crop/1","volume":{"kind":"sphere","center":[0,0,0],"radius":1}}');
 check('npm-crop-roundtrip', crop.volume.kind === 'sphere' && sfmeval.cropFile(crop).includes('"sfmeval.crop/1"'));
 console.log(`npm: demo evaluated in ${ms.toFixed(0)} ms in Node`);

@@ -5,6 +5,11 @@ import type {
   Cameras as RawCameras,
 } from './sfmeval_wasm.js';
 import * as rawBindings from './sfmeval_wasm.js';
+import type { Report, Volume } from './report.js';
+
+/** The report's types (`Report`, its sections, `Note`, the note `Code`s, ...), generated from the
+ * core's Rust types (`report.d.ts`, `scripts/gen-report-types.sh`). */
+export * from './report.js';
 
 /** File contents by (relative) file name. */
 export type Files = Record<string, Uint8Array | ArrayBuffer | ArrayBufferView | string>;
@@ -12,13 +17,8 @@ export type Files = Record<string, Uint8Array | ArrayBuffer | ArrayBufferView | 
 /** A 3D point. */
 export type Vec3 = [number, number, number];
 
-/** Crop volume in the ground-truth frame (`sfmeval.crop/1`). */
-export type Volume =
-  | { kind: 'box'; min: Vec3; max: Vec3 }
-  | { kind: 'oriented_box'; center: Vec3; half_extents: Vec3; rotation: [Vec3, Vec3, Vec3] }
-  | { kind: 'sphere'; center: Vec3; radius: number };
-
-/** A crop: an optional volume and an optional maximum distance to the ground truth. */
+/** A crop: an optional volume (`Volume`, as in the report: `box`, `oriented_box`, `sphere`,
+ * `polygon_prism`) and an optional maximum distance to the ground truth. */
 export interface Crop {
   schema?: 'sfmeval.crop/1';
   volume?: Volume;
@@ -83,10 +83,10 @@ export type ProgressCallback = (stage: string, done: number, total: number) => v
 
 /** The result of {@link evaluate}. */
 export interface EvaluationResult {
-  /** The `sfmeval.report/2` JSON text, byte for byte what `sfmeval eval --report` writes. */
+  /** The `sfmeval.report/3` JSON text, byte for byte what `sfmeval eval --report` writes. */
   readonly reportJson: string;
-  /** The parsed report. */
-  readonly report: any;
+  /** The parsed report (`JSON.parse(reportJson)`). */
+  readonly report: Report;
   /** Every reconstructed point in the ground-truth frame, `x0, y0, z0, ...`. */
   pointsInGt(): Float64Array;
   /** The same as 32-bit floats (WebGL). */

@@ -28,6 +28,7 @@ use crate::geometry::{Point3, sub};
 /// A crop volume in the ground-truth frame.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(tag = "kind", rename_all = "snake_case", deny_unknown_fields)]
+#[cfg_attr(feature = "ts", derive(ts_rs::TS))]
 pub enum Volume {
     /// Axis-aligned box.
     Box {
@@ -71,6 +72,7 @@ pub enum Volume {
 /// A coordinate axis.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "lowercase")]
+#[cfg_attr(feature = "ts", derive(ts_rs::TS))]
 pub enum Axis {
     /// x.
     X,

@@ -10,6 +10,7 @@ use serde_json::{Map, Value};
 /// How much a note matters.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
+#[cfg_attr(feature = "ts", derive(ts_rs::TS))]
 pub enum Level {
     /// Routine information on how the numbers were made.
     Info,
@@ -32,8 +33,10 @@ macro_rules! codes {
     ($($(#[doc = $doc:literal])+ $variant:ident = $code:literal, $level:ident;)+) => {
         /// The stable code of a note (serialized as its text, e.g. `alignment.icp_rejected`).
         #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash)]
+        // TypeScript: the union of the code texts (each variant renamed to its text)
+        #[cfg_attr(feature = "ts", derive(ts_rs::TS))]
         pub enum Code {
-            $($(#[doc = $doc])+ $variant,)+
+            $($(#[doc = $doc])+ #[cfg_attr(feature = "ts", ts(rename = $code))] $variant,)+
         }
 
         impl Code {
@@ -188,6 +191,7 @@ impl<'de> Deserialize<'de> for Code {
 
 /// One note of a report.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "ts", derive(ts_rs::TS))]
 pub struct Note {
     /// Stable code.
     pub code: Code,

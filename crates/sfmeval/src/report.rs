@@ -21,8 +21,10 @@ pub(crate) const REPORT_SCHEMA: &str = "sfmeval.report/3";
 
 /// The whole report.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "ts", derive(ts_rs::TS))]
 pub struct Report {
     /// Always `"sfmeval.report/3"`.
+    #[cfg_attr(feature = "ts", ts(type = "\"sfmeval.report/3\""))]
     pub schema: String,
     /// The program that wrote it.
     pub tool: Tool,
@@ -45,10 +47,12 @@ pub struct Report {
     /// Completeness over the part of the surface the ground-truth images see (only when depth
     /// maps were given).
     #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[cfg_attr(feature = "ts", ts(optional))]
     pub completeness_visible: Option<VisibleCompletenessReport>,
     /// Track-based true error of the reconstructed points (only when depth maps were given and
     /// the reconstruction has tracks).
     #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[cfg_attr(feature = "ts", ts(optional))]
     pub track_error: Option<TrackErrorReport>,
     /// What the reader should know besides the numbers, typed (`crate::note`).
     pub notes: Vec<Note>,
@@ -56,6 +60,7 @@ pub struct Report {
 
 /// Name and version of the writer.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "ts", derive(ts_rs::TS))]
 pub struct Tool {
     /// `"sfmeval"`.
     pub name: String,
@@ -74,6 +79,7 @@ impl Default for Tool {
 
 /// Both inputs.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "ts", derive(ts_rs::TS))]
 pub struct Inputs {
     /// The reconstruction.
     pub reconstruction: ReconstructionInput,
@@ -83,6 +89,7 @@ pub struct Inputs {
 
 /// The reconstruction as read.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "ts", derive(ts_rs::TS))]
 pub struct ReconstructionInput {
     /// File name (no folders).
     pub name: String,
@@ -96,6 +103,7 @@ pub struct ReconstructionInput {
 
 /// The ground truth as read.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "ts", derive(ts_rs::TS))]
 pub struct GroundTruthInput {
     /// File name (no folders).
     pub name: String,
@@ -113,6 +121,7 @@ pub struct GroundTruthInput {
 
 /// Options that change numbers.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "ts", derive(ts_rs::TS))]
 pub struct ReportOptions {
     /// Completeness samples requested on a mesh.
     pub samples: u64,
@@ -131,11 +140,13 @@ pub struct ReportOptions {
     pub align: String,
     /// Images a surface sample must be seen in to count as visible (only with depth maps).
     #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[cfg_attr(feature = "ts", ts(optional))]
     pub min_views: Option<u64>,
 }
 
 /// What the crop did.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "ts", derive(ts_rs::TS))]
 pub struct CropReport {
     /// `none`, `box`, `oriented_box`, `sphere`, `max_distance`, or `<volume>+max_distance`.
     pub kind: String,
@@ -157,6 +168,7 @@ pub struct CropReport {
 
 /// One stage of the alignment.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "ts", derive(ts_rs::TS))]
 pub struct AlignmentStage {
     /// `given`, `cameras`, `points`, `global`, `icp`.
     pub method: String,
@@ -180,6 +192,7 @@ pub struct AlignmentStage {
 
 /// The final transform and how it was found.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "ts", derive(ts_rs::TS))]
 pub struct AlignmentReport {
     /// `none`, `given`, `cameras`, `icp`, `global`, `cameras+icp`, ...
     pub method: String,
@@ -201,6 +214,7 @@ pub struct AlignmentReport {
 
 /// Reconstruction → ground-truth distance statistics.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "ts", derive(ts_rs::TS))]
 pub struct AccuracyReport {
     /// Always `reconstruction_to_ground_truth`.
     pub direction: String,
@@ -211,11 +225,13 @@ pub struct AccuracyReport {
     pub stats: Statistics,
     /// Statistics of signed distances (by the closest triangle's normal), when asked for.
     #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[cfg_attr(feature = "ts", ts(optional))]
     pub signed: Option<Statistics>,
 }
 
 /// Ground-truth → reconstruction distance statistics.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "ts", derive(ts_rs::TS))]
 pub struct CompletenessReport {
     /// Always `ground_truth_to_reconstruction`.
     pub direction: String,
@@ -232,6 +248,7 @@ pub struct CompletenessReport {
 
 /// Precision, recall and F-score at one threshold.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "ts", derive(ts_rs::TS))]
 pub struct ThresholdReport {
     /// Threshold in ground-truth units.
     pub tau: f64,
@@ -248,6 +265,7 @@ pub struct ThresholdReport {
 /// Completeness over the visible part of the surface: the completeness samples seen in at least
 /// `min_views` ground-truth images (`crate::visibility`).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "ts", derive(ts_rs::TS))]
 pub struct VisibleCompletenessReport {
     /// Always `ground_truth_to_reconstruction`.
     pub direction: String,
@@ -263,6 +281,7 @@ pub struct VisibleCompletenessReport {
     pub visible_fraction: f64,
     /// Visible area in squared ground-truth units (mesh ground truth without crop volume only).
     #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[cfg_attr(feature = "ts", ts(optional))]
     pub visible_area: Option<f64>,
     /// The threshold of the per-sample labels covered / missed / unseen (the first threshold).
     pub labels_tau: f64,
@@ -275,6 +294,7 @@ pub struct VisibleCompletenessReport {
 
 /// Recall at one threshold, over all samples and over the visible ones.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "ts", derive(ts_rs::TS))]
 pub struct VisibleThresholdReport {
     /// Threshold in ground-truth units.
     pub tau: f64,
@@ -288,6 +308,7 @@ pub struct VisibleThresholdReport {
 
 /// Track-based true error (`crate::track_error`).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "ts", derive(ts_rs::TS))]
 pub struct TrackErrorReport {
     /// Always `reconstruction_to_track_truth`: from each aligned point to the robust mean of its
     /// observations back-projected on the ground-truth depth maps.
@@ -325,6 +346,7 @@ pub struct TrackErrorReport {
 
 /// Sliding points at one threshold.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "ts", derive(ts_rs::TS))]
 pub struct SlidingThresholdReport {
     /// Threshold in ground-truth units.
     pub tau: f64,
@@ -337,6 +359,7 @@ pub struct SlidingThresholdReport {
 
 /// The report's `cameras` section: the pose errors and the transform they were measured after.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "ts", derive(ts_rs::TS))]
 pub struct CamerasSection {
     /// The pose errors.
     #[serde(flatten)]
@@ -347,6 +370,7 @@ pub struct CamerasSection {
 
 /// Which transform the camera poses were measured after.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "ts", derive(ts_rs::TS))]
 pub struct CamerasAlignment {
     /// `cameras` (the camera stage's transform, before any point refinement) or the
     /// alignment method when no camera stage ran.
@@ -363,5 +387,96 @@ impl Report {
         let mut s = serde_json::to_string_pretty(self).unwrap_or_default();
         s.push('\n');
         s
+    }
+}
+
+/// The TypeScript declarations of [`Report`] and every type it holds, generated by ts-rs from
+/// the types above (serde's renames, flattening and skips included), and the check that the
+/// npm package ships them (`crates/sfmeval-wasm/js/report.d.ts`, imported by its `index.d.ts`).
+/// `scripts/gen-report-types.sh` rewrites the file (`SFMEVAL_WRITE_REPORT_TYPES=1`); without
+/// that variable the test fails when the file is stale.
+#[cfg(all(test, feature = "ts"))]
+mod typescript {
+    use std::collections::HashMap;
+
+    use ts_rs::{Config, TS, TypeVisitor};
+
+    use super::{REPORT_SCHEMA, Report};
+
+    /// The package file, from this crate's folder.
+    const FILE: &str = "../sfmeval-wasm/js/report.d.ts";
+
+    /// Every declarable type reachable from the visited ones, each once, in the order first met.
+    struct Declarations<'a> {
+        cfg: &'a Config,
+        /// Declarations by name.
+        seen: HashMap<String, String>,
+        out: String,
+    }
+
+    impl TypeVisitor for Declarations<'_> {
+        fn visit<T: TS + 'static + ?Sized>(&mut self) {
+            // primitives and containers have no declaration of their own
+            if T::output_path().is_none() {
+                return;
+            }
+            // one declaration a name (serde_json's `Value` and `Map` both declare `JsonValue`)
+            let decl = T::decl(self.cfg);
+            match self.seen.get(&T::ident(self.cfg)) {
+                Some(earlier) => {
+                    assert_eq!(
+                        *earlier,
+                        decl,
+                        "two report types named {}",
+                        T::ident(self.cfg)
+                    );
+                    return;
+                }
+                None => self.seen.insert(T::ident(self.cfg), decl.clone()),
+            };
+            self.out.push('\n');
+            if let Some(docs) = T::docs() {
+                self.out.push_str(&docs);
+            }
+            self.out.push_str("export ");
+            self.out.push_str(&decl);
+            self.out.push('\n');
+            T::visit_dependencies(self);
+        }
+    }
+
+    fn declarations() -> String {
+        // u64 counts are JSON numbers, which `JSON.parse` reads as `number` (not `bigint`)
+        let cfg = Config::new().with_large_int("number");
+        let mut d = Declarations {
+            cfg: &cfg,
+            seen: HashMap::new(),
+            out: format!(
+                "// The `{REPORT_SCHEMA}` report's types, generated from the Rust types of\n\
+                 // crates/sfmeval (feature `ts`, ts-rs) by scripts/gen-report-types.sh: do not edit.\n"
+            ),
+        };
+        d.visit::<Report>();
+        // ts-rs leaves a space at the end of each field's line
+        d.out
+            .lines()
+            .map(|l| format!("{}\n", l.trim_end()))
+            .collect()
+    }
+
+    #[test]
+    fn report_types_are_the_committed_ones() {
+        let text = declarations();
+        assert!(text.contains(&format!("schema: \"{REPORT_SCHEMA}\"")));
+        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join(FILE);
+        if std::env::var_os("SFMEVAL_WRITE_REPORT_TYPES").is_some() {
+            std::fs::write(&path, &text).expect("write report.d.ts");
+        }
+        let committed = std::fs::read_to_string(&path).unwrap_or_default();
+        assert!(
+            committed == text,
+            "{} is not what the report types generate: run scripts/gen-report-types.sh",
+            path.display()
+        );
     }
 }

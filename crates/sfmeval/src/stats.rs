@@ -8,6 +8,7 @@ use crate::parallel;
 
 /// Percentiles reported in every statistics block.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, Default)]
+#[cfg_attr(feature = "ts", derive(ts_rs::TS))]
 pub struct Percentiles {
     /// 50th percentile (the median).
     pub p50: f64,
@@ -23,6 +24,7 @@ pub struct Percentiles {
 /// Values below the first edge or above the last are not in any bin but counted in
 /// `underflow` / `overflow`, so `counts` + both always add up to the number of values.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize, Default)]
+#[cfg_attr(feature = "ts", derive(ts_rs::TS))]
 pub struct Histogram {
     /// Bin edges, increasing.
     pub edges: Vec<f64>,
@@ -43,6 +45,7 @@ pub(crate) const HISTOGRAM_TAIL: f64 = 0.5;
 
 /// Statistics of a set of values. All zero when `count == 0`.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize, Default)]
+#[cfg_attr(feature = "ts", derive(ts_rs::TS))]
 pub struct Statistics {
     /// Number of values.
     pub count: u64,

@@ -50,6 +50,7 @@ impl Default for PoseOptions {
 
 /// Relative accuracy at one threshold.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "ts", derive(ts_rs::TS))]
 pub struct RelativeAccuracy {
     /// Threshold in degrees.
     pub threshold_deg: f64,
@@ -63,6 +64,7 @@ pub struct RelativeAccuracy {
 
 /// Relative-pose errors over all ground-truth image pairs.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "ts", derive(ts_rs::TS))]
 pub struct RelativePoseReport {
     /// Number of pairs evaluated.
     pub pairs: usize,
@@ -82,6 +84,7 @@ pub struct RelativePoseReport {
 
 /// Focal-length error of one estimated camera.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "ts", derive(ts_rs::TS))]
 pub struct FocalError {
     /// Estimated camera id.
     pub camera_id: u64,
@@ -99,6 +102,7 @@ pub struct FocalError {
 
 /// Pose error of one matched image.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "ts", derive(ts_rs::TS))]
 pub struct ImagePoseError {
     /// Ground-truth image name.
     pub name: String,
@@ -114,6 +118,7 @@ pub struct ImagePoseError {
 
 /// The report's `cameras` section.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "ts", derive(ts_rs::TS))]
 pub struct CamerasReport {
     /// Ground-truth images.
     pub ground_truth: usize,

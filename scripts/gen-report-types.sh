@@ -1,0 +1,14 @@
+#!/usr/bin/env bash
+# Writes crates/sfmeval-wasm/js/report.d.ts, the npm package's TypeScript types of the
+# `sfmeval.report/3` report, from the core's Rust types (feature `ts`: ts-rs derives; the test
+# `report::typescript` in crates/sfmeval/src/report.rs). With --check it writes nothing and fails
+# when the committed file is not what the types generate (scripts/test.sh runs that).
+# A debug build of the core alone (a few minutes from scratch).
+set -euo pipefail
+cd "$(dirname "$0")/.."
+case "${1:-}" in
+  --check) ;;
+  "") export SFMEVAL_WRITE_REPORT_TYPES=1 ;;
+  *) echo "usage: $0 [--check]" >&2; exit 2 ;;
+esac
+cargo test --locked -p sfmeval --features ts --lib report::typescript::report_types_are_the_committed_ones
