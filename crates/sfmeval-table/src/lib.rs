@@ -15,4 +15,4 @@ pub mod text;
 pub use order::BUILTIN_PIPELINES;
 pub use row::{Prf, Row};
 pub use run::{RunFacts, Status, failed_row, report_row};
-pub use tables::{Tables, alignment_caption, summary_json, tables};
+pub use tables::{Tables, summary_json, tables};

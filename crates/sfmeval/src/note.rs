@@ -234,11 +234,6 @@ impl Note {
         self.message = format!("{prefix}{}", self.message);
         self
     }
-
-    /// `true` for a warning.
-    pub fn is_warning(&self) -> bool {
-        self.level == Level::Warning
-    }
 }
 
 impl std::fmt::Display for Note {

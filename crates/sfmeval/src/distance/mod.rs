@@ -13,7 +13,7 @@ pub(crate) mod slot_tree;
 pub use cloud::CloudIndex;
 pub use kd_cloud::{KdCloud, NO_POINT, distance2};
 pub use mesh::{MeshHint, MeshHit, MeshIndex};
-pub use neighbour_list::{LIST_LEN, NeighbourList};
+pub use neighbour_list::NeighbourList;
 
 /// `f32` not above `v` (rounds towards −∞): the lower corner of a box that must contain `v`
 /// (the BVH's and the slot tree's `f32` boxes).
