@@ -17,6 +17,9 @@ mapped before comparing (numbers compare exactly, as parsed from the JSON text):
   given` (or `icp`) and cameras, the pose errors are measured after the camera alignment, as
   `auto` measures them, not after the final transform.
 
+Two `sfmeval.report/3` reports compare whole, their notes (codes, levels, messages, values and
+order) included.
+
 Prints one line per case and exits 1 when any case differs. `DIR` holds demo depth maps
 (tests/browser/make_demo_depth.py) for the visibility and track-error case.
 """
@@ -75,7 +78,9 @@ def run(binary, args, path):
 
 def upgrade(old, new):
     """The /1 or /2 report `old` in /3 terms (`new` gives the requested mode); the notes of both
-    are dropped (see the module's doc)."""
+    are dropped (see the module's doc). Two /3 reports compare whole, notes included."""
+    if old.get("schema") == new.get("schema") == "sfmeval.report/3":
+        return old
     if old.get("schema") == "sfmeval.report/1":
         old["schema"] = "sfmeval.report/2"
         for t in old.get("thresholds", []):

@@ -61,439 +61,6 @@ track_error?: TrackErrorReport,
 notes: Array<Note>, };
 
 /**
- * One note of a report.
- */
-export type Note = {
-/**
- * Stable code.
- */
-code: Code,
-/**
- * `info` or `warning` (the code's level).
- */
-level: Level,
-/**
- * What happened, in words for people.
- */
-message: string,
-/**
- * The values the message states, by name (counts, shares, thresholds, the stage).
- */
-values?: { [key in string]: JsonValue }, };
-
-export type JsonValue = number | string | boolean | Array<JsonValue> | { [key in string]: JsonValue } | null;
-
-/**
- * How much a note matters.
- */
-export type Level = "info" | "warning";
-
-/**
- * The stable code of a note (serialized as its text, e.g. `alignment.icp_rejected`).
- */
-export type Code = "input.model_no_points" | "input.several_models" | "input.incomplete_model_ignored" | "input.several_model_files" | "input.trailing_content" | "input.dangling_references" | "input.no_image_list" | "input.unregistered_images" | "input.missing_intrinsics" | "input.no_principal_point" | "input.unknown_image_size" | "input.principal_point_outside" | "input.unknown_camera_frame" | "input.camera_centres_removed" | "input.cloud_with_model_cameras" | "input.no_point_at_camera_centres" | "input.mesh_vertices_only" | "input.degenerate_faces_skipped" | "input.non_surface_primitive_skipped" | "input.duplicate_image_names" | "input.images_matched_by_stem" | "cameras.reconstruction_has_no_cameras" | "cameras.no_image_in_common" | "cameras.non_finite_poses" | "cameras.few_matched" | "cameras.unmatched_estimated" | "cameras.scene_radius_degenerate" | "cameras.centres_out_of_range" | "cameras.relative_pairs_subsampled" | "cameras.poses_after_final_transform" | "alignment.non_finite_points_ignored" | "alignment.global_search_result" | "alignment.ambiguous_pose" | "alignment.icp_rejected" | "alignment.stage_failed" | "alignment.fell_back" | "alignment.icp_from_identity" | "alignment.camera_outliers" | "alignment.non_finite_camera_pairs" | "alignment.camera_centres_degenerate" | "alignment.few_inliers" | "alignment.unsettled_tight_fit" | "alignment.unsettled_loose_fit" | "measure.signed_needs_mesh" | "measure.crop_discarded_everything" | "measure.no_ground_truth_in_crop" | "measure.nothing_visible" | "measure.no_track_error" | "measure.no_track_measured";
-
-/**
- * Options that change numbers.
- */
-export type ReportOptions = {
-/**
- * Completeness samples requested on a mesh.
- */
-samples: number,
-/**
- * Seed of the surface sampler.
- */
-seed: number,
-/**
- * Whether signed accuracy was computed.
- */
-signed: boolean,
-/**
- * Histogram bins.
- */
-histogram_bins: number,
-/**
- * Thresholds given in ground-truth units.
- */
-tau: Array<number>,
-/**
- * Thresholds given in percent of the ground-truth bounding-box diagonal.
- */
-tau_percent_of_diagonal: Array<number>,
-/**
- * The requested alignment mode (`auto`, `cameras+icp`, `given`, ...); what ran is
- * `alignment.method`.
- */
-align: string,
-/**
- * Images a surface sample must be seen in to count as visible (only with depth maps).
- */
-min_views?: number, };
-
-/**
- * Ground-truth → reconstruction distance statistics.
- */
-export type CompletenessReport = {
-/**
- * Always `ground_truth_to_reconstruction`.
- */
-direction: string,
-/**
- * `surface_samples` (mesh GT) or `ground_truth_points` (cloud GT).
- */
-source: string,
-/**
- * Ground-truth points measured (inside the crop volume).
- */
-samples: number,
-/**
- * Seed of the surface sampler.
- */
-seed: number,
-/**
- * Number of values.
- */
-count: number,
-/**
- * Smallest value.
- */
-min: number,
-/**
- * Largest value.
- */
-max: number,
-/**
- * Arithmetic mean.
- */
-mean: number,
-/**
- * Population standard deviation (divides by n).
- */
-std: number,
-/**
- * Median (= p50).
- */
-median: number,
-/**
- * Root mean square.
- */
-rms: number,
-/**
- * Percentiles.
- */
-percentiles: Percentiles,
-/**
- * Histogram.
- */
-histogram: Histogram, };
-
-/**
- * A histogram with `edges.len() == counts.len() + 1`; the last bin includes its right edge.
- * Values below the first edge or above the last are not in any bin but counted in
- * `underflow` / `overflow`, so `counts` + both always add up to the number of values.
- */
-export type Histogram = {
-/**
- * Bin edges, increasing.
- */
-edges: Array<number>,
-/**
- * Values per bin.
- */
-counts: Array<number>,
-/**
- * Values below the first edge.
- */
-underflow: number,
-/**
- * Values above the last edge.
- */
-overflow: number, };
-
-/**
- * Percentiles reported in every statistics block.
- */
-export type Percentiles = {
-/**
- * 50th percentile (the median).
- */
-p50: number,
-/**
- * 90th percentile.
- */
-p90: number,
-/**
- * 95th percentile.
- */
-p95: number,
-/**
- * 99th percentile.
- */
-p99: number, };
-
-/**
- * Name and version of the writer.
- */
-export type Tool = {
-/**
- * `"sfmeval"`.
- */
-name: string,
-/**
- * Crate version.
- */
-version: string, };
-
-/**
- * What the crop did.
- */
-export type CropReport = {
-/**
- * `none`, `box`, `oriented_box`, `sphere`, `max_distance`, or `<volume>+max_distance`.
- */
-kind: string,
-/**
- * Reconstructed points kept.
- */
-kept: number,
-/**
- * Reconstructed points discarded (all reasons).
- */
-discarded: number,
-/**
- * Discarded because outside the volume.
- */
-discarded_outside_volume: number,
-/**
- * Discarded because farther than `max_distance` from the ground truth.
- */
-discarded_farther_than_max_distance: number,
-/**
- * The volume, as in the crop file.
- */
-volume: Volume | null,
-/**
- * The distance limit.
- */
-max_distance: number | null,
-/**
- * Ground-truth samples inside the volume (used for completeness).
- */
-ground_truth_samples_kept: number, };
-
-/**
- * A crop volume in the ground-truth frame.
- */
-export type Volume = { "kind": "box",
-/**
- * Minimum corner.
- */
-min: [number, number, number],
-/**
- * Maximum corner.
- */
-max: [number, number, number], } | { "kind": "oriented_box",
-/**
- * Centre.
- */
-center: [number, number, number],
-/**
- * Half sizes along the box axes.
- */
-half_extents: [number, number, number],
-/**
- * Row-major `world_from_box` rotation (columns are the box axes in the world).
- */
-rotation: [[number, number, number], [number, number, number], [number, number, number]], } | { "kind": "sphere",
-/**
- * Centre.
- */
-center: [number, number, number],
-/**
- * Radius.
- */
-radius: number, } | { "kind": "polygon_prism",
-/**
- * The polygon's vertices in order (closed implicitly).
- */
-polygon: Array<[number, number, number]>,
-/**
- * The extrusion axis: `x`, `y` or `z`.
- */
-axis: Axis,
-/**
- * Lower bound along `axis`.
- */
-axis_min: number,
-/**
- * Upper bound along `axis`.
- */
-axis_max: number, };
-
-/**
- * A coordinate axis.
- */
-export type Axis = "x" | "y" | "z";
-
-/**
- * Both inputs.
- */
-export type Inputs = {
-/**
- * The reconstruction.
- */
-reconstruction: ReconstructionInput,
-/**
- * The ground truth.
- */
-ground_truth: GroundTruthInput, };
-
-/**
- * The ground truth as read.
- */
-export type GroundTruthInput = {
-/**
- * File name (no folders).
- */
-name: string,
-/**
- * `glb`, `gltf`, `ply`, `obj`.
- */
-format: string,
-/**
- * Vertices (or points of a cloud).
- */
-vertices: number,
-/**
- * Triangles (0 for a cloud).
- */
-triangles: number,
-/**
- * Length of the bounding-box diagonal, in ground-truth units.
- */
-diagonal: number,
-/**
- * Surface area (0 for a cloud).
- */
-area: number, };
-
-/**
- * The reconstruction as read.
- */
-export type ReconstructionInput = {
-/**
- * File name (no folders).
- */
-name: string,
-/**
- * `ply`, `colmap`, `nvm`, ...
- */
-format: string,
-/**
- * Points read.
- */
-points: number,
-/**
- * Registered images (0 for a bare cloud).
- */
-images: number, };
-
-/**
- * Reconstruction → ground-truth distance statistics.
- */
-export type AccuracyReport = {
-/**
- * Always `reconstruction_to_ground_truth`.
- */
-direction: string,
-/**
- * `point_to_triangle` (mesh GT) or `point_to_point` (cloud GT).
- */
-metric: string,
-/**
- * Statistics of signed distances (by the closest triangle's normal), when asked for.
- */
-signed?: Statistics,
-/**
- * Number of values.
- */
-count: number,
-/**
- * Smallest value.
- */
-min: number,
-/**
- * Largest value.
- */
-max: number,
-/**
- * Arithmetic mean.
- */
-mean: number,
-/**
- * Population standard deviation (divides by n).
- */
-std: number,
-/**
- * Median (= p50).
- */
-median: number,
-/**
- * Root mean square.
- */
-rms: number,
-/**
- * Percentiles.
- */
-percentiles: Percentiles,
-/**
- * Histogram.
- */
-histogram: Histogram, };
-
-/**
- * Statistics of a set of values. All zero when `count == 0`.
- */
-export type Statistics = {
-/**
- * Number of values.
- */
-count: number,
-/**
- * Smallest value.
- */
-min: number,
-/**
- * Largest value.
- */
-max: number,
-/**
- * Arithmetic mean.
- */
-mean: number,
-/**
- * Population standard deviation (divides by n).
- */
-std: number,
-/**
- * Median (= p50).
- */
-median: number,
-/**
- * Root mean square.
- */
-rms: number,
-/**
- * Percentiles.
- */
-percentiles: Percentiles,
-/**
- * Histogram.
- */
-histogram: Histogram, };
-
-/**
  * The report's `cameras` section: the pose errors and the transform they were measured after.
  */
 export type CamerasSection = {
@@ -559,6 +126,24 @@ images: Array<ImagePoseError>,
 notes: Array<Note>, };
 
 /**
+ * Which transform the camera poses were measured after.
+ */
+export type CamerasAlignment = {
+/**
+ * `cameras` (the camera stage's transform, before any point refinement) or the
+ * alignment method when no camera stage ran.
+ */
+stage: string,
+/**
+ * Row-major 4×4 mapping the reconstruction into the ground-truth frame.
+ */
+gt_from_recon: [[number, number, number, number], [number, number, number, number], [number, number, number, number], [number, number, number, number]],
+/**
+ * Its scale.
+ */
+scale: number, };
+
+/**
  * Focal-length error of one estimated camera.
  */
 export type FocalError = {
@@ -586,6 +171,91 @@ error_percent: number,
  * Matched images using this camera.
  */
 images: number, };
+
+/**
+ * Statistics of a set of values. All zero when `count == 0`.
+ */
+export type Statistics = {
+/**
+ * Number of values.
+ */
+count: number,
+/**
+ * Smallest value.
+ */
+min: number,
+/**
+ * Largest value.
+ */
+max: number,
+/**
+ * Arithmetic mean.
+ */
+mean: number,
+/**
+ * Population standard deviation (divides by n).
+ */
+std: number,
+/**
+ * Median (= p50).
+ */
+median: number,
+/**
+ * Root mean square.
+ */
+rms: number,
+/**
+ * Percentiles.
+ */
+percentiles: Percentiles,
+/**
+ * Histogram.
+ */
+histogram: Histogram, };
+
+/**
+ * Percentiles reported in every statistics block.
+ */
+export type Percentiles = {
+/**
+ * 50th percentile (the median).
+ */
+p50: number,
+/**
+ * 90th percentile.
+ */
+p90: number,
+/**
+ * 95th percentile.
+ */
+p95: number,
+/**
+ * 99th percentile.
+ */
+p99: number, };
+
+/**
+ * A histogram with `edges.len() == counts.len() + 1`; the last bin includes its right edge.
+ * Values below the first edge or above the last are not in any bin but counted in
+ * `underflow` / `overflow`, so `counts` + both always add up to the number of values.
+ */
+export type Histogram = {
+/**
+ * Bin edges, increasing.
+ */
+edges: Array<number>,
+/**
+ * Values per bin.
+ */
+counts: Array<number>,
+/**
+ * Values below the first edge.
+ */
+underflow: number,
+/**
+ * Values above the last edge.
+ */
+overflow: number, };
 
 /**
  * Relative-pose errors over all ground-truth image pairs.
@@ -667,92 +337,37 @@ center_error: number,
 center_error_percent: number, };
 
 /**
- * Which transform the camera poses were measured after.
+ * One note of a report.
  */
-export type CamerasAlignment = {
+export type Note = {
 /**
- * `cameras` (the camera stage's transform, before any point refinement) or the
- * alignment method when no camera stage ran.
+ * Stable code.
  */
-stage: string,
+code: Code,
 /**
- * Row-major 4×4 mapping the reconstruction into the ground-truth frame.
+ * `info` or `warning` (the code's level).
  */
-gt_from_recon: [[number, number, number, number], [number, number, number, number], [number, number, number, number], [number, number, number, number]],
+level: Level,
 /**
- * Its scale.
+ * What happened, in words for people.
  */
-scale: number, };
+message: string,
+/**
+ * The values the message states, by name (counts, shares, thresholds, the stage).
+ */
+values?: { [key in string]: JsonValue }, };
 
 /**
- * The final transform and how it was found.
+ * How much a note matters.
  */
-export type AlignmentReport = {
-/**
- * `none`, `given`, `cameras`, `icp`, `global`, `cameras+icp`, ...
- */
-method: string,
-/**
- * Row-major 4×4 mapping the reconstruction into the ground-truth frame.
- */
-gt_from_recon: [[number, number, number, number], [number, number, number, number], [number, number, number, number], [number, number, number, number]],
-/**
- * Scale of the transform.
- */
-scale: number,
-/**
- * Residual of the last stage (null when no stage measured one).
- */
-rmse: number | null,
-/**
- * Inlier share of the last stage.
- */
-inlier_ratio: number | null,
-/**
- * Iterations over all stages.
- */
-iterations: number,
-/**
- * Whether every stage converged.
- */
-converged: boolean,
-/**
- * One entry per stage.
- */
-stages: Array<AlignmentStage>, };
+export type Level = "info" | "warning";
+
+export type JsonValue = number | string | boolean | Array<JsonValue> | { [key in string]: JsonValue } | null;
 
 /**
- * One stage of the alignment.
+ * The stable code of a note (serialized as its text, e.g. `alignment.icp_rejected`).
  */
-export type AlignmentStage = {
-/**
- * `given`, `cameras`, `points`, `global`, `icp`.
- */
-method: string,
-/**
- * The transform after this stage.
- */
-gt_from_recon: [[number, number, number, number], [number, number, number, number], [number, number, number, number], [number, number, number, number]],
-/**
- * Its scale.
- */
-scale: number,
-/**
- * Root mean square residual of the stage's correspondences.
- */
-rmse: number | null,
-/**
- * Share of correspondences kept as inliers.
- */
-inlier_ratio: number | null,
-/**
- * Iterations run.
- */
-iterations: number,
-/**
- * Whether the stage met its stopping criterion.
- */
-converged: boolean, };
+export type Code = "input.model_no_points" | "input.several_models" | "input.incomplete_model_ignored" | "input.several_model_files" | "input.trailing_content" | "input.dangling_references" | "input.no_image_list" | "input.unregistered_images" | "input.missing_intrinsics" | "input.no_principal_point" | "input.unknown_image_size" | "input.principal_point_outside" | "input.unknown_camera_frame" | "input.camera_centres_removed" | "input.cloud_with_model_cameras" | "input.no_point_at_camera_centres" | "input.mesh_vertices_only" | "input.degenerate_faces_skipped" | "input.non_surface_primitive_skipped" | "input.duplicate_image_names" | "input.images_matched_by_stem" | "cameras.reconstruction_has_no_cameras" | "cameras.no_image_in_common" | "cameras.non_finite_poses" | "cameras.few_matched" | "cameras.unmatched_estimated" | "cameras.scene_radius_degenerate" | "cameras.centres_out_of_range" | "cameras.relative_pairs_subsampled" | "cameras.poses_after_final_transform" | "alignment.non_finite_points_ignored" | "alignment.global_search_result" | "alignment.ambiguous_pose" | "alignment.icp_rejected" | "alignment.stage_failed" | "alignment.fell_back" | "alignment.icp_from_identity" | "alignment.camera_outliers" | "alignment.non_finite_camera_pairs" | "alignment.camera_centres_degenerate" | "alignment.few_inliers" | "alignment.unsettled_tight_fit" | "alignment.unsettled_loose_fit" | "measure.signed_needs_mesh" | "measure.crop_discarded_everything" | "measure.no_ground_truth_in_crop" | "measure.nothing_visible" | "measure.no_track_error" | "measure.no_track_measured";
 
 /**
  * Precision, recall and F-score at one threshold.
@@ -879,6 +494,127 @@ recall_visible: number,
 f_score_visible: number, };
 
 /**
+ * Name and version of the writer.
+ */
+export type Tool = {
+/**
+ * `"sfmeval"`.
+ */
+name: string,
+/**
+ * Crate version.
+ */
+version: string, };
+
+/**
+ * Options that change numbers.
+ */
+export type ReportOptions = {
+/**
+ * Completeness samples requested on a mesh.
+ */
+samples: number,
+/**
+ * Seed of the surface sampler.
+ */
+seed: number,
+/**
+ * Whether signed accuracy was computed.
+ */
+signed: boolean,
+/**
+ * Histogram bins.
+ */
+histogram_bins: number,
+/**
+ * Thresholds given in ground-truth units.
+ */
+tau: Array<number>,
+/**
+ * Thresholds given in percent of the ground-truth bounding-box diagonal.
+ */
+tau_percent_of_diagonal: Array<number>,
+/**
+ * The requested alignment mode (`auto`, `cameras+icp`, `given`, ...); what ran is
+ * `alignment.method`.
+ */
+align: string,
+/**
+ * Images a surface sample must be seen in to count as visible (only with depth maps).
+ */
+min_views?: number, };
+
+/**
+ * The final transform and how it was found.
+ */
+export type AlignmentReport = {
+/**
+ * `none`, `given`, `cameras`, `icp`, `global`, `cameras+icp`, ...
+ */
+method: string,
+/**
+ * Row-major 4×4 mapping the reconstruction into the ground-truth frame.
+ */
+gt_from_recon: [[number, number, number, number], [number, number, number, number], [number, number, number, number], [number, number, number, number]],
+/**
+ * Scale of the transform.
+ */
+scale: number,
+/**
+ * Residual of the last stage (null when no stage measured one).
+ */
+rmse: number | null,
+/**
+ * Inlier share of the last stage.
+ */
+inlier_ratio: number | null,
+/**
+ * Iterations over all stages.
+ */
+iterations: number,
+/**
+ * Whether every stage converged.
+ */
+converged: boolean,
+/**
+ * One entry per stage.
+ */
+stages: Array<AlignmentStage>, };
+
+/**
+ * One stage of the alignment.
+ */
+export type AlignmentStage = {
+/**
+ * `given`, `cameras`, `points`, `global`, `icp`.
+ */
+method: string,
+/**
+ * The transform after this stage.
+ */
+gt_from_recon: [[number, number, number, number], [number, number, number, number], [number, number, number, number], [number, number, number, number]],
+/**
+ * Its scale.
+ */
+scale: number,
+/**
+ * Root mean square residual of the stage's correspondences.
+ */
+rmse: number | null,
+/**
+ * Share of correspondences kept as inliers.
+ */
+inlier_ratio: number | null,
+/**
+ * Iterations run.
+ */
+iterations: number,
+/**
+ * Whether the stage met its stopping criterion.
+ */
+converged: boolean, };
+
+/**
  * Track-based true error (`crate::track_error`).
  */
 export type TrackErrorReport = {
@@ -993,3 +729,267 @@ sliding_fraction: number,
  * Share of measured points whose true error is below tau (a track-based precision).
  */
 true_error_below: number, };
+
+/**
+ * Reconstruction → ground-truth distance statistics.
+ */
+export type AccuracyReport = {
+/**
+ * Always `reconstruction_to_ground_truth`.
+ */
+direction: string,
+/**
+ * `point_to_triangle` (mesh GT) or `point_to_point` (cloud GT).
+ */
+metric: string,
+/**
+ * Statistics of signed distances (by the closest triangle's normal), when asked for.
+ */
+signed?: Statistics,
+/**
+ * Number of values.
+ */
+count: number,
+/**
+ * Smallest value.
+ */
+min: number,
+/**
+ * Largest value.
+ */
+max: number,
+/**
+ * Arithmetic mean.
+ */
+mean: number,
+/**
+ * Population standard deviation (divides by n).
+ */
+std: number,
+/**
+ * Median (= p50).
+ */
+median: number,
+/**
+ * Root mean square.
+ */
+rms: number,
+/**
+ * Percentiles.
+ */
+percentiles: Percentiles,
+/**
+ * Histogram.
+ */
+histogram: Histogram, };
+
+/**
+ * Ground-truth → reconstruction distance statistics.
+ */
+export type CompletenessReport = {
+/**
+ * Always `ground_truth_to_reconstruction`.
+ */
+direction: string,
+/**
+ * `surface_samples` (mesh GT) or `ground_truth_points` (cloud GT).
+ */
+source: string,
+/**
+ * Ground-truth points measured (inside the crop volume).
+ */
+samples: number,
+/**
+ * Seed of the surface sampler.
+ */
+seed: number,
+/**
+ * Number of values.
+ */
+count: number,
+/**
+ * Smallest value.
+ */
+min: number,
+/**
+ * Largest value.
+ */
+max: number,
+/**
+ * Arithmetic mean.
+ */
+mean: number,
+/**
+ * Population standard deviation (divides by n).
+ */
+std: number,
+/**
+ * Median (= p50).
+ */
+median: number,
+/**
+ * Root mean square.
+ */
+rms: number,
+/**
+ * Percentiles.
+ */
+percentiles: Percentiles,
+/**
+ * Histogram.
+ */
+histogram: Histogram, };
+
+/**
+ * What the crop did.
+ */
+export type CropReport = {
+/**
+ * `none`, `box`, `oriented_box`, `sphere`, `max_distance`, or `<volume>+max_distance`.
+ */
+kind: string,
+/**
+ * Reconstructed points kept.
+ */
+kept: number,
+/**
+ * Reconstructed points discarded (all reasons).
+ */
+discarded: number,
+/**
+ * Discarded because outside the volume.
+ */
+discarded_outside_volume: number,
+/**
+ * Discarded because farther than `max_distance` from the ground truth.
+ */
+discarded_farther_than_max_distance: number,
+/**
+ * The volume, as in the crop file.
+ */
+volume: Volume | null,
+/**
+ * The distance limit.
+ */
+max_distance: number | null,
+/**
+ * Ground-truth samples inside the volume (used for completeness).
+ */
+ground_truth_samples_kept: number, };
+
+/**
+ * A crop volume in the ground-truth frame.
+ */
+export type Volume = { "kind": "box",
+/**
+ * Minimum corner.
+ */
+min: [number, number, number],
+/**
+ * Maximum corner.
+ */
+max: [number, number, number], } | { "kind": "oriented_box",
+/**
+ * Centre.
+ */
+center: [number, number, number],
+/**
+ * Half sizes along the box axes.
+ */
+half_extents: [number, number, number],
+/**
+ * Row-major `world_from_box` rotation (columns are the box axes in the world).
+ */
+rotation: [[number, number, number], [number, number, number], [number, number, number]], } | { "kind": "sphere",
+/**
+ * Centre.
+ */
+center: [number, number, number],
+/**
+ * Radius.
+ */
+radius: number, } | { "kind": "polygon_prism",
+/**
+ * The polygon's vertices in order (closed implicitly).
+ */
+polygon: Array<[number, number, number]>,
+/**
+ * The extrusion axis: `x`, `y` or `z`.
+ */
+axis: Axis,
+/**
+ * Lower bound along `axis`.
+ */
+axis_min: number,
+/**
+ * Upper bound along `axis`.
+ */
+axis_max: number, };
+
+/**
+ * A coordinate axis.
+ */
+export type Axis = "x" | "y" | "z";
+
+/**
+ * Both inputs.
+ */
+export type Inputs = {
+/**
+ * The reconstruction.
+ */
+reconstruction: ReconstructionInput,
+/**
+ * The ground truth.
+ */
+ground_truth: GroundTruthInput, };
+
+/**
+ * The reconstruction as read.
+ */
+export type ReconstructionInput = {
+/**
+ * File name (no folders).
+ */
+name: string,
+/**
+ * `ply`, `colmap`, `nvm`, ...
+ */
+format: string,
+/**
+ * Points read.
+ */
+points: number,
+/**
+ * Registered images (0 for a bare cloud).
+ */
+images: number, };
+
+/**
+ * The ground truth as read.
+ */
+export type GroundTruthInput = {
+/**
+ * File name (no folders).
+ */
+name: string,
+/**
+ * `glb`, `gltf`, `ply`, `obj`.
+ */
+format: string,
+/**
+ * Vertices (or points of a cloud).
+ */
+vertices: number,
+/**
+ * Triangles (0 for a cloud).
+ */
+triangles: number,
+/**
+ * Length of the bounding-box diagonal, in ground-truth units.
+ */
+diagonal: number,
+/**
+ * Surface area (0 for a cloud).
+ */
+area: number, };

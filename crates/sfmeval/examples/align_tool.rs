@@ -73,8 +73,14 @@ fn run(args: &[String]) -> Result<serde_json::Value, String> {
             let (t, stage) =
                 align::refine_icp(&gt, &recon, &start, &opts).map_err(|e| e.to_string())?;
             let secs = t0.elapsed().as_secs_f64();
+            let report = align::Alignment {
+                gt_from_recon: t,
+                stages: vec![stage],
+                requested: align::AlignMode::Icp,
+            }
+            .report();
             Ok(
-                serde_json::json!({"matrix": t.matrix, "scale": t.scale(), "stage": stage, "seconds": secs, "prepare_seconds": prep}),
+                serde_json::json!({"matrix": t.matrix, "scale": t.scale(), "stage": report.stages[0], "seconds": secs, "prepare_seconds": prep}),
             )
         }
         "auto" => {
@@ -102,9 +108,10 @@ fn run(args: &[String]) -> Result<serde_json::Value, String> {
                 start: None,
             };
             let t0 = Instant::now();
-            let (t, report) = align::align(&gt, &input, method, &AlignOptions::default())
+            let alignment = align::align(&gt, &input, method, &AlignOptions::default())
                 .map_err(|e| e.to_string())?;
             let secs = t0.elapsed().as_secs_f64();
+            let (t, report) = (alignment.gt_from_recon, alignment.report());
             Ok(
                 serde_json::json!({"matrix": t.matrix, "scale": t.scale(), "report": report, "seconds": secs, "prepare_seconds": prep}),
             )

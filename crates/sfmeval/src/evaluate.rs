@@ -3,7 +3,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use crate::align::AlignMode;
+use crate::align::Alignment;
 use crate::crop::Crop;
 use crate::distance::slot_tree::{SlotTree, kd_order};
 use crate::error::{Error, Result};
@@ -162,65 +162,6 @@ pub struct Evaluation {
     pub track_errors: Option<Vec<Option<f64>>>,
 }
 
-/// The alignment part of an evaluation, decided before measuring.
-#[derive(Debug, Clone, PartialEq)]
-pub struct AlignmentInput {
-    /// The transform.
-    pub gt_from_recon: Similarity,
-    /// The report section describing how it was found.
-    pub report: AlignmentReport,
-    /// The mode that was asked for (the report's `options.align`).
-    pub requested: AlignMode,
-}
-
-impl AlignmentInput {
-    /// No alignment: the reconstruction is already in the ground-truth frame.
-    pub fn none() -> Self {
-        AlignmentInput {
-            gt_from_recon: Similarity::IDENTITY,
-            report: AlignmentReport {
-                method: "none".into(),
-                gt_from_recon: Similarity::IDENTITY.matrix,
-                scale: 1.0,
-                rmse: None,
-                inlier_ratio: None,
-                iterations: 0,
-                converged: true,
-                stages: Vec::new(),
-            },
-            requested: AlignMode::None,
-        }
-    }
-
-    /// A transform given by the user.
-    pub fn given(t: Similarity) -> Self {
-        let stage = AlignmentStage {
-            method: "given".into(),
-            gt_from_recon: t.matrix,
-            scale: t.scale(),
-            rmse: None,
-            inlier_ratio: None,
-            iterations: 0,
-            converged: true,
-            notes: Vec::new(),
-        };
-        AlignmentInput {
-            gt_from_recon: t,
-            report: AlignmentReport {
-                method: "given".into(),
-                gt_from_recon: t.matrix,
-                scale: t.scale(),
-                rmse: None,
-                inlier_ratio: None,
-                iterations: 0,
-                converged: true,
-                stages: vec![stage],
-            },
-            requested: AlignMode::Given,
-        }
-    }
-}
-
 impl Evaluation {
     /// Number of reconstructed points.
     pub fn point_count(&self) -> usize {
@@ -311,7 +252,7 @@ fn nearest_kept(
 const BLOCK: usize = 1 << 20;
 
 /// Runs the evaluation of the reconstruction's points `recon` (its own frame; kept, reordered,
-/// in the [`Evaluation`]) against a prepared ground truth.
+/// in the [`Evaluation`]) against a prepared ground truth, and builds its report.
 ///
 /// Memory, `n` points: the points as read (12 bytes a point in `f32`, 24 in `f64`), their input
 /// indices in tree order (4), the distances (8; 8 more signed), the status (1), the live mask
@@ -319,12 +260,60 @@ const BLOCK: usize = 1 << 20;
 /// (the statistics select their percentiles without a copy).
 pub fn evaluate(
     gt: &PreparedGroundTruth,
-    mut recon: Positions,
-    alignment: &AlignmentInput,
+    recon: Positions,
+    alignment: &Alignment,
     options: &EvalOptions,
     info: &InputInfo,
     progress: &dyn Progress,
 ) -> Result<Evaluation> {
+    let measured = measure(gt, recon, alignment.gt_from_recon, options, progress)?;
+    Ok(measured.into_evaluation(gt, options, info, alignment, Extras::default()))
+}
+
+/// What [`measure`] found: the per-point data and the report sections they give, before the
+/// report is built.
+pub(crate) struct Measured {
+    recon: Positions,
+    slot_input: Vec<u32>,
+    gt_from_recon: Similarity,
+    pub(crate) distances: Vec<f64>,
+    signed_distances: Option<Vec<f64>>,
+    pub(crate) status: Vec<PointStatus>,
+    pub(crate) completeness_points: Vec<Point3>,
+    pub(crate) completeness_distances: Vec<f64>,
+    /// The thresholds, resolved once: every score of the report is taken at these.
+    pub(crate) thresholds: Thresholds,
+    /// Precision, recall and F-score at each of `thresholds`.
+    pub(crate) scores: Vec<ThresholdReport>,
+    crop: CropReport,
+    accuracy: AccuracyReport,
+    completeness: CompletenessReport,
+    notes: Vec<Note>,
+}
+
+/// What the pipeline measured beyond the points' distances (cameras, visibility, track error),
+/// with the notes in the order they were found.
+#[derive(Default)]
+pub(crate) struct Extras {
+    pub(crate) cameras: Option<CamerasSection>,
+    pub(crate) completeness_visible: Option<VisibleCompletenessReport>,
+    pub(crate) min_views: Option<u64>,
+    pub(crate) track_error: Option<TrackErrorReport>,
+    pub(crate) notes: Vec<Note>,
+    pub(crate) sample_views: Option<Vec<u32>>,
+    pub(crate) sample_labels: Option<Vec<crate::visibility::SampleLabel>>,
+    pub(crate) track_errors: Option<Vec<Option<f64>>>,
+}
+
+/// Distances, crop, completeness and scores of the reconstruction's points `recon` (its own
+/// frame) mapped by `t` into the ground-truth frame.
+pub(crate) fn measure(
+    gt: &PreparedGroundTruth,
+    mut recon: Positions,
+    t: Similarity,
+    options: &EvalOptions,
+    progress: &dyn Progress,
+) -> Result<Measured> {
     options.validate()?;
     if options.samples != gt.requested_samples && gt.is_mesh() {
         return Err(Error::InvalidOption(format!(
@@ -338,8 +327,7 @@ pub fn evaluate(
         });
     }
     let n = recon.len();
-    let mut warnings = info.notes.clone();
-    let t = alignment.gt_from_recon;
+    let mut notes = Vec::new();
     crate::geometry::check_finite_with("aligned reconstruction", "point", n, |i| {
         t.apply(recon.get(i))
     })?;
@@ -360,57 +348,17 @@ pub fn evaluate(
         }
     };
 
-    progress.start(Stage::Accuracy, n as u64);
-    let signed_wanted = options.signed && gt.is_mesh();
-    let mut distances = vec![0.0f64; n];
-    let mut signed_distances = signed_wanted.then(|| vec![0.0f64; n]);
-    for start in (0..n).step_by(BLOCK) {
-        let end = (start + BLOCK).min(n);
-        let block = parallel::map_range_with_state(start, end, progress, |hint, k| {
-            gt.distance_from(in_gt(k), options.signed, hint)
-        });
-        for (k, (d, s)) in (start..end).zip(block) {
-            let i = slot_input[k] as usize;
-            distances[i] = d;
-            if let Some(sd) = signed_distances.as_mut() {
-                sd[i] = s.unwrap_or(d);
-            }
-        }
-    }
-    progress.finish();
+    let (distances, signed_distances) =
+        accuracy_distances(gt, &slot_input, options.signed, &in_gt, progress);
     if options.signed && !gt.is_mesh() {
-        warnings.push(Note::new(
+        notes.push(Note::new(
             Code::SignedNeedsMesh,
             "signed distances need a mesh ground truth; reported unsigned only",
         ));
     }
 
     let crop = &options.crop;
-    // Each slot's status and the live mask (tree order) in parallel, then the statuses into
-    // input order.
-    let slot_status = parallel::map_range(n, |k| {
-        if !crop.in_volume(in_gt(k)) {
-            PointStatus::OutsideVolume
-        } else if crop
-            .max_distance
-            .is_some_and(|m| distances[slot_input[k] as usize] > m)
-        {
-            PointStatus::TooFar
-        } else {
-            PointStatus::Kept
-        }
-    });
-    let live: Vec<u64> = parallel::map_range(n.div_ceil(64), |w| {
-        let slots = &slot_status[w * 64..((w + 1) * 64).min(n)];
-        (slots.iter().enumerate())
-            .filter(|(_, s)| **s == PointStatus::Kept)
-            .fold(0u64, |bits, (b, _)| bits | 1 << b)
-    });
-    let mut status = vec![PointStatus::Kept; n];
-    for (&i, &s) in slot_input.iter().zip(&slot_status) {
-        status[i as usize] = s;
-    }
-    drop(slot_status);
+    let (status, live) = crop_status(crop, &distances, &slot_input, &in_gt);
     let is_live = |k: usize| live[k / 64] >> (k % 64) & 1 == 1;
     let count = |s: PointStatus| status.iter().filter(|&&x| x == s).count() as u64;
     let (kept_n, outside, too_far) = (
@@ -419,7 +367,7 @@ pub fn evaluate(
         count(PointStatus::TooFar),
     );
     if kept_n == 0 {
-        warnings.push(Note::new(
+        notes.push(Note::new(
             Code::CropDiscardedEverything,
             "the crop discarded every reconstructed point",
         ));
@@ -458,16 +406,15 @@ pub fn evaluate(
         d
     };
     if completeness_points.is_empty() {
-        warnings.push(Note::new(
+        notes.push(Note::new(
             Code::NoGroundTruthInCrop,
             "no ground-truth sample lies inside the crop volume",
         ));
     }
 
-    let diagonal = gt.aabb.diagonal();
-    let resolved = options.thresholds(diagonal);
+    let thresholds = options.thresholds(gt.aabb.diagonal());
     let is_kept = |i: usize| status[i] == PointStatus::Kept;
-    let thresholds = resolved
+    let scores = thresholds
         .taus
         .iter()
         .map(|&tau| {
@@ -481,7 +428,7 @@ pub fn evaluate(
             let recall = share_below(&completeness_distances, tau);
             ThresholdReport {
                 tau,
-                tau_percent_of_diagonal: resolved.percent_of_diagonal(tau),
+                tau_percent_of_diagonal: thresholds.percent_of_diagonal(tau),
                 precision,
                 recall,
                 f_score: f_score(precision, recall),
@@ -490,89 +437,46 @@ pub fn evaluate(
         .collect();
 
     let bins = options.histogram_bins;
-    let accuracy_stats = Statistics::of_kept(&distances, is_kept, bins);
-    let signed_stats = signed_distances
-        .as_ref()
-        .map(|s| Statistics::of_kept(s, is_kept, bins));
-    let report = Report {
-        schema: REPORT_SCHEMA.into(),
-        tool: Tool::default(),
-        inputs: Inputs {
-            reconstruction: ReconstructionInput {
-                name: info.recon_name.clone(),
-                format: info.recon_format.clone(),
-                points: n as u64,
-                images: info.recon_images,
-            },
-            ground_truth: GroundTruthInput {
-                name: info.gt_name.clone(),
-                format: info.gt_format.clone(),
-                vertices: gt.vertices,
-                triangles: gt.triangles,
-                diagonal,
-                area: gt.area,
-            },
-        },
-        options: ReportOptions {
-            samples: if gt.is_mesh() {
-                options.samples as u64
-            } else {
-                gt.samples.len() as u64
-            },
-            seed: gt.sample_seed,
-            signed: options.signed,
-            histogram_bins: bins as u64,
-            tau: options.tau.clone(),
-            tau_percent_of_diagonal: resolved.percents_used.clone(),
-            align: alignment.requested.name().into(),
-            min_views: None,
-        },
-        crop: CropReport {
-            kind: crop.kind(),
-            kept: kept_n,
-            discarded: outside + too_far,
-            discarded_outside_volume: outside,
-            discarded_farther_than_max_distance: too_far,
-            volume: crop.volume.clone(),
-            max_distance: crop.max_distance,
-            ground_truth_samples_kept: completeness_points.len() as u64,
-        },
-        alignment: alignment.report.clone(),
-        accuracy: AccuracyReport {
-            direction: "reconstruction_to_ground_truth".into(),
-            metric: if gt.is_mesh() {
-                "point_to_triangle"
-            } else {
-                "point_to_point"
-            }
-            .into(),
-            stats: accuracy_stats,
-            signed: signed_stats,
-        },
-        completeness: CompletenessReport {
-            direction: "ground_truth_to_reconstruction".into(),
-            source: if gt.is_mesh() {
-                "surface_samples"
-            } else {
-                "ground_truth_points"
-            }
-            .into(),
-            samples: completeness_points.len() as u64,
-            seed: gt.sample_seed,
-            stats: Statistics::of_kept(
-                &completeness_distances,
-                |i| completeness_distances[i].is_finite(),
-                bins,
-            ),
-        },
-        thresholds,
-        cameras: None,
-        completeness_visible: None,
-        track_error: None,
-        notes: warnings,
+    let accuracy = AccuracyReport {
+        direction: "reconstruction_to_ground_truth".into(),
+        metric: if gt.is_mesh() {
+            "point_to_triangle"
+        } else {
+            "point_to_point"
+        }
+        .into(),
+        stats: Statistics::of_kept(&distances, is_kept, bins),
+        signed: signed_distances
+            .as_ref()
+            .map(|s| Statistics::of_kept(s, is_kept, bins)),
     };
-    Ok(Evaluation {
-        report,
+    let completeness = CompletenessReport {
+        direction: "ground_truth_to_reconstruction".into(),
+        source: if gt.is_mesh() {
+            "surface_samples"
+        } else {
+            "ground_truth_points"
+        }
+        .into(),
+        samples: completeness_points.len() as u64,
+        seed: gt.sample_seed,
+        stats: Statistics::of_kept(
+            &completeness_distances,
+            |i| completeness_distances[i].is_finite(),
+            bins,
+        ),
+    };
+    let crop = CropReport {
+        kind: crop.kind(),
+        kept: kept_n,
+        discarded: outside + too_far,
+        discarded_outside_volume: outside,
+        discarded_farther_than_max_distance: too_far,
+        volume: crop.volume.clone(),
+        max_distance: crop.max_distance,
+        ground_truth_samples_kept: completeness_points.len() as u64,
+    };
+    Ok(Measured {
         recon,
         slot_input,
         gt_from_recon: t,
@@ -581,11 +485,153 @@ pub fn evaluate(
         status,
         completeness_points: completeness_points.into_owned(),
         completeness_distances,
-        thresholds: resolved,
-        sample_views: None,
-        sample_labels: None,
-        track_errors: None,
+        thresholds,
+        scores,
+        crop,
+        accuracy,
+        completeness,
+        notes,
     })
+}
+
+/// The distance (and, when `signed` on a mesh, the signed distance) of every point to the
+/// ground truth, in input order; the queries run in tree order, `in_gt(k)` giving slot `k`.
+fn accuracy_distances(
+    gt: &PreparedGroundTruth,
+    slot_input: &[u32],
+    signed: bool,
+    in_gt: &(impl Fn(usize) -> Point3 + Sync),
+    progress: &dyn Progress,
+) -> (Vec<f64>, Option<Vec<f64>>) {
+    let n = slot_input.len();
+    progress.start(Stage::Accuracy, n as u64);
+    let mut distances = vec![0.0f64; n];
+    let mut signed_distances = (signed && gt.is_mesh()).then(|| vec![0.0f64; n]);
+    for start in (0..n).step_by(BLOCK) {
+        let end = (start + BLOCK).min(n);
+        let block = parallel::map_range_with_state(start, end, progress, |hint, k| {
+            gt.distance_from(in_gt(k), signed, hint)
+        });
+        for (k, (d, s)) in (start..end).zip(block) {
+            let i = slot_input[k] as usize;
+            distances[i] = d;
+            if let Some(sd) = signed_distances.as_mut() {
+                sd[i] = s.unwrap_or(d);
+            }
+        }
+    }
+    progress.finish();
+    (distances, signed_distances)
+}
+
+/// Each point's status in input order, and the live mask of the kept slots (tree order, a bit
+/// a slot), computed per slot in parallel.
+fn crop_status(
+    crop: &Crop,
+    distances: &[f64],
+    slot_input: &[u32],
+    in_gt: &(impl Fn(usize) -> Point3 + Sync),
+) -> (Vec<PointStatus>, Vec<u64>) {
+    let n = slot_input.len();
+    let slot_status = parallel::map_range(n, |k| {
+        if !crop.in_volume(in_gt(k)) {
+            PointStatus::OutsideVolume
+        } else if crop
+            .max_distance
+            .is_some_and(|m| distances[slot_input[k] as usize] > m)
+        {
+            PointStatus::TooFar
+        } else {
+            PointStatus::Kept
+        }
+    });
+    let live: Vec<u64> = parallel::map_range(n.div_ceil(64), |w| {
+        let slots = &slot_status[w * 64..((w + 1) * 64).min(n)];
+        (slots.iter().enumerate())
+            .filter(|(_, s)| **s == PointStatus::Kept)
+            .fold(0u64, |bits, (b, _)| bits | 1 << b)
+    });
+    let mut status = vec![PointStatus::Kept; n];
+    for (&i, &s) in slot_input.iter().zip(&slot_status) {
+        status[i as usize] = s;
+    }
+    (status, live)
+}
+
+impl Measured {
+    /// The evaluation, with its report built once from the inputs, the alignment, what was
+    /// measured and the `extras`; the notes in the order they arose (reading and aligning,
+    /// measuring, then the extras').
+    pub(crate) fn into_evaluation(
+        self,
+        gt: &PreparedGroundTruth,
+        options: &EvalOptions,
+        info: &InputInfo,
+        alignment: &Alignment,
+        extras: Extras,
+    ) -> Evaluation {
+        let mut notes = info.notes.clone();
+        notes.extend(self.notes);
+        notes.extend(extras.notes);
+        let report = Report {
+            schema: REPORT_SCHEMA.into(),
+            tool: Tool::default(),
+            inputs: Inputs {
+                reconstruction: ReconstructionInput {
+                    name: info.recon_name.clone(),
+                    format: info.recon_format.clone(),
+                    points: self.distances.len() as u64,
+                    images: info.recon_images,
+                },
+                ground_truth: GroundTruthInput {
+                    name: info.gt_name.clone(),
+                    format: info.gt_format.clone(),
+                    vertices: gt.vertices,
+                    triangles: gt.triangles,
+                    diagonal: self.thresholds.diagonal,
+                    area: gt.area,
+                },
+            },
+            options: ReportOptions {
+                samples: if gt.is_mesh() {
+                    options.samples as u64
+                } else {
+                    gt.samples.len() as u64
+                },
+                seed: gt.sample_seed,
+                signed: options.signed,
+                histogram_bins: options.histogram_bins as u64,
+                tau: options.tau.clone(),
+                tau_percent_of_diagonal: self.thresholds.percents_used.clone(),
+                align: alignment.requested.name().into(),
+                min_views: extras.min_views,
+            },
+            crop: self.crop,
+            alignment: alignment.report(),
+            accuracy: self.accuracy,
+            completeness: self.completeness,
+            thresholds: self.scores,
+            cameras: extras.cameras,
+            completeness_visible: extras.completeness_visible,
+            track_error: extras.track_error,
+            notes,
+        };
+        Evaluation {
+            report,
+            recon: self.recon,
+            slot_input: self.slot_input,
+            gt_from_recon: self.gt_from_recon,
+            distances: self.distances,
+            signed_distances: self.signed_distances,
+            status: self.status,
+            completeness_points: self.completeness_points,
+            completeness_distances: self.completeness_distances,
+            thresholds: self.thresholds,
+            sample_views: extras.sample_views,
+            sample_labels: extras.sample_labels,
+            track_errors: extras.track_errors,
+        }
+    }
 }
 
 #[cfg(test)]
@@ -645,7 +691,7 @@ mod tests {
             [0.0, 0.0, 0.0, 1.0],
         ])
         .unwrap();
-        let alignment = AlignmentInput::given(t);
+        let alignment = Alignment::given(t);
         let options = EvalOptions {
             samples: 500,
             seed: 3,

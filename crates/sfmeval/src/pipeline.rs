@@ -7,11 +7,12 @@
 use std::collections::BTreeMap;
 
 use crate::align::{
-    self, AlignInput, AlignMethod, AlignMode, AlignOptions, AlignRequest, CameraPair,
+    self, AlignInput, AlignMethod, AlignMode, AlignOptions, AlignRequest, Alignment, CameraPair,
+    StageKind,
 };
 use crate::dataset::Dataset;
 use crate::error::{Error, Result};
-use crate::evaluate::{AlignmentInput, EvalOptions, Evaluation, InputInfo, PointStatus, evaluate};
+use crate::evaluate::{EvalOptions, Evaluation, Extras, InputInfo, Measured, PointStatus, measure};
 use crate::geometry::PointCloud;
 use crate::gt_views::GtView;
 use crate::io;
@@ -332,8 +333,8 @@ pub fn run_owned(
         request,
         progress,
     )?;
-    notes.extend(align::stage_notes(&alignment.report));
-    notes.extend(align::fit_verdict(&alignment.report, gt.aabb.diagonal()));
+    notes.extend(alignment.notes().cloned());
+    notes.extend(align::fit_verdict(&alignment, gt.aabb.diagonal()));
     let info = InputInfo {
         recon_name: recon.name.clone(),
         recon_format: recon.format.clone(),
@@ -344,35 +345,36 @@ pub fn run_owned(
     };
     let points = std::mem::take(&mut recon.cloud.points);
     recon.cloud.colors = None;
-    let mut evaluation = evaluate(gt, points, &alignment, &request.eval, &info, progress)?;
+    let measured = measure(gt, points, alignment.gt_from_recon, &request.eval, progress)?;
+    let mut extras = Extras::default();
     if let (Some(g), Some(e), Some(m), None) = (gt_cameras, &recon.model, &matches, &no_match) {
-        evaluation.report.cameras = Some(camera_section(
+        extras.cameras = Some(camera_section(
             g,
             e,
             m,
             &pairs,
             &alignment,
             request,
-            &mut evaluation,
+            &mut extras.notes,
         )?);
     }
     if let Some(views) = dataset.views() {
-        add_visibility(&mut evaluation, views, request, progress);
+        add_visibility(&mut extras, &measured, gt, views, request, progress);
         match (gt_cameras, &recon.model) {
-            (Some(_), Some(_)) if !recon.cloud_is_model_points => evaluation.report.notes.push(Note::new(
+            (Some(_), Some(_)) if !recon.cloud_is_model_points => extras.notes.push(Note::new(
                 Code::NoTrackError,
                 "depth maps were given but the evaluated cloud is not the SfM model's own points: no track-based error",
             )),
             (Some(g), Some(e)) if e.points.iter().any(|p| !p.track.is_empty()) => {
-                add_track_error(&mut evaluation, g, e, views, &alignment, request, progress)?;
+                add_track_error(&mut extras, &measured, g, e, views, &alignment, request, progress)?;
             }
-            _ => evaluation.report.notes.push(Note::new(
+            _ => extras.notes.push(Note::new(
                 Code::NoTrackError,
                 "depth maps were given but the reconstruction has no tracks (or no ground-truth cameras): no track-based error",
             )),
         }
     }
-    Ok(evaluation)
+    Ok(measured.into_evaluation(gt, &request.eval, &info, &alignment, extras))
 }
 
 /// Runs the requested alignment (none, the given transform, or the stages).
@@ -384,12 +386,12 @@ fn align_recon(
     have_gt_cameras: bool,
     request: &EvalRequest,
     progress: &dyn Progress,
-) -> Result<AlignmentInput> {
+) -> Result<Alignment> {
     let a = &request.align;
     let Some((method, refine)) = a.mode.stages() else {
         return Ok(match (a.mode, a.transform) {
-            (AlignMode::Given, Some(t)) => AlignmentInput::given(t),
-            _ => AlignmentInput::none(),
+            (AlignMode::Given, Some(t)) => Alignment::given(t),
+            _ => Alignment::none(),
         });
     };
     if a.mode.needs_cameras() && pairs.is_empty() {
@@ -409,27 +411,23 @@ fn align_recon(
         ..AlignOptions::default()
     }
     .with_seed(request.eval.seed);
-    let (t, mut report) = align::align(gt, &input, method, &opts)?;
+    let mut alignment = align::align(gt, &input, method, &opts)?;
     progress.finish();
     if let (AlignMethod::Auto, Some(detail)) = (method, no_match)
-        && let Some(first) = report.stages.first_mut()
+        && let Some(first) = alignment.stages.first_mut()
     {
-        let mut notes = vec![
+        let fell_back = align::fell_back(first.kind.name());
+        first.prepend_notes(vec![
             Note::new(
                 Code::StageFailed,
                 format!("the camera-based alignment was skipped: {detail}"),
             )
             .with("stage", "cameras"),
-            align::fell_back(&first.method),
-        ];
-        notes.append(&mut first.notes);
-        first.notes = notes;
+            fell_back,
+        ]);
     }
-    Ok(AlignmentInput {
-        gt_from_recon: t,
-        report,
-        requested: a.mode,
-    })
+    alignment.requested = a.mode;
+    Ok(alignment)
 }
 
 /// The pose errors of the matched cameras, measured after the camera alignment whatever the
@@ -444,45 +442,37 @@ fn camera_section(
     est: &Reconstruction,
     matches: &model::matching::ImageMatches,
     pairs: &[CameraPair],
-    alignment: &AlignmentInput,
+    alignment: &Alignment,
     request: &EvalRequest,
-    evaluation: &mut Evaluation,
+    notes: &mut Vec<Note>,
 ) -> Result<CamerasSection> {
-    let camera_stage = alignment
-        .report
-        .stages
-        .iter()
-        .find(|s| s.method == "cameras");
-    let (t, used) = match camera_stage {
-        Some(stage) => (Similarity::from_matrix(stage.gt_from_recon)?, "cameras"),
+    let (t, used) = match alignment.stage(StageKind::Cameras) {
+        Some(stage) => (stage.gt_from_recon, StageKind::Cameras.name().to_string()),
         None => {
             let opts = AlignOptions::default().with_seed(request.eval.seed);
             match align::align_cameras(pairs, &opts.cameras) {
-                Ok((t, _)) => (t, "cameras"),
-                Err(_) => (alignment.gt_from_recon, alignment.report.method.as_str()),
+                Ok((t, _)) => (t, StageKind::Cameras.name().to_string()),
+                Err(_) => (alignment.gt_from_recon, alignment.method()),
             }
         }
     };
     let errors = evaluate_cameras_matched(gt_cameras, est, matches, &t, &request.pose)?;
-    if used != "cameras" {
-        evaluation.report.notes.push(
+    if used != StageKind::Cameras.name() {
+        notes.push(
             Note::new(
                 Code::PosesAfterFinalTransform,
                 format!(
                     "the cameras could not be aligned on their own (fewer than 3 usable camera pairs): the pose errors are measured after the final transform ({used})"
                 ),
             )
-            .with("transform", used),
+            .with("transform", used.as_str()),
         );
     }
-    evaluation
-        .report
-        .notes
-        .extend(errors.notes.iter().map(|n| n.clone().prefixed("cameras: ")));
+    notes.extend(errors.notes.iter().map(|n| n.clone().prefixed("cameras: ")));
     Ok(CamerasSection {
         errors,
         alignment: CamerasAlignment {
-            stage: used.to_string(),
+            stage: used,
             gt_from_recon: t.matrix,
             scale: t.scale(),
         },
@@ -521,48 +511,52 @@ fn cameras_unavailable(have_gt_cameras: bool, recon: &ReconInput, no_match: Opti
     }
 }
 
+/// The visible completeness: which completeness samples the ground-truth images see, and the
+/// recall over those.
 fn add_visibility(
-    evaluation: &mut Evaluation,
+    extras: &mut Extras,
+    measured: &Measured,
+    gt: &PreparedGroundTruth,
     views: &[GtView],
     request: &EvalRequest,
     progress: &dyn Progress,
 ) {
     let min_views = request.eval.min_views;
-    progress.start(
-        Stage::Visibility,
-        evaluation.completeness_points.len() as u64,
-    );
-    let counts = visibility::count_views(views, &evaluation.completeness_points, progress);
+    progress.start(Stage::Visibility, measured.completeness_points.len() as u64);
+    let counts = visibility::count_views(views, &measured.completeness_points, progress);
     progress.finish();
-    let report = &mut evaluation.report;
-    let whole_surface = report.crop.volume.is_none() && report.inputs.ground_truth.area > 0.0;
+    let whole_surface = request.eval.crop.volume.is_none() && gt.area > 0.0;
     let (section, warning) = visibility::visible_completeness(
         &counts,
-        &evaluation.completeness_distances,
-        &report.thresholds,
+        &measured.completeness_distances,
+        &measured.scores,
         min_views,
         views.len(),
-        whole_surface.then_some(report.inputs.ground_truth.area),
+        whole_surface.then_some(gt.area),
         request.eval.histogram_bins,
     );
-    report.notes.extend(warning);
-    report.options.min_views = Some(u64::from(min_views));
-    evaluation.sample_labels = Some(visibility::labels(
+    extras.notes.extend(warning);
+    extras.min_views = Some(u64::from(min_views));
+    extras.sample_labels = Some(visibility::labels(
         &counts,
-        &evaluation.completeness_distances,
+        &measured.completeness_distances,
         min_views,
         section.labels_tau,
     ));
-    report.completeness_visible = Some(section);
-    evaluation.sample_views = Some(counts);
+    extras.completeness_visible = Some(section);
+    extras.sample_views = Some(counts);
 }
 
+/// The track-based true error of the model's points (the evaluated cloud is the model's points
+/// in order, `Reconstruction::to_point_cloud`).
+#[allow(clippy::too_many_arguments)]
 fn add_track_error(
-    evaluation: &mut Evaluation,
+    extras: &mut Extras,
+    measured: &Measured,
     gt_cameras: &Reconstruction,
     est: &Reconstruction,
     views: &[GtView],
-    alignment: &AlignmentInput,
+    alignment: &Alignment,
     request: &EvalRequest,
     progress: &dyn Progress,
 ) -> Result<()> {
@@ -589,24 +583,22 @@ fn add_track_error(
         progress,
     );
     progress.finish();
-    // The evaluated cloud is the model's points in order (`Reconstruction::to_point_cloud`).
-    let report = &mut evaluation.report;
-    if outcomes.len() != evaluation.distances.len() {
-        report.notes.push(
+    if outcomes.len() != measured.distances.len() {
+        extras.notes.push(
             Note::new(
                 Code::NoTrackError,
                 format!(
                     "track error skipped: the model has {} points but {} were evaluated",
                     outcomes.len(),
-                    evaluation.distances.len()
+                    measured.distances.len()
                 ),
             )
             .with("model_points", outcomes.len())
-            .with("evaluated", evaluation.distances.len()),
+            .with("evaluated", measured.distances.len()),
         );
         return Ok(());
     }
-    let kept: Vec<bool> = evaluation
+    let kept: Vec<bool> = measured
         .status
         .iter()
         .map(|s| *s == PointStatus::Kept)
@@ -614,14 +606,14 @@ fn add_track_error(
     let (section, warning) = track_error::aggregate(
         convention,
         &outcomes,
-        &evaluation.distances,
+        &measured.distances,
         &kept,
-        &evaluation.thresholds.taus,
+        &measured.thresholds.taus,
         request.eval.histogram_bins,
     );
-    report.notes.extend(warning);
-    report.track_error = Some(section);
-    evaluation.track_errors = Some(outcomes.iter().map(|o| o.true_error).collect());
+    extras.notes.extend(warning);
+    extras.track_error = Some(section);
+    extras.track_errors = Some(outcomes.iter().map(|o| o.true_error).collect());
     Ok(())
 }
 
@@ -645,26 +637,21 @@ pub fn cameras_only(
             no_match_detail(gt_cameras, recon)
         )));
     }
-    let (t, report) = match given {
-        Some(t) => (t, AlignmentInput::given(t).report),
+    let alignment = match given {
+        Some(t) => Alignment::given(t),
         None => {
             let opts = AlignOptions::default().with_seed(seed);
             let (t, stage) = align::align_cameras(&pairs, &opts.cameras)?;
-            let report = crate::report::AlignmentReport {
-                method: stage.method.clone(),
-                gt_from_recon: t.matrix,
-                scale: t.scale(),
-                rmse: stage.rmse,
-                inlier_ratio: stage.inlier_ratio,
-                iterations: stage.iterations,
-                converged: stage.converged,
+            Alignment {
+                gt_from_recon: t,
                 stages: vec![stage],
-            };
-            (t, report)
+                requested: AlignMode::Cameras,
+            }
         }
     };
+    let t = alignment.gt_from_recon;
     let cams = evaluate_cameras_matched(gt_cameras, recon, &matches, &t, pose)?;
-    Ok((t, report, cams))
+    Ok((t, alignment.report(), cams))
 }
 
 // Test data only: platform maths is fine here (reports use libm, see clippy.toml).

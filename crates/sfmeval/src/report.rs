@@ -184,10 +184,6 @@ pub struct AlignmentStage {
     pub iterations: u64,
     /// Whether the stage met its stopping criterion.
     pub converged: bool,
-    /// Why the stage was rejected or what it fell back to, if anything: the report lists these
-    /// in its `notes` (with the stage in their values), not in the stage.
-    #[serde(skip)]
-    pub notes: Vec<Note>,
 }
 
 /// The final transform and how it was found.

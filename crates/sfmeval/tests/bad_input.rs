@@ -2,7 +2,8 @@
 
 use std::collections::BTreeMap;
 
-use sfmeval::evaluate::{AlignmentInput, EvalOptions, InputInfo, evaluate};
+use sfmeval::align::Alignment;
+use sfmeval::evaluate::{EvalOptions, InputInfo, evaluate};
 use sfmeval::geometry::{GroundTruth, PointCloud, TriangleMesh};
 use sfmeval::io;
 use sfmeval::prepared::PreparedGroundTruth;
@@ -143,7 +144,7 @@ fn degenerate_ground_truth_and_empty_reconstruction() {
     let r = evaluate(
         &gt,
         PointCloud::default().points,
-        &AlignmentInput::none(),
+        &Alignment::none(),
         &options,
         &InputInfo::default(),
         &NoProgress,
@@ -162,7 +163,7 @@ fn degenerate_ground_truth_and_empty_reconstruction() {
     let r = evaluate(
         &gt,
         cloud.points.clone(),
-        &AlignmentInput::none(),
+        &Alignment::none(),
         &bad,
         &InputInfo::default(),
         &NoProgress,

@@ -24,8 +24,9 @@ use base64::Engine as _;
 use rand::{Rng as _, SeedableRng as _};
 use rand_chacha::ChaCha8Rng;
 use sfmeval::align::{self, AlignInput, AlignMethod, AlignOptions, CameraPair, GlobalOptions};
+use sfmeval::align::{AlignMode, Alignment};
 use sfmeval::crop::Crop;
-use sfmeval::evaluate::{AlignmentInput, EvalOptions, InputInfo, evaluate};
+use sfmeval::evaluate::{EvalOptions, InputInfo, evaluate};
 use sfmeval::geometry::{GroundTruth, PointCloud, TriangleMesh};
 use sfmeval::io::{self, ReadLimits};
 use sfmeval::model::{self, Reconstruction};
@@ -333,7 +334,7 @@ fn evaluate_cloud(label: &str, gt: &PreparedGroundTruth, cloud: &PointCloud, ali
     match evaluate(
         gt,
         cloud.points.clone(),
-        &AlignmentInput::none(),
+        &Alignment::none(),
         &options(),
         &info,
         &NoProgress,
@@ -359,12 +360,7 @@ fn evaluate_cloud(label: &str, gt: &PreparedGroundTruth, cloud: &PointCloud, ali
         ..AlignOptions::default()
     };
     match align::align(gt, &input, AlignMethod::Auto, &opts) {
-        Ok((t, report)) => {
-            let alignment = AlignmentInput {
-                gt_from_recon: t,
-                report,
-                requested: sfmeval::align::AlignMode::Auto,
-            };
+        Ok(alignment) => {
             match evaluate(
                 gt,
                 cloud.points.clone(),
@@ -434,12 +430,16 @@ fn use_model(label: &str, rec: &Reconstruction, gt: &PreparedGroundTruth) {
             .collect();
         match align::align_cameras(&pairs, &align::CamerasOptions::default()) {
             Ok((t, stage)) => {
+                let scale = stage.gt_from_recon.scale();
                 assert!(
-                    stage.scale > 0.0 && stage.scale.is_finite(),
-                    "{label}: camera stage scale {}",
-                    stage.scale
+                    scale > 0.0 && scale.is_finite(),
+                    "{label}: camera stage scale {scale}"
                 );
-                assert_no_null(label, &serde_json::to_value(&stage).unwrap(), "/stage");
+                assert_no_null(
+                    label,
+                    &stage_report(stage, AlignMode::Cameras),
+                    "/alignment",
+                );
                 if let Ok(t) = Similarity::from_matrix(t.matrix) {
                     match evaluate_cameras(rec, rec, &t, &PoseOptions::default()) {
                         Ok(c) => {
@@ -1511,7 +1511,7 @@ fn small_files_body() -> usize {
                 match evaluate(
                     &gt,
                     cloud.points.clone(),
-                    &AlignmentInput::none(),
+                    &Alignment::none(),
                     &options,
                     &InputInfo::default(),
                     &NoProgress,
@@ -1535,7 +1535,7 @@ fn small_files_body() -> usize {
         tally(&r);
         match r {
             Ok(t) => {
-                let alignment = AlignmentInput::given(t);
+                let alignment = Alignment::given(t);
                 let cloud = PointCloud {
                     points: vec![[0.1, 0.2, 0.3], [2.0, 0.0, 0.0], [1e10, 0.0, 0.9]].into(),
                     colors: None,
@@ -1588,9 +1588,14 @@ fn small_files_body() -> usize {
         match r {
             Ok(p) => match aligned {
                 Ok((t, stage)) => {
-                    assert!(stage.scale > 0.0 && stage.scale.is_finite(), "{stage:?}");
-                    assert_no_null("pairs", &serde_json::to_value(&stage).unwrap(), "/stage");
-                    let alignment = AlignmentInput::given(t);
+                    let scale = stage.gt_from_recon.scale();
+                    assert!(scale > 0.0 && scale.is_finite(), "{stage:?}");
+                    assert_no_null(
+                        "pairs",
+                        &stage_report(stage, AlignMode::Points),
+                        "/alignment",
+                    );
+                    let alignment = Alignment::given(t);
                     let cloud = PointCloud {
                         points: p.iter().map(|p| p.recon).collect::<Vec<_>>().into(),
                         colors: None,
@@ -1624,4 +1629,14 @@ fn small_files_body() -> usize {
 #[test]
 fn hostile_small_files() {
     guarded("hostile_small_files", 380, small_files_body);
+}
+
+/// The report's `alignment` section of one stage alone, as JSON.
+fn stage_report(stage: sfmeval::align::AlignStage, requested: AlignMode) -> serde_json::Value {
+    let alignment = Alignment {
+        gt_from_recon: stage.gt_from_recon,
+        stages: vec![stage],
+        requested,
+    };
+    serde_json::to_value(alignment.report()).unwrap()
 }

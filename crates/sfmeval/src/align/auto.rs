@@ -4,14 +4,13 @@
 
 use super::global::align_global;
 use super::{
-    CameraPair, CamerasOptions, GlobalOptions, IcpOptions, PointPair, align_cameras, align_points,
-    refine_icp,
+    AlignMode, AlignStage, Alignment, CameraPair, CamerasOptions, GlobalOptions, IcpOptions,
+    PointPair, align_cameras, align_points, refine_icp,
 };
 use crate::error::{Error, Result};
 use crate::geometry::Point3;
 use crate::note::{Code, Note};
 use crate::prepared::PreparedGroundTruth;
-use crate::report::{AlignmentReport, AlignmentStage};
 use crate::transform::Similarity;
 
 /// Most runs of `icp` alone while it looks for its fixed point (`IcpOptions::max_restarts`).
@@ -109,15 +108,6 @@ impl AlignOptions {
     }
 }
 
-/// Puts `notes` (what happened before the stage ran) before the stage's own notes.
-fn add_notes(stage: &mut AlignmentStage, notes: Vec<Note>) {
-    if !notes.is_empty() {
-        let own = std::mem::take(&mut stage.notes);
-        stage.notes = notes;
-        stage.notes.extend(own);
-    }
-}
-
 /// The note of a stage of `auto` that failed.
 fn stage_failed(stage: &str, error: &Error) -> Note {
     let what = match stage {
@@ -139,7 +129,7 @@ pub(crate) fn fell_back(to: &str) -> Note {
     Note::new(Code::FellBack, format!("the alignment fell back to {what}")).with("to", to)
 }
 
-/// Runs the chosen alignment; returns `gt_from_recon` and the report's `alignment` section.
+/// Runs the chosen alignment (ICP after the first stage when `opts.refine`).
 ///
 /// Errors when an explicitly chosen stage cannot run (for instance `cameras` with fewer than 3
 /// usable cameras); `auto` instead falls back and names the failure in the next stage's note.
@@ -148,10 +138,10 @@ pub fn align(
     input: &AlignInput<'_>,
     method: AlignMethod,
     opts: &AlignOptions,
-) -> Result<(Similarity, AlignmentReport)> {
-    let mut stages: Vec<AlignmentStage> = Vec::new();
+) -> Result<Alignment> {
+    let mut stages: Vec<AlignStage> = Vec::new();
     let mut pending: Vec<Note> = Vec::new();
-    let coarse: Option<(Similarity, AlignmentStage)> = match method {
+    let coarse: Option<(Similarity, AlignStage)> = match method {
         AlignMethod::Cameras => Some(align_cameras(input.cameras, &opts.cameras)?),
         AlignMethod::Points => Some(align_points(input.point_pairs)?),
         AlignMethod::Global => Some(align_global(gt, input.recon, &opts.global)?),
@@ -170,7 +160,7 @@ pub fn align(
                         if !pending.is_empty() {
                             pending.push(fell_back("points"));
                         }
-                        add_notes(&mut r.1, std::mem::take(&mut pending));
+                        r.1.prepend_notes(std::mem::take(&mut pending));
                         found = Some(r);
                     }
                     Err(e) => pending.push(stage_failed("points", &e)),
@@ -181,7 +171,7 @@ pub fn align(
                 if !pending.is_empty() {
                     pending.push(fell_back("global"));
                 }
-                add_notes(&mut r.1, std::mem::take(&mut pending));
+                r.1.prepend_notes(std::mem::take(&mut pending));
                 found = Some(r);
             }
             found
@@ -217,33 +207,13 @@ pub fn align(
             _ => opts.icp.clone(),
         };
         let (t2, mut stage) = refine_icp(gt, input.recon, &t, &icp)?;
-        add_notes(&mut stage, std::mem::take(&mut pending));
+        stage.prepend_notes(std::mem::take(&mut pending));
         t = t2;
         stages.push(stage);
     }
-    let last = stages.last();
-    let report = AlignmentReport {
-        method: stages
-            .iter()
-            .map(|s| s.method.as_str())
-            .collect::<Vec<_>>()
-            .join("+"),
-        gt_from_recon: t.matrix,
-        scale: t.scale(),
-        rmse: last.and_then(|s| s.rmse),
-        inlier_ratio: last.and_then(|s| s.inlier_ratio),
-        iterations: stages.iter().map(|s| s.iterations).sum(),
-        converged: stages.iter().all(|s| s.converged),
+    Ok(Alignment {
+        gt_from_recon: t,
         stages,
-    };
-    Ok((t, report))
-}
-
-/// The notes of every stage of an alignment report, in stage order, for the report's `notes`.
-pub(crate) fn stage_notes(report: &AlignmentReport) -> Vec<Note> {
-    report
-        .stages
-        .iter()
-        .flat_map(|s| s.notes.iter().cloned())
-        .collect()
+        requested: AlignMode::of_stages(method, opts.refine),
+    })
 }

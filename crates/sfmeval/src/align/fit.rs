@@ -2,25 +2,25 @@
 //! points inside the stage's distance gate, or a stage that stopped before settling with a
 //! tight or a loose fit. The thresholds travel in the notes' values.
 
+use super::{Alignment, StageKind};
 use crate::note::{Code, Note};
-use crate::report::AlignmentReport;
 
 /// Below this share of the points inside the final stage's distance gate, the fit is doubtful.
 pub const MIN_INLIER_RATIO: f64 = 0.5;
 /// An rmse of at most this percentage of the ground-truth diagonal is a tight fit.
 pub const TIGHT_RMSE_PERCENT_OF_DIAGONAL: f64 = 0.5;
 
-/// The notes on the fit of the last stage of `report` when it is a search against the surface
-/// (`icp` or `global`) and was not rejected; `diagonal` is the ground truth's bounding-box
-/// diagonal.
-pub(crate) fn fit_verdict(report: &AlignmentReport, diagonal: f64) -> Vec<Note> {
-    let Some(last) = report.stages.last() else {
+/// The notes on the fit of the last stage of `alignment` when it is a search against the
+/// surface (`icp` or `global`) and was not rejected; `diagonal` is the ground truth's
+/// bounding-box diagonal.
+pub(crate) fn fit_verdict(alignment: &Alignment, diagonal: f64) -> Vec<Note> {
+    let Some(last) = alignment.stages.last() else {
         return Vec::new();
     };
     let rejected = last.notes.iter().any(|n| n.code == Code::IcpRejected);
-    let name = match last.method.as_str() {
-        "icp" => "ICP",
-        "global" => "the global search",
+    let name = match last.kind {
+        StageKind::Icp => "ICP",
+        StageKind::Global => "the global search",
         _ => return Vec::new(),
     };
     if rejected {
@@ -33,7 +33,7 @@ pub(crate) fn fit_verdict(report: &AlignmentReport, diagonal: f64) -> Vec<Note> 
     };
     let with_fit = |mut n: Note| {
         n = n
-            .with("stage", last.method.as_str())
+            .with("stage", last.kind.name())
             .with("iterations", last.iterations)
             .with_number("min_inlier_ratio", MIN_INLIER_RATIO)
             .with_number(
@@ -121,28 +121,22 @@ fn precision2(v: f64) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::report::AlignmentStage;
+    use crate::align::{AlignMode, AlignStage};
+    use crate::transform::Similarity;
 
-    fn report(method: &str, rmse: f64, ratio: f64, converged: bool) -> AlignmentReport {
-        let stage = AlignmentStage {
-            method: method.into(),
-            gt_from_recon: [[0.0; 4]; 4],
-            scale: 1.0,
-            rmse: Some(rmse),
-            inlier_ratio: Some(ratio),
-            iterations: 100,
-            converged,
-            notes: Vec::new(),
-        };
-        AlignmentReport {
-            method: method.into(),
-            gt_from_recon: stage.gt_from_recon,
-            scale: 1.0,
-            rmse: stage.rmse,
-            inlier_ratio: stage.inlier_ratio,
-            iterations: 100,
-            converged,
-            stages: vec![stage],
+    fn report(kind: StageKind, rmse: f64, ratio: f64, converged: bool) -> Alignment {
+        Alignment {
+            gt_from_recon: Similarity::IDENTITY,
+            stages: vec![AlignStage {
+                kind,
+                gt_from_recon: Similarity::IDENTITY,
+                rmse: Some(rmse),
+                inlier_ratio: Some(ratio),
+                iterations: 100,
+                converged,
+                notes: Vec::new(),
+            }],
+            requested: AlignMode::Auto,
         }
     }
 
@@ -153,28 +147,34 @@ mod tests {
     #[test]
     fn verdicts_follow_the_thresholds() {
         // diagonal 10: the tight limit is an rmse of 0.05
-        assert!(fit_verdict(&report("icp", 0.2, 0.9, true), 10.0).is_empty());
+        assert!(fit_verdict(&report(StageKind::Icp, 0.2, 0.9, true), 10.0).is_empty());
         assert_eq!(
-            codes(&fit_verdict(&report("icp", 0.05, 0.5, false), 10.0)),
+            codes(&fit_verdict(
+                &report(StageKind::Icp, 0.05, 0.5, false),
+                10.0
+            )),
             [Code::UnsettledTightFit]
         );
         assert_eq!(
-            codes(&fit_verdict(&report("icp", 0.0501, 0.9, false), 10.0)),
+            codes(&fit_verdict(
+                &report(StageKind::Icp, 0.0501, 0.9, false),
+                10.0
+            )),
             [Code::UnsettledLooseFit]
         );
-        let few = fit_verdict(&report("global", 0.01, 0.49, false), 10.0);
+        let few = fit_verdict(&report(StageKind::Global, 0.01, 0.49, false), 10.0);
         assert_eq!(codes(&few), [Code::FewInliers, Code::UnsettledLooseFit]);
         assert_eq!(few[0].values["min_inlier_ratio"], 0.5);
         assert_eq!(few[0].values["inlier_ratio"], 0.49);
         assert_eq!(few[0].values["stage"], "global");
         assert!(few[0].message.contains("49 %"), "{}", few[0].message);
         // camera and given stages have no surface fit
-        assert!(fit_verdict(&report("cameras", 1.0, 0.1, false), 10.0).is_empty());
+        assert!(fit_verdict(&report(StageKind::Cameras, 1.0, 0.1, false), 10.0).is_empty());
     }
 
     #[test]
     fn a_rejected_refinement_has_no_verdict() {
-        let mut r = report("icp", 1.0, 0.1, false);
+        let mut r = report(StageKind::Icp, 1.0, 0.1, false);
         r.stages[0]
             .notes
             .push(Note::new(Code::IcpRejected, "rejected"));

@@ -24,14 +24,15 @@
 use nalgebra::{Matrix3, Quaternion, UnitQuaternion, Vector3};
 
 use super::icp::{box_corners, finite_subsample, motion, next_gate, update};
-use super::{from_m, make_stage, non_finite_ignored, rotation_angle_deg, sorted_eigen};
+use super::{
+    AlignStage, StageKind, from_m, make_stage, non_finite_ignored, rotation_angle_deg, sorted_eigen,
+};
 use crate::distance::CloudIndex;
 use crate::error::{Error, Result};
 use crate::geometry::Point3;
 use crate::note::{Code, Note};
 use crate::prepared::PreparedGroundTruth;
 use crate::progress::NoProgress;
-use crate::report::AlignmentStage;
 use crate::transform::Similarity;
 
 /// Options of the `global` stage.
@@ -330,7 +331,7 @@ pub(crate) fn align_global(
     gt: &PreparedGroundTruth,
     recon: &[Point3],
     opts: &GlobalOptions,
-) -> Result<(Similarity, AlignmentStage)> {
+) -> Result<(Similarity, AlignStage)> {
     opts.validate()?;
     let diag = gt.aabb.diagonal();
     let (all, skipped) = finite_subsample(recon, usize::MAX, 0);
@@ -495,7 +496,7 @@ pub(crate) fn align_global(
     // A coarse stage: settled when the best start's last step moved < 0.1 % of the diagonal.
     let converged = best.moved < 1e-3;
     let stage = make_stage(
-        "global",
+        StageKind::Global,
         &best.t,
         Some(best.rmse),
         Some(best.inliers as f64 / final_pts.len() as f64),

@@ -23,13 +23,12 @@
 
 use nalgebra::Vector3;
 
-use super::{is_finite, make_stage, subsample_indices, to_v};
+use super::{AlignStage, StageKind, is_finite, make_stage, subsample_indices, to_v};
 use crate::error::{Error, Result};
 use crate::geometry::{Aabb, Point3};
 use crate::note::{Code, Note};
 use crate::prepared::PreparedGroundTruth;
 use crate::progress::NoProgress;
-use crate::report::AlignmentStage;
 use crate::transform::Similarity;
 
 /// Options of the `icp` stage.
@@ -241,7 +240,7 @@ pub fn refine_icp(
     recon: &[Point3],
     start: &Similarity,
     opts: &IcpOptions,
-) -> Result<(Similarity, AlignmentStage)> {
+) -> Result<(Similarity, AlignStage)> {
     opts.validate()?;
     let (mut t, mut stage) = refine_once(gt, recon, start, opts)?;
     if opts.max_restarts == 1 || stage.notes.iter().any(|n| n.code == Code::IcpRejected) {
@@ -277,7 +276,7 @@ fn refine_once(
     recon: &[Point3],
     start: &Similarity,
     opts: &IcpOptions,
-) -> Result<(Similarity, AlignmentStage)> {
+) -> Result<(Similarity, AlignStage)> {
     if start.matrix.iter().flatten().any(|v| !v.is_finite()) || !(start.scale() > 0.0) {
         return Err(Error::InvalidOption(
             "ICP start transform is not a finite similarity".into(),
@@ -495,7 +494,7 @@ fn refine_once(
             .with("reason", reason),
         );
         let stage = make_stage(
-            "icp",
+            StageKind::Icp,
             start,
             rmse,
             Some(inlier_ratio),
@@ -506,7 +505,7 @@ fn refine_once(
         return Ok((*start, stage));
     }
     let stage = make_stage(
-        "icp",
+        StageKind::Icp,
         &t,
         rmse,
         Some(inlier_ratio),

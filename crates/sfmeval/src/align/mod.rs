@@ -22,13 +22,14 @@ mod icp;
 mod points;
 mod ransac;
 mod request;
+mod result;
 mod umeyama;
 
 #[cfg(test)]
 mod tests;
 
+pub(crate) use auto::fell_back;
 pub use auto::{AlignInput, AlignMethod, AlignOptions, align};
-pub(crate) use auto::{fell_back, stage_notes};
 pub(crate) use fit::fit_verdict;
 pub use fit::{MIN_INLIER_RATIO, TIGHT_RMSE_PERCENT_OF_DIAGONAL};
 pub use global::GlobalOptions;
@@ -36,6 +37,7 @@ pub use icp::{IcpOptions, refine_icp};
 pub use points::{PointPair, align_points, parse_point_pairs};
 pub use ransac::{CameraPair, CamerasOptions, align_cameras};
 pub use request::{AlignMode, AlignRequest};
+pub use result::{AlignStage, Alignment, StageKind};
 pub use umeyama::umeyama;
 pub use umeyama::{PairSums, umeyama_pairs};
 
@@ -45,26 +47,24 @@ use rand_chacha::ChaCha8Rng;
 
 use crate::geometry::Point3;
 use crate::note::{Code, Note};
-use crate::report::AlignmentStage;
 use crate::transform::Similarity;
 
 /// A row-major 3×3 rotation matrix.
 pub(crate) type Rotation = [[f64; 3]; 3];
 
-/// Builds the report entry of a stage.
+/// A stage's result.
 pub(crate) fn make_stage(
-    method: &str,
+    kind: StageKind,
     t: &Similarity,
     rmse: Option<f64>,
     inlier_ratio: Option<f64>,
     iterations: u64,
     converged: bool,
     notes: Vec<Note>,
-) -> AlignmentStage {
-    AlignmentStage {
-        method: method.into(),
-        gt_from_recon: t.matrix,
-        scale: t.scale(),
+) -> AlignStage {
+    AlignStage {
+        kind,
+        gt_from_recon: *t,
         rmse,
         inlier_ratio,
         iterations,

@@ -3,10 +3,9 @@
 
 use serde::{Deserialize, Serialize};
 
-use super::{is_finite, make_stage, planarity_ratio};
+use super::{AlignStage, StageKind, is_finite, make_stage, planarity_ratio};
 use crate::error::{Error, Result};
 use crate::geometry::{MAX_COORDINATE, Point3, show};
-use crate::report::AlignmentStage;
 use crate::transform::Similarity;
 
 /// One correspondence: a point of the reconstruction and the same point in the ground truth.
@@ -89,14 +88,14 @@ const MIN_PLANARITY: f64 = 1e-3;
 /// by hand). RMSE is the residual of the pairs in ground-truth units. Every failure is an
 /// [`Error::PointPairs`] (too few pairs, collinear or identical points, out-of-range values, no
 /// similarity), so front ends can name the pairs file.
-pub fn align_points(pairs: &[PointPair]) -> Result<(Similarity, AlignmentStage)> {
+pub fn align_points(pairs: &[PointPair]) -> Result<(Similarity, AlignStage)> {
     align_points_inner(pairs).map_err(|e| match e {
         Error::PointPairs(_) => e,
         other => Error::PointPairs(other.to_string()),
     })
 }
 
-fn align_points_inner(pairs: &[PointPair]) -> Result<(Similarity, AlignmentStage)> {
+fn align_points_inner(pairs: &[PointPair]) -> Result<(Similarity, AlignStage)> {
     if pairs.len() < 3 {
         return Err(Error::PointPairs(format!(
             "the points alignment needs at least 3 point pairs, got {}",
@@ -122,7 +121,15 @@ fn align_points_inner(pairs: &[PointPair]) -> Result<(Similarity, AlignmentStage
         .map(|(a, b)| sq_dist(t.apply(*a), *b))
         .sum();
     let rmse = (ss / pairs.len() as f64).sqrt();
-    let stage = make_stage("points", &t, Some(rmse), Some(1.0), 1, true, Vec::new());
+    let stage = make_stage(
+        StageKind::Points,
+        &t,
+        Some(rmse),
+        Some(1.0),
+        1,
+        true,
+        Vec::new(),
+    );
     Ok((t, stage))
 }
 
@@ -146,7 +153,7 @@ mod tests {
         let (t, stage) = align_points(&pairs).unwrap();
         assert!((t.scale() - 2.0).abs() < 1e-12);
         assert!(stage.rmse.unwrap() < 1e-12);
-        assert_eq!(stage.method, "points");
+        assert_eq!(stage.kind, StageKind::Points);
         assert_eq!(
             parse_point_pairs(b"[{\"recon\": [0,0,0], \"gt\": [1,1,1]}]")
                 .unwrap()

@@ -10,13 +10,12 @@ use rand_chacha::ChaCha8Rng;
 
 use super::points::sq_dist;
 use super::{
-    Rotation, from_m, is_finite, make_stage, planarity_ratio, project_to_rotation,
-    rotation_angle_deg, to_m, to_v,
+    AlignStage, Rotation, StageKind, from_m, is_finite, make_stage, planarity_ratio,
+    project_to_rotation, rotation_angle_deg, to_m, to_v,
 };
 use crate::error::{Error, Result};
 use crate::geometry::Point3;
 use crate::note::{Code, Note};
-use crate::report::AlignmentStage;
 use crate::transform::Similarity;
 
 /// One camera seen in both the reconstruction and the ground truth (matched by image name).
@@ -226,7 +225,7 @@ fn rms(t: &Similarity, pairs: &[CameraPair], idx: &[usize]) -> f64 {
 pub fn align_cameras(
     pairs: &[CameraPair],
     opts: &CamerasOptions,
-) -> Result<(Similarity, AlignmentStage)> {
+) -> Result<(Similarity, AlignStage)> {
     opts.validate()?;
     let mut notes = Vec::new();
     let usable: Vec<CameraPair> = pairs.iter().copied().filter(CameraPair::finite).collect();
@@ -413,7 +412,7 @@ pub fn align_cameras(
         );
     }
     let stage = make_stage(
-        "cameras",
+        StageKind::Cameras,
         &best.t,
         Some(rmse),
         Some(ratio),

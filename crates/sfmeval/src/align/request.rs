@@ -128,6 +128,21 @@ impl AlignMode {
             AlignMode::Given | AlignMode::None => return None,
         })
     }
+
+    /// The mode that runs `method`, refined by ICP when `refine` (the inverse of
+    /// [`Self::stages`]; `auto` and `icp` always end with ICP).
+    pub(crate) fn of_stages(method: AlignMethod, refine: bool) -> AlignMode {
+        match (method, refine) {
+            (AlignMethod::Auto, _) => AlignMode::Auto,
+            (AlignMethod::Icp, _) => AlignMode::Icp,
+            (AlignMethod::Cameras, false) => AlignMode::Cameras,
+            (AlignMethod::Points, false) => AlignMode::Points,
+            (AlignMethod::Global, false) => AlignMode::Global,
+            (AlignMethod::Cameras, true) => AlignMode::CamerasIcp,
+            (AlignMethod::Points, true) => AlignMode::PointsIcp,
+            (AlignMethod::Global, true) => AlignMode::GlobalIcp,
+        }
+    }
 }
 
 impl fmt::Display for AlignMode {
@@ -302,6 +317,11 @@ mod tests {
         );
         assert_eq!(AlignMode::Auto.stages(), Some((AlignMethod::Auto, true)));
         assert_eq!(AlignMode::Given.stages(), None);
+        for mode in AlignMode::ALL {
+            if let Some((method, refine)) = mode.stages() {
+                assert_eq!(AlignMode::of_stages(method, refine), mode);
+            }
+        }
         assert!(AlignMode::CamerasIcp.needs_cameras() && !AlignMode::Auto.needs_cameras());
     }
 }

@@ -219,9 +219,10 @@ proptest! {
         let recon = make_recon(&mesh, &truth, 40_000, 0.005, 0.2, seed, &|_| true);
         let cams = orbit_pairs(&mesh, &truth, 30, seed);
         let input = AlignInput { recon: &recon, cameras: &cams, ..Default::default() };
-        let (t, report) = align(&gt, &input, AlignMethod::Auto, &accurate()).unwrap();
-        prop_assert_eq!(report.method.as_str(), "cameras+icp");
-        prop_assert!(report.converged, "{:?}", report.stages);
+        let report = align(&gt, &input, AlignMethod::Auto, &accurate()).unwrap();
+        let t = report.gt_from_recon;
+        prop_assert_eq!(report.method(), "cameras+icp");
+        prop_assert!(report.stages.iter().all(|s| s.converged), "{:?}", report.stages);
         check(&t, &truth, 0.05, 0.002)?;
     }
 
@@ -233,8 +234,9 @@ proptest! {
         let truth = random_truth(seed, log_scale, [tx, -tx, 0.5 * tx]);
         let recon = make_recon(&mesh, &truth, 40_000, 0.005, 0.2, seed, &|_| true);
         let input = AlignInput { recon: &recon, ..Default::default() };
-        let (t, report) = align(&gt, &input, AlignMethod::Auto, &accurate()).unwrap();
-        prop_assert_eq!(report.method.as_str(), "global+icp");
+        let report = align(&gt, &input, AlignMethod::Auto, &accurate()).unwrap();
+        let t = report.gt_from_recon;
+        prop_assert_eq!(report.method(), "global+icp");
         check(&t, &truth, 0.05, 0.002)?;
     }
 
@@ -250,7 +252,8 @@ proptest! {
         let recon = make_recon(&mesh, &truth, 40_000, 0.005, 0.2, seed, &|p| p[0] * n[0] + (p[1] - 0.1) * n[1] + p[2] * n[2] > 0.0);
         let cams = orbit_pairs(&mesh, &truth, 30, seed);
         let input = AlignInput { recon: &recon, cameras: &cams, ..Default::default() };
-        let (t, report) = align(&gt, &input, AlignMethod::Auto, &accurate()).unwrap();
+        let report = align(&gt, &input, AlignMethod::Auto, &accurate()).unwrap();
+        let t = report.gt_from_recon;
         prop_assert!(report.stages[1].notes.is_empty(), "{:?}", report.stages[1]);
         // Half the surface constrains the pose less (a shorter lever arm, a sliding
         // direction), so the statistical bound is twice the full object's; a collapse would be
@@ -351,8 +354,9 @@ fn auto_falls_back_and_names_it() {
         align(&gt, &input, AlignMethod::Cameras, &AlignOptions::default()),
         Err(crate::Error::Geometry(_))
     ));
-    let (t, report) = align(&gt, &input, AlignMethod::Auto, &AlignOptions::default()).unwrap();
-    assert_eq!(report.method, "global+icp");
+    let report = align(&gt, &input, AlignMethod::Auto, &AlignOptions::default()).unwrap();
+    let t = report.gt_from_recon;
+    assert_eq!(report.method(), "global+icp");
     let notes = &report.stages[0].notes;
     let codes: Vec<Code> = notes.iter().map(|n| n.code).collect();
     assert!(
@@ -361,7 +365,7 @@ fn auto_falls_back_and_names_it() {
             && notes[1].values["to"] == "global",
         "{notes:?}"
     );
-    assert!(!stage_notes(&report).is_empty());
+    assert!(report.notes().next().is_some());
     let dr = rotation_angle_deg(&t.rotation(), &truth.rotation());
     assert!(
         dr < 0.05,
@@ -372,7 +376,7 @@ fn auto_falls_back_and_names_it() {
     assert_eq!(
         align(&gt, &input, AlignMethod::Auto, &AlignOptions::default())
             .unwrap()
-            .0,
+            .gt_from_recon,
         t
     );
 }
@@ -421,8 +425,10 @@ fn icp_alone_ends_at_its_fixed_point() {
         start: Some(hand),
         ..Default::default()
     };
-    let (t, report) = align(&gt, &input, AlignMethod::Icp, &AlignOptions::default()).unwrap();
-    assert!(report.converged, "{report:?}");
+    let report = align(&gt, &input, AlignMethod::Icp, &AlignOptions::default()).unwrap();
+    let t = report.gt_from_recon;
+    assert!(report.stages.iter().all(|s| s.converged), "{report:?}");
+    assert_eq!(report.requested, AlignMode::Icp);
     let once = IcpOptions::default();
     assert_eq!(once.max_restarts, 1);
     let (again, _) = refine_icp(&gt, &recon, &t, &once).unwrap();
