@@ -46,9 +46,13 @@ enum Command {
         /// else 16 numbers as text).
         #[arg(long, value_name = "FILE")]
         out: Option<PathBuf>,
-        /// Seed of the randomised stages.
+        /// Seed of the randomised stages and of the surface sampler.
         #[arg(long, value_name = "S", default_value_t = 0)]
         seed: u64,
+        /// Ground-truth surface samples the `global` search measures against (as `eval
+        /// --samples`: with the same value and seed, `align` finds `eval`'s alignment).
+        #[arg(long, value_name = "N", default_value_t = DEFAULT_SAMPLES)]
+        samples: usize,
     },
     /// Camera-pose errors of a reconstruction's cameras against the ground-truth cameras.
     Cameras {
@@ -241,7 +245,12 @@ pub fn run(cli: Cli) -> Result<()> {
             }
             eval(&args)
         }
-        Command::Align { input, out, seed } => align_cmd(&input, out.as_deref(), seed),
+        Command::Align {
+            input,
+            out,
+            seed,
+            samples,
+        } => align_cmd(&input, out.as_deref(), seed, samples),
         Command::Cameras {
             gt_cameras,
             recon,
@@ -461,11 +470,13 @@ fn eval(args: &EvalArgs) -> Result<()> {
     Ok(())
 }
 
-fn align_cmd(input: &InputArgs, out: Option<&Path>, seed: u64) -> Result<()> {
+fn align_cmd(input: &InputArgs, out: Option<&Path>, seed: u64, samples: usize) -> Result<()> {
+    // The ground truth is sampled as `eval` samples it: the global search measures against
+    // those samples (one sample, as this once drew, is a ground truth of zero extent).
     let request = EvalRequest {
         align: align_request(input)?,
         eval: EvalOptions {
-            samples: 1,
+            samples,
             seed,
             ..EvalOptions::default()
         },
