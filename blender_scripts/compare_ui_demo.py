@@ -24,11 +24,9 @@ prefs = bpy.context.preferences.addons["sfmeval_blender"].preferences
 prefs.sfmeval_path, prefs.runner_path = sfmeval_bin, runner_bin
 from sfmeval_blender.compare import panel as cpanel  # noqa: E402
 
-# the dataset panel closed, so the comparison fits the window
-gen = bpy.types.SFMEVAL_PT_panel
-bpy.utils.unregister_class(gen)
-gen.bl_options = {"DEFAULT_CLOSED"}
-bpy.utils.register_class(gen)
+# the dataset panel (tab "sfmeval") out of the picture: the sidebar shows the comparison's own
+# tab, "sfmeval compare" (Blender 3.4 cannot switch tabs from Python)
+bpy.utils.unregister_class(bpy.types.SFMEVAL_PT_panel)
 ticks = []
 state = {"phase": "start", "t0": 0.0}
 

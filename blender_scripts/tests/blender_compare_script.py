@@ -129,6 +129,7 @@ bpy.context.view_layer.update()
 res["crop_matrix"] = [list(r) for r in crop.matrix_world]
 
 # 10. Automatic alignment of the kept points, then Refine (ICP) from a start moved by 3° and 2 %.
+c.active_recon = c.recons.find(first)  # the row Automatic and Refine act on
 res["align_auto"] = call(bpy.ops.sfmeval.compare_align, mode="auto")
 auto = np.array(list(obj["sfmeval_gt_from_recon"])).reshape(4, 4)
 res["auto"] = auto.tolist()

@@ -167,9 +167,15 @@ def _tick():
                 res["active_color"] = (me.color_attributes.active_color.name
                                        if me.color_attributes.active_color else None)
                 res["vertices"] = len(me.vertices)
-                # the points framed (the startup cube, which would hide them, removed)
+                # the points framed (the startup cube, which would hide them, removed; the
+                # ground-truth mesh the import shows, in its own collection, hidden)
                 if "Cube" in bpy.data.objects:
                     bpy.data.objects.remove(bpy.data.objects["Cube"])
+                gt_layer = bpy.context.view_layer.layer_collection.children.get(
+                    "sfmeval ground truth")
+                res["gt_shown"] = bool(gt_layer and len(gt_layer.collection.objects))
+                if gt_layer:
+                    gt_layer.hide_viewport = True
                 co = np.array([obj.matrix_world @ v.co for v in me.vertices])
                 lo, hi = np.percentile(co, [10, 90], axis=0)  # (outliers far off)
                 r3d = area.spaces.active.region_3d

@@ -4,14 +4,16 @@ call (the compare drivers read the Compare pipelines panel's text this way)."""
 import bpy
 
 
-def panel_labels(panel, scene):
-    """The label texts `panel.draw` writes for `scene` (preferences from the running Blender)."""
+def panel_labels(panel, scene, icons=False):
+    """The label texts `panel.draw` writes for `scene` (preferences from the running Blender);
+    with `icons`, [text, icon] pairs."""
     labels = []
 
     class Layout:
         def __getattr__(self, name):
             if name == "label":
-                return lambda text="", **k: labels.append(text)
+                return lambda text="", icon="NONE", **k: labels.append(
+                    [text, icon] if icons else text)
             return lambda *a, **k: Layout()
 
         def __setattr__(self, k, v):

@@ -13,6 +13,7 @@ import json
 import math
 import os
 import shutil
+import shlex
 import signal
 import subprocess
 import sys
@@ -240,7 +241,7 @@ def _check(res, ds, bins, tmp_path, ran):
         f1 = [t for t in rep["thresholds"] if t["tau_percent_of_diagonal"] == 1.0][0]
         assert s["f1"] == f1["f_score"]
         assert p in res["labels"]
-        assert any(x.startswith("mean %.4g " % acc["mean"]) for x in res["labels"])
+        assert "%.4g" % acc["mean"] in res["labels"]
         # Table I (file and text block): this report's mean and point count
         with open(os.path.join(ds, "compare", "table1.md"), encoding="utf-8") as f:
             md = f.read()
@@ -290,10 +291,9 @@ def test_compare_pipelines_workflow(blender, bpy_result, tiny, addon_zip, bins, 
 
 
 def test_table1_is_the_runners_format(bpy_result, bins, tmp_path):
-    """The add-on's Table I writer, given the rows of `sfmeval-runner report`'s own reports,
-    writes table1.md and table1.csv byte for byte as the runner does (ok and failed runs)."""
-    sys.path.insert(0, BLENDER_SCRIPTS)
-    from sfmeval_blender.compare import evaluate as ev
+    """Table I the panel shows comes from `sfmeval table`: given the reports of
+    `sfmeval-runner report` and its failed run, it writes table1.md and table1.csv byte for byte
+    as the runner does (ok and failed runs, the runner's column order)."""
     src_ds, _ = bpy_result
     name = os.path.basename(src_ds)
     runs = tmp_path / "runs"
@@ -304,20 +304,17 @@ def test_table1_is_the_runners_format(bpy_result, bins, tmp_path):
                            "--datasets", src_ds, "--samples", "20000"],
                           capture_output=True, text=True)
     assert proc.returncode == 0, proc.stderr
-    rows = []
-    for p in REAL + ["bad"]:
+    sys.path.insert(0, BLENDER_SCRIPTS)
+    from sfmeval_blender.compare import evaluate as ev
+    reports, failed = [], []
+    for p in REAL[::-1] + ["bad"]:
         with open(runs / name / p / "run.json") as f:
             rec = json.load(f)
         if rec["status"] == "ok":
-            with open(table / "reports" / name / ("%s.json" % p)) as f:
-                rep = json.load(f)
-            rows.append((p, rep["accuracy"]["mean"], rep["inputs"]["reconstruction"]["points"],
-                         "ok", ""))
+            reports.append((p, str(table / "reports" / name / ("%s.json" % p))))
         else:
-            rows.append((p, None, 0, rec["status"], rec["reason"]))
-    listed = json.loads(subprocess.run([bins["runner"], "pipelines", "--json"],
-                                       capture_output=True, text=True, check=True).stdout)
-    md, csv_text = ev.table1(name, ev.table_order(rows[::-1], [x["name"] for x in listed]))
+            failed.append((p, rec["reason"]))
+    md, csv_text = ev.table(bins["sfmeval"], name, reports, failed, str(tmp_path / "mine"))
     assert md.encode() == (table / "table1.md").read_bytes()
     assert csv_text.encode() == (table / "table1.csv").read_bytes()
 
@@ -420,3 +417,125 @@ def test_crop_sphere_is_written_and_matches_the_cli(addon_zip, bins, tmp_path):
     assert mine.read_bytes() == raw, "the add-on's report differs from the CLI's"
     assert res["summary"]["points"] == rep["crop"]["kept"]
     assert res["summary"]["mean"] == rep["accuracy"]["mean"]
+
+
+FLOAT64_SCRIPT = os.path.join(os.path.dirname(SCRIPT), "blender_float64_script.py")
+
+
+@pytest.mark.parametrize("blender", ["bpy", "debian"])
+def test_float64_points_selected_rows_and_notes(blender, addon_zip, bins, tmp_path):
+    """data/demo's sparse.ply and its COLMAP model imported as files (through `sfmeval export`),
+    vertices of both deleted in Edit Mode: each evaluation measures exactly the float64 source
+    rows still present, and its report is byte for byte `sfmeval eval` on the same points,
+    transform and cameras (ATE and rotation errors included). Automatic and Refine act on the
+    selected row only, Refine is one `sfmeval align --align icp` from the moved placement, Table
+    I is `sfmeval table`'s, and a report whose messages are reworded shows the same notes."""
+    ds = tmp_path / "demo"
+    shutil.copytree(os.path.join(REPO, "data", "demo"), ds)
+    out = tmp_path / "f64.json"
+    env = dict(os.environ, BLENDER_USER_SCRIPTS=str(tmp_path / "user_scripts"),
+               BLENDER_USER_CONFIG=str(tmp_path / "user_config"))
+    args = [addon_zip, str(ds), str(out), bins["sfmeval"]]
+    if blender == "bpy":
+        assert have_bpy(), "PyPI bpy is not installed"
+        cmd = [sys.executable, FLOAT64_SCRIPT] + args
+    else:
+        exe = shutil.which("blender")
+        assert exe, "Debian blender not installed (apt-get install blender python3-numpy)"
+        cmd = [exe, "-b", "--factory-startup", "-noaudio", "--python-exit-code", "1",
+               "-P", FLOAT64_SCRIPT, "--"] + args
+    proc = subprocess.run(cmd, capture_output=True, text=True, env=env, timeout=600)
+    assert proc.returncode == 0 and "FLOAT64 DONE" in proc.stdout, \
+        proc.stdout[-4000:] + proc.stderr[-4000:]
+    res = json.loads(out.read_text())
+    ply_name, colmap_name = "sparse", "demo-sparse"
+    # its own tab; an empty Dataset field says what to choose; rows listed at once; no stale text
+    assert res["category"] == "sfmeval compare"
+    assert any("Choose a dataset folder" in x for x in res["empty_labels"]), res["empty_labels"]
+    assert res["listed_after_import"] == [[ply_name], [ply_name, colmap_name]]
+    assert res["message_after_import"] == "" and res["message_after_eval"] == ""
+    assert res["gt_collection"] and "MESH" in res["gt_collection"]
+    # imports: `sfmeval export` then `sfmeval align`, no evaluation round trip
+    verbs = [shlex.split(x)[1] for x in res["import_commands"]]
+    assert verbs == ["export", "align", "export", "align"], res["import_commands"]
+    # Automatic: one align on the selected (COLMAP) row; the PLY's alignment untouched
+    assert res["ply_untouched"]
+    assert [shlex.split(x)[1] for x in res["auto_commands"]] == ["align"]
+    assert os.path.join("compare", colmap_name) in res["auto_commands"][0]
+    # Refine: ONE `sfmeval align --align icp` from the moved placement; the test's own run of
+    # that command gives the same alignment
+    assert len(res["refine_commands"]) == 1, res["refine_commands"]
+    argv = shlex.split(res["refine_commands"][0])
+    assert argv[1] == "align" and argv[argv.index("--align") + 1] == "icp"
+    start = np.array(res["icp_start"])
+    moved = np.array(res["auto"])
+    a = math.radians(2.0)
+    P = np.eye(4)
+    P[:3, :3] = 1.01 * np.array([[math.cos(a), -math.sin(a), 0], [math.sin(a), math.cos(a), 0],
+                                 [0, 0, 1]])
+    assert np.allclose(start, P @ moved, rtol=1e-5, atol=1e-5)
+    argv[argv.index("--out") + 1] = str(tmp_path / "mine_alignment.json")
+    subprocess.run(argv, check=True, capture_output=True)
+    mine = json.loads((tmp_path / "mine_alignment.json").read_text())
+    assert mine == res["refine_alignment"]
+    assert res["refined"] == [v for row in mine["gt_from_recon"] for v in row]
+    # each evaluation: the float64 source rows of the vertices left, the CLI's report bytes
+    for name, step in ((ply_name, 5), (colmap_name, 3)):
+        item = res["items"][name]
+        import trimesh
+        src = np.asarray(trimesh.load(item["source"], process=False).vertices, np.float64)
+        idx = np.array(item["index"])
+        expect = np.delete(np.arange(len(src)), res["deleted"][name])
+        assert np.array_equal(idx, expect)
+        work = os.path.dirname(item["report"])
+        with open(os.path.join(work, "points.ply"), "rb") as f:
+            body = f.read()
+        pts = np.frombuffer(body[body.index(b"end_header\n") + 11:], "<f8").reshape(-1, 3)
+        assert np.array_equal(pts, src[idx])  # float64, bit for bit
+        mine = tmp_path / ("%s.json" % name)
+        argv = [bins["sfmeval"], "eval", "--dataset", str(ds), "--recon",
+                os.path.join(work, "points.ply"), "--align", "given", "--transform",
+                os.path.join(work, "gt_from_recon.json"), "--report", str(mine), "--quiet"]
+        if item["cameras_source"]:
+            argv += ["--recon-cameras", item["cameras_source"]]
+        subprocess.run(argv, check=True, capture_output=True)
+        with open(item["report"], "rb") as f:
+            raw = f.read()
+        assert mine.read_bytes() == raw, "the add-on's report differs from the CLI's"
+        rep = json.loads(raw)
+        assert rep["inputs"]["reconstruction"]["points"] == item["vertices"] == len(expect)
+        T = np.array(rep["alignment"]["gt_from_recon"])
+        assert np.allclose(np.array(item["stored"]).reshape(4, 4), T, rtol=1e-6, atol=1e-6)
+        s = item["summary"]
+        assert s["mean"] == rep["accuracy"]["mean"] and s["min"] == rep["accuracy"]["min"]
+        assert s["ate"] == (rep["cameras"] or {}).get("ate_rmse")
+    # the COLMAP model's cameras: ATE and rotation errors are those `sfmeval eval` gives the
+    # model itself (camera alignment, whatever aligned the points)
+    rep = json.loads(open(res["items"][colmap_name]["report"]).read())
+    cli = tmp_path / "model.json"
+    subprocess.run([bins["sfmeval"], "eval", "--dataset", str(ds), "--recon", str(ds / "sparse"),
+                    "--report", str(cli), "--quiet", "--samples", "20000"], check=True,
+                   capture_output=True)
+    cli = json.loads(cli.read_text())
+    assert rep["cameras"]["registered"] == cli["cameras"]["registered"] > 0
+    assert rep["cameras"]["ate_rmse"] == cli["cameras"]["ate_rmse"]
+    assert rep["cameras"]["rotation_error_deg"] == cli["cameras"]["rotation_error_deg"]
+    assert res["items"][colmap_name]["summary"]["ate"] == cli["cameras"]["ate_rmse"]
+    # the numbers readable at the sidebar's width: one short label per value
+    texts = [t for t, _ in res["labels"]]
+    assert "mean" in texts and "%.4g" % res["items"][ply_name]["summary"]["mean"] in texts
+    assert max(len(t) for t in texts if t in ("mean", "median", "ATE")) <= 6
+    # Table I is `sfmeval table`'s on the same reports (the runner's bytes)
+    table = tmp_path / "table"
+    subprocess.run([bins["sfmeval"], "table"] +
+                   ["%s=%s" % (n, res["items"][n]["report"]) for n in (ply_name, colmap_name)] +
+                   ["--dataset", "demo", "--out", str(table)], check=True, capture_output=True)
+    for name in ("table1.md", "table1.csv"):
+        assert (table / name).read_bytes() == (ds / "compare" / name).read_bytes(), name
+    assert (table / "table1.md").read_text() in res["table_text"]
+    # notes by level: the reworded report's warnings shown with their new words, infos not
+    shown = [(t, icon) for t, icon in res["reworded_labels"] if t.startswith("REWORDED")]
+    warnings = [n for n in res["notes"] if n["level"] == "warning"]
+    assert warnings, res["notes"]
+    assert shown == [(n["message"], "ERROR") for n in warnings]
+    assert any(n["code"] == "cameras.reconstruction_has_no_cameras" for n in warnings)

@@ -164,6 +164,7 @@ def test_compare_run_and_cancel_in_a_window(tmp_path):
     assert res["color_type"] == "VERTEX", (res["color_type_before"], res["color_type"])
     assert res["active_color"] == "sfmeval_color", res["active_color"]
     assert res["vertices"] == rec["points"], (res["vertices"], rec["points"])
+    assert res["gt_shown"], "the import shows the ground truth in its own collection"
     single = str(png)[:-len(".png")] + "-single.png"
     n_color = viridis_pixels(png, res["view_region"])
     n_single = viridis_pixels(single, res["view_region"])

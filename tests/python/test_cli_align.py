@@ -365,3 +365,24 @@ def test_eval_names_the_flag_an_alignment_lacks_or_ignores(sfmeval_bin, tmp_path
     assert r.returncode != 0
     assert message in r.stderr, r.stderr
     assert not out.exists()
+
+
+@pytest.mark.parametrize("method", ["global", "global+icp", "auto"])
+def test_align_samples_the_ground_truth_as_eval_does(sfmeval_bin, tmp_path, method):
+    """`sfmeval align` draws the ground truth's surface samples as `eval` does (it once drew 1,
+    and `--align global` then failed with "the ground truth has zero extent"): on the demo's
+    sparse.ply (no cameras, so `auto` runs the global search too) `align` writes exactly the
+    alignment section of `eval`'s report."""
+    demo = ROOT / "data" / "demo"
+    common = ["--gt", demo / "ground_truth.glb", "--recon", demo / "sparse.ply",
+              "--align", method]
+    run(sfmeval_bin, "align", *common, "--out", tmp_path / "a.json")
+    run(sfmeval_bin, "eval", *common, "--report", tmp_path / "r.json", "--quiet")
+    aligned = json.loads((tmp_path / "a.json").read_text())
+    report = json.loads((tmp_path / "r.json").read_text())
+    assert aligned["method"] == {"auto": "global+icp"}.get(method, method)
+    assert aligned == report["alignment"]
+    # and a smaller sample count is a different search (the flag reaches the core)
+    run(sfmeval_bin, "align", *common, "--samples", "2000", "--out", tmp_path / "b.json")
+    fewer = json.loads((tmp_path / "b.json").read_text())
+    assert fewer["gt_from_recon"] != aligned["gt_from_recon"]

@@ -6,6 +6,11 @@ blender_from_gltf, so a points object's own matrix (``matrix_basis``) IS the ali
 gt_from_recon and its mesh holds the points in the reconstruction's frame, as the file has them.
 Moving, rotating or scaling the object changes the alignment; deleting vertices in Edit Mode
 removes points from the evaluation.
+
+The mesh's vertices are float32 (Blender's), so they are only what is shown: every vertex
+carries the integer attribute ``sfmeval_index``, its row in the float64 source that ``sfmeval
+export`` wrote (``compare/NAME/source/points.ply``), and what is measured are the source's rows
+of the vertices still there.
 """
 
 import json
@@ -23,7 +28,9 @@ GT_FRAME = "sfmeval GT frame"
 # glTF = (x, z, -y) of Blender (geometry.blender_to_gltf)
 GLTF_FROM_BLENDER = np.array([[1, 0, 0, 0], [0, 0, 1, 0], [0, -1, 0, 0], [0, 0, 0, 1]], float)
 PROP_T = "sfmeval_gt_from_recon"
-REFINE_ROUNDS = 6
+INDEX = "sfmeval_index"
+SOURCE = "sfmeval_points"  # the object's float64 source PLY (sfmeval export)
+GT_COLLECTION = "sfmeval ground truth"
 
 
 def dataset_dir(context):
@@ -89,9 +96,40 @@ def set_gt_from_recon(obj, m):
     obj[PROP_T] = m.reshape(-1).tolist()
 
 
+def show_ground_truth(context, dataset):
+    """The dataset's ground_truth.glb in the scene, in its own collection "sfmeval ground truth"
+    (once; display only: the evaluation reads the file). Returns an error text, or ""."""
+    coll = _collection(context, GT_COLLECTION)
+    if len(coll.objects):
+        return ""
+    path = os.path.join(dataset, "ground_truth.glb")
+    if not os.path.isfile(path):
+        return "no ground_truth.glb in %s" % dataset
+    if not hasattr(np, "bool"):  # Blender 3.4's glTF importer uses np.bool (numpy < 1.24)
+        np.bool = bool
+    before = set(bpy.data.objects)
+    layer = context.view_layer
+    selected, active = list(context.selected_objects), layer.objects.active
+    try:
+        bpy.ops.import_scene.gltf(filepath=path)
+    except Exception as exc:  # display only: never fail the import for it
+        return "ground truth display: %s" % exc
+    for obj in set(bpy.data.objects) - before:
+        for other in list(obj.users_collection):
+            other.objects.unlink(obj)
+        coll.objects.link(obj)
+        obj.select_set(False)  # the importer selects what it made: the user's selection stays
+    for obj in selected:
+        if obj.name in layer.objects:
+            obj.select_set(True)
+    layer.objects.active = active
+    return ""
+
+
 def new_points_object(context, name, points, cameras_json=None):
     """A collection `name` with the points object `name` (mesh of loose vertices in the
-    reconstruction's frame) under the GT frame, and the estimated cameras as its children."""
+    reconstruction's frame, each with its source row in ``sfmeval_index``) under the GT frame,
+    and the estimated cameras as its children."""
     coll = _collection(context, "sfmeval " + name)
     old = bpy.data.objects.get(name)
     if old is not None:
@@ -102,6 +140,8 @@ def new_points_object(context, name, points, cameras_json=None):
     pts = np.asarray(points, dtype=np.float32).reshape(-1, 3)
     mesh.vertices.add(len(pts))
     mesh.vertices.foreach_set("co", pts.ravel())
+    index = mesh.attributes.new(INDEX, "INT", "POINT")
+    index.data.foreach_set("value", np.arange(len(pts), dtype=np.int32))
     mesh.update()
     obj = bpy.data.objects.new(name, mesh)
     coll.objects.link(obj)
@@ -226,14 +266,44 @@ def leave_edit_mode(obj):
         bpy.ops.object.mode_set(mode="OBJECT")
 
 
-def kept_points(obj):
-    """The vertices left in the object's mesh (recon frame, float64), Edit Mode deletions
-    included (the object leaves Edit Mode)."""
+def kept_indices(obj):
+    """The source rows (``sfmeval_index``) of the vertices left in the object's mesh, Edit Mode
+    deletions included (the object leaves Edit Mode)."""
     leave_edit_mode(obj)
     mesh = obj.data
-    co = np.empty(len(mesh.vertices) * 3, dtype=np.float32)
-    mesh.vertices.foreach_get("co", co)
-    return co.reshape(-1, 3).astype(np.float64)
+    attr = mesh.attributes.get(INDEX)
+    if attr is None or attr.data_type != "INT" or attr.domain != "POINT":
+        raise ValueError("%s has no integer point attribute '%s': import it again" %
+                         (obj.name, INDEX))
+    idx = np.empty(len(mesh.vertices), dtype=np.int32)
+    attr.data.foreach_get("value", idx)
+    return idx
+
+
+_SOURCES = {}
+
+
+def source_points(obj):
+    """The object's float64 source points (``sfmeval export``'s PLY; read once per file)."""
+    path = obj.get(SOURCE)
+    if not path or not os.path.isfile(path):
+        raise ValueError("%s: its source points (%s) are gone: import it again" % (obj.name, path))
+    key = (path, os.path.getmtime(path))
+    if key not in _SOURCES:
+        _SOURCES.clear()
+        _SOURCES[key] = plyio.read_vertices(path)
+    return _SOURCES[key]
+
+
+def kept_points(obj):
+    """The float64 source points of the vertices left in the object's mesh (recon frame), Edit
+    Mode deletions included. A vertex added in Edit Mode has no source point: an error."""
+    idx = kept_indices(obj)
+    src = source_points(obj)
+    if len(idx) and (idx.min() < 0 or idx.max() >= len(src) or len(np.unique(idx)) != len(idx)):
+        raise ValueError("%s: vertices added or duplicated in Edit Mode have no source point "
+                         "(only deleting points is measured): import it again" % obj.name)
+    return src[idx]
 
 
 def crop_file(context):
@@ -295,9 +365,10 @@ def gt_override(context):
     return path
 
 
-def paint(obj, distances, status, clip):
-    """`distance` point attribute and the viridis colours (``sfmeval_color``, float RGBA = the
-    CLI's bytes / 255; points the crop drops are grey)."""
+def paint(obj, distances, status, kept_rgb):
+    """`distance` point attribute and the colours of ``sfmeval eval --colored`` (``sfmeval_color``,
+    float RGBA = the CLI's bytes / 255, its rows are the kept points in input order; points the
+    crop drops are grey)."""
     mesh = obj.data
     n = len(mesh.vertices)
     for name in ("distance", "sfmeval_color"):
@@ -306,9 +377,12 @@ def paint(obj, distances, status, clip):
             mesh.attributes.remove(a)
     d = mesh.attributes.new("distance", "FLOAT", "POINT")
     d.data.foreach_set("value", np.asarray(distances, dtype=np.float32))
-    rgb = ev.distance_colors(distances, clip).astype(np.float32) / 255.0
-    kept = np.array([s == "kept" for s in status])
-    rgb[~kept] = 0.5
+    kept = np.array([s == "kept" for s in status], dtype=bool)
+    if int(kept.sum()) != len(kept_rgb):
+        raise ev.CliError("%s: the coloured PLY has %d points, the evaluation kept %d"
+                          % (obj.name, len(kept_rgb), int(kept.sum())))
+    rgb = np.full((n, 3), 0.5, np.float32)
+    rgb[kept] = np.asarray(kept_rgb, np.float32) / 255.0
     rgba = np.concatenate([rgb, np.ones((n, 1), np.float32)], axis=1)
     if hasattr(mesh, "color_attributes"):
         col = mesh.color_attributes.new("sfmeval_color", "FLOAT_COLOR", "POINT")
@@ -347,17 +421,9 @@ def align_item(context, sfmeval, item, mode):
     if mode != "icp":
         a = ev.align(sfmeval, ds, pts, work, mode=mode, recon_cameras=cams, gt=gt)
     else:
-        # One ICP run stops when a step is small; on a sparse cloud that can leave it ~0.06°
-        # short of its fixed point. Refine restarts it from its own answer until it stays put.
-        start = gt_from_recon(obj)
-        for _ in range(REFINE_ROUNDS):
-            a = ev.align(sfmeval, ds, pts, work, mode="icp", start=start, recon_cameras=cams,
-                         gt=gt)
-            end = np.array(a["gt_from_recon"], float)
-            deg, ds_rel = ev.rotation_scale_change(start, end)
-            start = end
-            if deg < 1e-3 and abs(ds_rel) < 1e-6:
-                break
+        # one call: the core's ICP runs to its fixed point (restarts included)
+        a = ev.align(sfmeval, ds, pts, work, mode="icp", start=gt_from_recon(obj),
+                     recon_cameras=cams, gt=gt)
     set_gt_from_recon(obj, a["gt_from_recon"])
     return a
 
@@ -365,55 +431,44 @@ def align_item(context, sfmeval, item, mode):
 def measure_item(context, sfmeval, item, crop=None, gt=None):
     """Evaluates the object's kept points with its matrix as the alignment (``sfmeval eval
     --align given``), the crop file and the run's cameras; paints the points; returns the
-    report. Files: compare/<name>/{points.ply, gt_from_recon.txt, report.json, distances.csv}."""
+    report. Files: compare/<name>/{points.ply, gt_from_recon.json, report.json, distances.csv,
+    colored.ply}."""
     obj = item.object
     ds, work, pts = write_kept_points(context, item)
-    tpath = os.path.join(work, "gt_from_recon.txt")
-    ev.write_transform(tpath, gt_from_recon(obj))
-    rep, dist, status = ev.evaluate(sfmeval, ds, pts, tpath, os.path.join(work, "report.json"),
-                                    recon_cameras=item.cameras_source or None, crop=crop,
-                                    csv_out=os.path.join(work, "distances.csv"), gt=gt)
+    tpath = os.path.join(work, "gt_from_recon.json")
+    ev.write_matrix_json(tpath, gt_from_recon(obj))
+    rep, dist, status, rgb = ev.evaluate(
+        sfmeval, ds, pts, tpath, os.path.join(work, "report.json"),
+        recon_cameras=item.cameras_source or None, crop=crop,
+        csv_out=os.path.join(work, "distances.csv"), gt=gt,
+        colored=os.path.join(work, "colored.ply"))
     if len(dist) != len(obj.data.vertices):
         raise ev.CliError("%s: the CLI measured %d points of %d (camera-centre points removed?)"
                           % (pts, len(dist), len(obj.data.vertices)))
-    paint(obj, dist, status, ev.color_clip(rep))
+    paint(obj, dist, status, rgb)
     return rep
 
 
 def import_source(context, sfmeval, name, source, run_dir=None):
-    """Imports a reconstruction: a run folder (its sparse.ply, model/ and cameras.json) or any
-    file the CLI reads. Aligns it automatically; returns the points object."""
+    """Imports a reconstruction: a run folder (its sparse.ply with the cameras of its model/) or
+    any file or folder the CLI reads, through ``sfmeval export`` (its points as float64 and its
+    cameras, in its own frame, into compare/NAME/source/). Aligns it automatically; returns
+    (the points object, the cameras file evaluations use or None)."""
     ds = require_dataset(context)
     work = work_dir(context, name)
     os.makedirs(work, exist_ok=True)
-    cameras_source, cameras_json = None, None
+    recon, model = source, None
     if run_dir:
         recon = os.path.join(run_dir, "sparse.ply")
         if os.path.isdir(os.path.join(run_dir, "model")):
-            cameras_source = os.path.join(run_dir, "model")
-        cameras_json = os.path.join(run_dir, "cameras.json")
-    else:
-        recon = source
+            model = os.path.join(run_dir, "model")
     if not os.path.exists(recon):
         raise ValueError("%s does not exist" % recon)
+    points_ply, cameras_json = ev.export(sfmeval, recon, os.path.join(work, "source"), model)
     gt = gt_override(context)
-    if recon.lower().endswith(".ply"):
-        points = plyio.read_vertices(recon)
-        a = ev.align(sfmeval, ds, recon, work, recon_cameras=cameras_source, gt=gt)
-    else:
-        # Any other format: the CLI reads it; its points come back in the GT frame (--csv),
-        # mapped into the reconstruction's frame by the inverse alignment.
-        a = ev.align(sfmeval, ds, recon, work, gt=gt)
-        t = os.path.join(work, "gt_from_recon.txt")
-        ev.write_transform(t, a["gt_from_recon"])
-        csv_out = os.path.join(work, "distances.csv")
-        ev.evaluate(sfmeval, ds, recon, t, os.path.join(work, "report.json"), csv_out=csv_out,
-                    gt=gt)
-        g = ev.points_in_gt(csv_out)
-        inv = np.linalg.inv(np.array(a["gt_from_recon"], float))
-        points = g @ inv[:3, :3].T + inv[:3, 3]
-        cameras_source = recon
-    obj = new_points_object(context, name, points, cameras_json)
+    a = ev.align(sfmeval, ds, points_ply, work, recon_cameras=cameras_json, gt=gt)
+    obj = new_points_object(context, name, plyio.read_vertices(points_ply), cameras_json)
+    obj[SOURCE] = points_ply
     set_gt_from_recon(obj, a["gt_from_recon"])
     obj["sfmeval_source"] = recon
-    return obj, cameras_source
+    return obj, cameras_json

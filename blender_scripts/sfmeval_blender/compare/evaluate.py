@@ -1,44 +1,22 @@
-"""The measurements, all through the ``sfmeval`` binary: alignment (``sfmeval align``, also ICP
-from a given start), evaluation of the points the user kept (``sfmeval eval --align given``
-with the object's matrix, the crop file, the run's model for the cameras), viridis colours with
-the CLI's clip rule, and Table I in the runner's format (native_runner/src/table/mod.rs)."""
+"""The measurements, all through the ``sfmeval`` binary: the reconstruction's own points and
+cameras (``sfmeval export``), alignment (``sfmeval align``, also ICP from a given start), the
+evaluation of the points the user kept (``sfmeval eval --align given`` with the object's matrix,
+the crop file and the cameras; the colours are the CLI's ``--colored`` PLY) and Table I
+(``sfmeval table``). Nothing here computes a number, a colour or a table of its own."""
 
 import csv
-import decimal
 import json
 import os
+import shlex
 import subprocess
 
 import numpy as np
 
-# crates/sfmeval/src/colormap.rs
-VIRIDIS = np.array([[68, 1, 84], [71, 44, 122], [59, 81, 139], [44, 113, 142], [33, 144, 141],
-                    [39, 173, 129], [92, 200, 99], [170, 220, 50], [253, 231, 37]], dtype=float)
+from . import plyio
 
-
-def viridis(t):
-    """Colours (N, 3) uint8 of t in [0, 1] (clamped, NaN → top), as colormap.rs computes them."""
-    t = np.asarray(t, dtype=float)
-    t = np.where(np.isnan(t), 1.0, np.clip(t, 0.0, 1.0))
-    x = t * (len(VIRIDIS) - 1)
-    i = np.minimum(np.floor(x).astype(int), len(VIRIDIS) - 2)
-    f = (x - i)[..., None]
-    c = VIRIDIS[i] + (VIRIDIS[i + 1] - VIRIDIS[i]) * f
-    # Rust's f64::round rounds half away from zero; the values are ≥ 0.
-    return np.floor(c + 0.5).astype(np.uint8)
-
-
-def distance_colors(d, clip):
-    """colormap.rs `distance_color`: viridis(d / clip), the top colour when clip ≤ 0."""
-    d = np.asarray(d, dtype=float)
-    if clip > 0:
-        return viridis(d / clip)
-    return viridis(np.ones_like(d))
-
-
-def color_clip(report):
-    """The CLI's default clip (`--color-clip`): the accuracy p95."""
-    return report["accuracy"]["percentiles"]["p95"]
+# Every sfmeval command the add-on ran, as a shell line (the panel copies them into the text
+# block "sfmeval commands": what a user types to get the same files).
+COMMANDS = []
 
 
 class CliError(RuntimeError):
@@ -46,6 +24,8 @@ class CliError(RuntimeError):
 
 
 def _run(argv, timeout=600):
+    argv = [str(a) for a in argv]
+    COMMANDS.append(" ".join(shlex.quote(a) for a in argv))
     proc = subprocess.run(argv, capture_output=True, text=True, timeout=timeout)
     if proc.returncode != 0:
         msg = (proc.stderr.strip() or proc.stdout.strip())[-800:]
@@ -53,13 +33,24 @@ def _run(argv, timeout=600):
     return proc
 
 
-def write_transform(path, m):
-    """A gt_from_recon file: 16 numbers, row-major, exact (as ``sfmeval align --out`` writes)."""
+def write_matrix_json(path, m):
+    """`m` (4×4) as ``{"gt_from_recon": [[...], ...]}``, the JSON form ``--transform`` reads
+    (Python's JSON numbers round-trip exactly)."""
     m = np.asarray(m, dtype=float).reshape(4, 4)
-    text = "# gt_from_recon (Blender object matrix)\n" + "".join(
-        " ".join("%.17e" % v for v in row) + "\n" for row in m)
     with open(path, "w") as f:
-        f.write(text)
+        json.dump({"gt_from_recon": m.tolist()}, f)
+        f.write("\n")
+
+
+def export(sfmeval, recon, out, recon_cameras=None):
+    """``sfmeval export``: the reconstruction's points (float64 PLY) and cameras (cameras.json)
+    in its own frame, into `out`. Returns (points.ply, cameras.json or None)."""
+    argv = [sfmeval, "export", recon, "--out", out]
+    if recon_cameras:
+        argv += ["--recon-cameras", recon_cameras]
+    _run(argv)
+    cams = os.path.join(out, "cameras.json")
+    return os.path.join(out, "points.ply"), (cams if os.path.isfile(cams) else None)
 
 
 def inputs(dataset, recon, recon_cameras=None, gt=None):
@@ -74,14 +65,15 @@ def inputs(dataset, recon, recon_cameras=None, gt=None):
 
 def align(sfmeval, dataset, recon, work, mode="auto", start=None, recon_cameras=None, gt=None):
     """``sfmeval align``: the alignment section (dict with gt_from_recon, method, scale, ...).
-    `start` (4×4) is the ICP start for mode "icp"."""
+    `start` (4×4) is the ICP start for mode "icp" (one call: the core's ICP runs to its fixed
+    point)."""
     os.makedirs(work, exist_ok=True)
     out = os.path.join(work, "alignment.json")
     argv = [sfmeval, "align"] + inputs(dataset, recon, recon_cameras, gt) + ["--align", mode,
                                                                             "--out", out]
     if start is not None:
-        tpath = os.path.join(work, "icp_start.txt")
-        write_transform(tpath, start)
+        tpath = os.path.join(work, "icp_start.json")
+        write_matrix_json(tpath, start)
         argv += ["--transform", tpath]
     _run(argv)
     with open(out) as f:
@@ -98,7 +90,7 @@ def rotation_scale_change(a, b):
 
 
 def eval_argv(sfmeval, dataset, points, transform, report, recon_cameras=None, crop=None,
-              csv_out=None, gt=None):
+              csv_out=None, gt=None, colored=None):
     """The ``sfmeval eval`` command of the panel's numbers (also what a user types to get them)."""
     argv = [sfmeval, "eval"] + inputs(dataset, points, recon_cameras, gt) + [
         "--align", "given", "--transform", transform, "--report", report, "--quiet"]
@@ -106,19 +98,26 @@ def eval_argv(sfmeval, dataset, points, transform, report, recon_cameras=None, c
         argv += ["--crop", crop]
     if csv_out:
         argv += ["--csv", csv_out]
+    if colored:
+        argv += ["--colored", colored]
     return argv
 
 
 def evaluate(sfmeval, dataset, points, transform, report, recon_cameras=None, crop=None,
-             csv_out=None, gt=None):
-    """Runs ``eval_argv``; returns (report dict, per-point distances, per-point status)."""
-    _run(eval_argv(sfmeval, dataset, points, transform, report, recon_cameras, crop, csv_out, gt))
+             csv_out=None, gt=None, colored=None):
+    """Runs ``eval_argv``; returns (report dict, per-point distances, per-point status, the
+    colours of the kept points in input order (N_kept, 3) uint8 from the ``--colored`` PLY)."""
+    _run(eval_argv(sfmeval, dataset, points, transform, report, recon_cameras, crop, csv_out,
+                   gt, colored))
     with open(report) as f:
         rep = json.load(f)
-    dist, status = None, None
+    dist, status, rgb = None, None, None
     if csv_out:
         dist, status = read_distances(csv_out)
-    return rep, dist, status
+    if colored:
+        cols = plyio.read_columns(colored)
+        rgb = np.stack([cols["red"], cols["green"], cols["blue"]], axis=1).astype(np.uint8)
+    return rep, dist, status, rgb
 
 
 def read_distances(path):
@@ -131,10 +130,20 @@ def read_distances(path):
     return np.array(d), s
 
 
-def points_in_gt(path):
-    """x, y, z (GT frame) of ``sfmeval eval --csv``."""
-    with open(path, newline="") as f:
-        return np.array([[float(r["x"]), float(r["y"]), float(r["z"])] for r in csv.DictReader(f)])
+def table(sfmeval, dataset_name, reports, failed, out):
+    """``sfmeval table`` of the reports ``[(pipeline, report path)]`` and the failed rows
+    ``[(pipeline, reason)]``, every table file written into `out`; returns (table1.md,
+    table1.csv) as the CLI wrote them (the runner's bytes)."""
+    argv = [sfmeval, "table"] + ["%s=%s" % (p, r) for p, r in reports]
+    for p, why in failed:
+        argv += ["--failed", "%s=%s" % (p, why or "failed")]
+    argv += ["--dataset", dataset_name, "--out", out]
+    _run(argv)
+    texts = []
+    for name in ("table1.md", "table1.csv"):
+        with open(os.path.join(out, name), encoding="utf-8", newline="") as f:
+            texts.append(f.read())
+    return tuple(texts)
 
 
 def _get(d, *keys):
@@ -155,9 +164,10 @@ def f_at(report, percent=1.0):
 
 
 def summary(report):
-    """The panel's row of a report (sfmeval.report/2): images registered / in the ground truth,
-    points kept (after the crop), accuracy statistics, completeness (mean GT → reconstruction
-    distance), F at 1 % of the diagonal, camera ATE (RMSE of the centres)."""
+    """The panel's numbers of a report (sfmeval.report/3), read from its fields: images
+    registered / in the ground truth, points kept (after the crop), accuracy statistics,
+    completeness (mean GT → reconstruction distance), F at 1 % of the diagonal, camera ATE (RMSE
+    of the centres), and the notes as the core typed them (code, level, message)."""
     acc = report.get("accuracy") or {}
     return {
         "registered": _get(report, "cameras", "registered"),
@@ -169,58 +179,16 @@ def summary(report):
         "completeness": _get(report, "completeness", "mean"),
         "f1": f_at(report, 1.0),
         "ate": _get(report, "cameras", "ate_rmse"),
+        "notes": notes(report),
     }
 
 
-def rust_num(x):
-    """A float as Rust's `{}` Display prints it (shortest round trip, never an exponent)."""
-    if x is None:
-        return ""
-    r = repr(float(x))
-    if "e" in r or "E" in r:
-        r = format(decimal.Decimal(r), "f")
-    if r.endswith(".0"):
-        r = r[:-2]
-    return r
+# The levels the panel shows (docs/notes.md: info or warning); info notes stay in the report.
+SHOWN_LEVELS = ("warning",)
 
 
-def _csv_field(s):
-    return '"%s"' % s.replace('"', '""') if any(c in s for c in ',"\n') else s
-
-
-def table_order(rows, builtin):
-    """The runner's column order (table/order.rs): the built-in pipelines in their order, then
-    the others by name."""
-    known = [r for b in builtin for r in rows if r[0] == b]
-    return known + sorted((r for r in rows if r[0] not in builtin), key=lambda r: r[0])
-
-
-def table1(dataset_name, rows, alignment="`auto` alignment"):
-    """(markdown, csv) of Table I for one dataset, byte-for-byte in the runner's format
-    (native_runner/src/table/mod.rs `write_tables`).
-
-    `rows`: [(pipeline, mean or None, points, status, reason)] in column order; `alignment`
-    names the alignment in the caption (the runner's: "`auto` alignment")."""
-    head = "| dataset |" + "".join(" %s |" % p for p, *_ in rows)
-    head += "\n|---|" + "---:|" * len(rows) + "\n"
-    cells = []
-    for _, mean, points, status, reason in rows:
-        if mean is not None:
-            cells.append("%.6f (%d)" % (mean, points))
-        else:
-            why = (reason or "").replace("|", " ").replace("\n", " ")
-            why = why if len(why) <= 120 else why[:120] + "…"
-            cells.append(why if why.startswith(status) else "%s: %s" % (status, why))
-    body = "| %s |" % dataset_name + "".join(" %s |" % c for c in cells) + "\n"
-    md = ("# Table I: mean distance to the ground truth (m) and number of points\n\nEach cell: "
-          "mean reconstruction → ground-truth distance in metres (after %s), and "
-          "in parentheses the number of points; failed runs show why.\n\n" % alignment
-          + head + body)
-    header = ["dataset"]
-    for p, *_ in rows:
-        header += ["%s.mean_m" % p, "%s.points" % p, "%s.status" % p]
-    rec = [dataset_name]
-    for _, mean, points, status, _ in rows:
-        rec += [rust_num(mean), str(points) if mean is not None else "", status]
-    csv_text = ",".join(map(_csv_field, header)) + "\n" + ",".join(map(_csv_field, rec)) + "\n"
-    return md, csv_text
+def notes(report):
+    """[{code, level, message}] of the report's notes whose level the panel shows, chosen by
+    the typed `level` (never by the message's text), in the report's order."""
+    return [{"code": n.get("code"), "level": n.get("level"), "message": n.get("message", "")}
+            for n in report.get("notes") or [] if n.get("level") in SHOWN_LEVELS]

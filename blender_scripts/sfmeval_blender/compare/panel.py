@@ -17,11 +17,13 @@ from . import evaluate as ev
 from . import run as runmod
 from . import tools
 from .blender import (align_item, crop_file, dataset_dir, gt_override, import_source,
-                      measure_item, require_dataset, work_dir)
+                      measure_item, require_dataset, show_ground_truth, work_dir)
 
 ADDON = __package__.split(".")[0]
 LOG_TEXT = "sfmeval runs"
 TABLE_TEXT = "sfmeval Table I"
+COMMANDS_TEXT = "sfmeval commands"
+CATEGORY = "sfmeval compare"  # its own sidebar tab
 _STATE = {"cancel": False, "running": False}
 
 
@@ -84,6 +86,8 @@ class SFMEVAL_PG_compare(bpy.types.PropertyGroup):
         ("known", "Known", "the dataset's cameras.json")])
     message: StringProperty(default="")
     recons: CollectionProperty(type=SFMEVAL_PG_recon)
+    active_recon: IntProperty(name="Reconstruction", default=0,
+                              description="The reconstruction Automatic and Refine align")
     import_path: StringProperty(name="File", subtype="FILE_PATH",
                                 description="PLY, COLMAP folder/text/binary, NVM, Bundler .out, "
                                             "OpenMVG sfm_data.json")
@@ -114,6 +118,21 @@ def _text(name, clear=False):
     if clear:
         t.clear()
     return t
+
+
+def _log_commands():
+    """The sfmeval commands run since the last call, appended to the text block "sfmeval
+    commands" (what a user types to get the same files)."""
+    if ev.COMMANDS:
+        t = _text(COMMANDS_TEXT)
+        for line in ev.COMMANDS:
+            t.write("$ %s\n" % line)
+        del ev.COMMANDS[:]
+
+
+def _redraw(context):
+    for area in (context.screen.areas if getattr(context, "screen", None) else ()):
+        area.tag_redraw()
 
 
 class SFMEVAL_OT_compare_pipelines(bpy.types.Operator):
@@ -272,7 +291,9 @@ class SFMEVAL_OT_compare_import_runs(bpy.types.Operator):
         if not os.path.isdir(base):
             return _fail(self, context, "no runs in %s: run pipelines first" % base)
         c.message = ""
-        for name in sorted(os.listdir(base)):
+        show_ground_truth(context, ds)
+        todo = []
+        for name in sorted(os.listdir(base)):  # every row listed first, then imported
             folder = os.path.join(base, name)
             if not os.path.isfile(os.path.join(folder, "run.json")):
                 continue
@@ -282,7 +303,16 @@ class SFMEVAL_OT_compare_import_runs(bpy.types.Operator):
             if status != "ok":
                 item.status, item.message = status, reason or status
                 continue
-            _import(context, sfmeval, item, folder, run_dir=folder)
+            item.status = "importing"
+            todo.append((name, folder))
+        _redraw(context)
+        for name, folder in todo:
+            _import(context, sfmeval, c.recons[name], folder, run_dir=folder)
+        active = c.recons[c.active_recon] if 0 <= c.active_recon < len(c.recons) else None
+        if active is None or active.object is None:  # select the first imported row
+            c.active_recon = next((i for i, r in enumerate(c.recons) if r.object), 0)
+        _log_commands()
+        _redraw(context)
         return {"FINISHED"}
 
 
@@ -311,9 +341,14 @@ class SFMEVAL_OT_compare_import_file(bpy.types.Operator):
         name = os.path.splitext(os.path.basename(path))[0] or "recon"
         if os.path.isdir(path):  # run/model, sparse/0: the parent names it
             name = "%s-%s" % (os.path.basename(os.path.dirname(path)), name)
+        c.message = ""
+        show_ground_truth(context, dataset_dir(context))
         item = _row(context, name)
         item.source = path
         _import(context, sfmeval, item, path)
+        c.active_recon = c.recons.find(name)
+        _log_commands()
+        _redraw(context)
         return {"FINISHED"}
 
 
@@ -325,6 +360,7 @@ class SFMEVAL_OT_compare_add_crop(bpy.types.Operator):
 
     def execute(self, context):
         c = context.scene.sfmeval_compare
+        c.message = ""
         obj = bpy.data.objects.new("sfmeval crop", None)
         obj.empty_display_type = self.kind
         obj.empty_display_size = 1.0
@@ -333,30 +369,31 @@ class SFMEVAL_OT_compare_add_crop(bpy.types.Operator):
         return {"FINISHED"}
 
 
-def _items(context, index):
-    c = context.scene.sfmeval_compare
-    return [r for i, r in enumerate(c.recons) if (index < 0 or i == index) and r.object]
-
-
 class SFMEVAL_OT_compare_align(bpy.types.Operator):
-    """Align the kept points: automatic (cameras or global, then ICP), or Refine: ICP from
-    where the object is now"""
+    """Align the selected reconstruction's kept points: automatic (cameras or global, then
+    ICP), or Refine: one ICP from where the object is now, run by the core to its fixed point"""
     bl_idname = "sfmeval.compare_align"
     bl_label = "Align"
     mode: EnumProperty(items=[("auto", "Automatic", ""), ("icp", "Refine (ICP)", "")])
-    index: IntProperty(default=-1)
+    index: IntProperty(default=-1, description="The row to align (-1: the panel's selected one)")
 
     def execute(self, context):
+        c = context.scene.sfmeval_compare
+        c.message = ""
         try:
             sfmeval = find_tool(context, "sfmeval")
         except tools.ToolMissing as exc:
             return _fail(self, context, str(exc))
-        for item in _items(context, self.index):
-            try:
-                align_item(context, sfmeval, item, self.mode)
-                item.status, item.message = "aligned (%s)" % self.mode, ""
-            except (ev.CliError, ValueError, OSError) as exc:
-                item.status, item.message = "failed", str(exc)
+        index = self.index if self.index >= 0 else c.active_recon
+        if not 0 <= index < len(c.recons) or c.recons[index].object is None:
+            return _fail(self, context, "select an imported reconstruction in the list first")
+        item = c.recons[index]
+        try:
+            align_item(context, sfmeval, item, self.mode)
+            item.status, item.message = "aligned (%s)" % self.mode, ""
+        except (ev.CliError, ValueError, OSError) as exc:
+            item.status, item.message = "failed", str(exc)
+        _log_commands()
         return {"FINISHED"}
 
 
@@ -376,36 +413,42 @@ class SFMEVAL_OT_compare_evaluate(bpy.types.Operator):
         except (tools.ToolMissing, ValueError) as exc:
             return _fail(self, context, str(exc))
         c.message = ""
-        rows = []
+        reports, failed = [], []
         for item in c.recons:
             if item.object is None:
-                rows.append((item.name, None, 0, item.status or "failed",
-                             item.message or "not imported"))
+                failed.append((item.name, item.message or item.status or "not imported"))
                 continue
             try:
-                rep = measure_item(context, sfmeval, item, crop=crop, gt=gt)
+                measure_item(context, sfmeval, item, crop=crop, gt=gt)
             except (ev.CliError, ValueError, OSError) as exc:
-                item.status, item.message = "failed", str(exc)
-                rows.append((item.name, None, 0, "failed", str(exc)))
+                item.status, item.message, item.summary = "failed", str(exc), ""
+                failed.append((item.name, str(exc)))
                 continue
-            s = ev.summary(rep)
-            item.summary, item.status, item.message = json.dumps(s), "ok", ""
-            item.report = os.path.join(work_dir(context, item.name), "report.json")
-            # Table I counts the points given to the evaluation, as the runner's does
-            rows.append((item.name, s["mean"], s["input_points"] or 0, "ok", ""))
-        rows = ev.table_order(rows, [p.name for p in c.pipelines])
-        md, csv_text = ev.table1(os.path.basename(ds), rows,
-                                 alignment="the alignment of each object in Blender")
-        out = work_dir(context)
-        os.makedirs(out, exist_ok=True)
-        for name, text in (("table1.md", md), ("table1.csv", csv_text)):
-            with open(os.path.join(out, name), "w", encoding="utf-8", newline="") as f:
-                f.write(text)
-        _text(TABLE_TEXT, clear=True).write(md + "\n" + csv_text)
+            load_report(item, os.path.join(work_dir(context, item.name), "report.json"))
+            reports.append((item.name, item.report))
+        if reports:
+            try:
+                md, csv_text = ev.table(sfmeval, os.path.basename(ds), reports, failed,
+                                        work_dir(context))
+                _text(TABLE_TEXT, clear=True).write(md + "\n" + csv_text)
+            except (ev.CliError, OSError) as exc:
+                c.message = "Table I: %s" % exc
+        _log_commands()
+        _redraw(context)
         return {"FINISHED"}
 
 
+def load_report(item, path):
+    """Shows the report at `path` in the row `item`: its numbers and its warnings (by level),
+    read from the report's fields."""
+    with open(path) as f:
+        rep = json.load(f)
+    item.summary, item.status, item.message = json.dumps(ev.summary(rep)), "ok", ""
+    item.report = path
+
+
 def _fmt(v, digits=4):
+    """A number for a narrow sidebar: 4 significant digits (0.003172, 1.2e-05), an integer as is."""
     if v is None:
         return "—"
     if isinstance(v, float):
@@ -413,17 +456,48 @@ def _fmt(v, digits=4):
     return str(v)
 
 
+def _value_rows(col, pairs):
+    """One row per value, the name left and the number right (readable at the sidebar's
+    default width, where "mean 0.003172  median 0.002811" is cut)."""
+    for name, value in pairs:
+        row = col.row(align=True)
+        row.label(text=name)
+        row.label(text=value)
+
+
+LEVEL_ICONS = {"warning": "ERROR", "info": "INFO"}
+
+
+class SFMEVAL_UL_recons(bpy.types.UIList):
+    """The imported reconstructions: the selected one is what Automatic and Refine align."""
+    bl_idname = "SFMEVAL_UL_recons"
+
+    def draw_item(self, context, layout, data, item, icon, active_data, active_propname,
+                  index=0):
+        row = layout.row()
+        row.label(text=item.name, icon="OUTLINER_OB_POINTCLOUD" if item.object else "CANCEL")
+        row.label(text=item.status or "")
+
+
 class SFMEVAL_PT_compare(bpy.types.Panel):
     bl_label = "Compare pipelines"
     bl_idname = "SFMEVAL_PT_compare"
     bl_space_type = "VIEW_3D"
     bl_region_type = "UI"
-    bl_category = "sfmeval"
+    bl_category = CATEGORY
 
     def draw(self, context):
         c = context.scene.sfmeval_compare
         lay = self.layout
         lay.prop(c, "dataset_dir")
+        if not c.dataset_dir:
+            d = dataset_dir(context)
+            if not d or not os.path.isfile(os.path.join(d, "cameras.json")):
+                lay.label(text="Choose a dataset folder (one with cameras.json and "
+                               "ground_truth.glb)", icon="INFO")
+                lay.label(text="or make one with steps 1–6 (into the output folder)")
+            else:
+                lay.label(text="Using the generator's output: %s" % d, icon="INFO")
         lay.prop(c, "runs_dir")
         for name in ("sfmeval", "sfmeval-runner"):
             try:
@@ -457,6 +531,11 @@ class SFMEVAL_PT_compare(bpy.types.Panel):
         row = box.row()
         row.prop(c, "import_path")
         row.operator("sfmeval.compare_import_file", text="Import")
+        if len(c.recons):
+            box.template_list("SFMEVAL_UL_recons", "", c, "recons", c, "active_recon", rows=3)
+        for r in c.recons:
+            if r.message:
+                box.label(text="%s: %s" % (r.name, r.message[:200]), icon="ERROR")
         box = lay.box()
         box.label(text="9. Cut away (delete points in Edit Mode, or crop)")
         row = box.row()
@@ -467,39 +546,43 @@ class SFMEVAL_PT_compare(bpy.types.Panel):
         row.prop(c, "use_max_distance")
         row.prop(c, "max_distance")
         box = lay.box()
-        box.label(text="10. Align")
+        active = c.recons[c.active_recon] if 0 <= c.active_recon < len(c.recons) else None
+        box.label(text="10. Align %s" % (active.name if active else "(select a reconstruction)"))
         row = box.row()
-        row.operator("sfmeval.compare_align", text="Automatic").mode = "auto"
-        row.operator("sfmeval.compare_align", text="Refine (ICP)").mode = "icp"
+        row.enabled = active is not None and active.object is not None
+        op = row.operator("sfmeval.compare_align", text="Automatic")
+        op.mode, op.index = "auto", c.active_recon
+        op = row.operator("sfmeval.compare_align", text="Refine (ICP)")
+        op.mode, op.index = "icp", c.active_recon
         box = lay.box()
         box.label(text="11. Evaluate and compare")
         box.prop(c, "gt_source")
         if c.gt_source == "OBJECT":
             box.prop(c, "gt_object")
         box.operator("sfmeval.compare_evaluate")
-        # one small block per reconstruction (an 11-column grid does not fit the sidebar)
+        # one small block per reconstruction, one value a row (a grid does not fit the sidebar)
         for r in c.recons:
             s = json.loads(r.summary) if r.summary else {}
             if not s:
                 continue
             col = box.box().column(align=True)
             col.label(text=r.name)
-            col.label(text="%s/%s images, %s points" % (_fmt(s["registered"]), _fmt(s["images"]),
-                                                        _fmt(s["points"])))
-            col.label(text="min %s  max %s" % (_fmt(s["min"]), _fmt(s["max"])))
-            col.label(text="mean %s  median %s" % (_fmt(s["mean"]), _fmt(s["median"])))
-            col.label(text="std %s  compl. %s" % (_fmt(s["std"]), _fmt(s["completeness"])))
-            col.label(text="F@1%% %s  ATE %s" % (_fmt(s["f1"]), _fmt(s["ate"])))
-        for r in c.recons:
-            if r.message:
-                box.label(text="%s: %s" % (r.name, r.message[:200]), icon="ERROR")
+            _value_rows(col, [
+                ("images", "%s / %s" % (_fmt(s["registered"]), _fmt(s["images"]))),
+                ("points", _fmt(s["points"])),
+                ("min", _fmt(s["min"])), ("max", _fmt(s["max"])),
+                ("mean", _fmt(s["mean"])), ("median", _fmt(s["median"])),
+                ("std", _fmt(s["std"])), ("completeness", _fmt(s["completeness"])),
+                ("F@1%", _fmt(s["f1"])), ("ATE", _fmt(s["ate"]))])
+            for n in s.get("notes", []):
+                col.label(text=n["message"], icon=LEVEL_ICONS.get(n["level"], "ERROR"))
 
 
 CLASSES = (SFMEVAL_AP_preferences, SFMEVAL_PG_pipeline, SFMEVAL_PG_recon, SFMEVAL_PG_compare,
            SFMEVAL_OT_compare_pipelines, SFMEVAL_OT_compare_run, SFMEVAL_OT_compare_cancel,
            SFMEVAL_OT_compare_import_runs, SFMEVAL_OT_compare_import_file,
            SFMEVAL_OT_compare_add_crop, SFMEVAL_OT_compare_align, SFMEVAL_OT_compare_evaluate,
-           SFMEVAL_PT_compare)
+           SFMEVAL_UL_recons, SFMEVAL_PT_compare)
 
 
 def register():

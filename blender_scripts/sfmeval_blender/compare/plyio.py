@@ -1,5 +1,6 @@
-"""PLY vertices in and out (numpy): read x, y, z of any ASCII or binary PLY (the runner's
-``sparse.ply``, a tool's export), write points as a binary little-endian PLY the CLI reads."""
+"""PLY vertices in and out (numpy): read the vertex properties of any ASCII or binary PLY
+(``sfmeval export``'s points, ``sfmeval eval --colored``'s colours), write the points the user
+kept (float64 rows of the exported source) as a binary little-endian PLY the CLI reads."""
 
 import numpy as np
 
@@ -10,6 +11,13 @@ _TYPES = {"char": "i1", "int8": "i1", "uchar": "u1", "uint8": "u1", "short": "i2
 
 def read_vertices(path):
     """(N, 3) float64 vertex positions of the PLY at `path`; ValueError naming the file."""
+    cols = read_columns(path)
+    return np.stack([cols["x"], cols["y"], cols["z"]], axis=1)
+
+
+def read_columns(path):
+    """{property: (N,) float64} of the vertices of the PLY at `path` (x, y, z required);
+    ValueError naming the file."""
     with open(path, "rb") as f:
         data = f.read()
     end = data.find(b"end_header")
@@ -53,7 +61,7 @@ def read_vertices(path):
             raise ValueError("unknown PLY format %r" % fmt)
     except ValueError as exc:
         raise ValueError("%s: truncated or malformed PLY body (%s)" % (path, exc))
-    return np.stack([cols["x"], cols["y"], cols["z"]], axis=1)
+    return cols
 
 
 def write_points(path, points):

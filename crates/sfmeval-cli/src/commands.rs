@@ -46,9 +46,13 @@ enum Command {
         /// else 16 numbers as text).
         #[arg(long, value_name = "FILE")]
         out: Option<PathBuf>,
-        /// Seed of the randomised stages.
+        /// Seed of the randomised stages and of the surface sampler.
         #[arg(long, value_name = "S", default_value_t = 0)]
         seed: u64,
+        /// Ground-truth surface samples the `global` search measures against (as `eval
+        /// --samples`: with the same value and seed, `align` finds `eval`'s alignment).
+        #[arg(long, value_name = "N", default_value_t = DEFAULT_SAMPLES)]
+        samples: usize,
     },
     /// Camera-pose errors of a reconstruction's cameras against the ground-truth cameras.
     Cameras {
@@ -86,6 +90,9 @@ enum Command {
     /// Table I and the comparison table of evaluation reports, as `sfmeval-runner report`
     /// writes them for its runs.
     Table(TableArgs),
+    /// Write a reconstruction's points (binary PLY, double x y z, with its colours) and its
+    /// cameras (cameras.json) in the reconstruction's own frame: any format --recon reads.
+    Export(ExportArgs),
     /// Evaluate the demo pair shipped with sfmeval and print the summary.
     Demo {
         /// Print the report JSON instead of the summary.
@@ -142,6 +149,22 @@ struct InputArgs {
     /// is expanded (checked before anything is allocated; raise it for a trusted large file).
     #[arg(long, value_name = "N", default_value_t = ReadLimits::DEFAULT_MAX_TRIANGLES)]
     max_triangles: u64,
+}
+
+/// The flags of `sfmeval export`.
+#[derive(Args, Debug)]
+struct ExportArgs {
+    /// The reconstruction: a PLY point cloud, a COLMAP model folder, an .nvm, a Bundler .out, an
+    /// OpenMVG sfm_data.json or a cameras.json (what `eval --recon` reads).
+    #[arg(value_name = "RECON")]
+    recon: PathBuf,
+    /// The SfM model whose cameras go with a PLY RECON (as `eval --recon-cameras`: the PLY's
+    /// points at the model's camera centres are removed).
+    #[arg(long, value_name = "PATH")]
+    recon_cameras: Option<PathBuf>,
+    /// The folder to write points.ply and cameras.json into (made when missing).
+    #[arg(long, value_name = "DIR")]
+    out: PathBuf,
 }
 
 #[derive(Args, Debug)]
@@ -241,7 +264,12 @@ pub fn run(cli: Cli) -> Result<()> {
             }
             eval(&args)
         }
-        Command::Align { input, out, seed } => align_cmd(&input, out.as_deref(), seed),
+        Command::Align {
+            input,
+            out,
+            seed,
+            samples,
+        } => align_cmd(&input, out.as_deref(), seed, samples),
         Command::Cameras {
             gt_cameras,
             recon,
@@ -262,6 +290,7 @@ pub fn run(cli: Cli) -> Result<()> {
         Command::Tnt(args) => tnt_cmd(&args),
         Command::Log(args) => log_cmd(&args),
         Command::Table(args) => table_cmd(&args),
+        Command::Export(args) => export_cmd(&args),
         Command::Demo { json, report } => demo(json, report.as_deref()),
     }
 }
@@ -389,14 +418,70 @@ fn run_error(e: sfmeval::Error, input: &InputArgs) -> anyhow::Error {
 /// in pieces, so a dense cloud is never in memory twice (file bytes and points).
 fn read_recon(input: &InputArgs) -> Result<ReconInput> {
     let name = input.name.clone().unwrap_or_else(|| name_of(&input.recon));
-    let Some(cameras_path) = &input.recon_cameras else {
-        return sfmeval_fs::read_reconstruction(&input.recon, &name);
+    read_recon_at(&input.recon, input.recon_cameras.as_deref(), &name)
+}
+
+/// Reads the reconstruction at `recon`, with the cameras of the model at `cameras_path`.
+fn read_recon_at(recon: &Path, cameras_path: Option<&Path>, name: &str) -> Result<ReconInput> {
+    let Some(cameras_path) = cameras_path else {
+        return sfmeval_fs::read_reconstruction(recon, name);
     };
-    let files = read_input_files(&input.recon)?;
+    let files = read_input_files(recon)?;
     let cameras = model::read_model_files(&read_input_files(cameras_path)?)
         .with_context(|| format!("reconstruction cameras '{}'", cameras_path.display()))?;
-    pipeline::read_reconstruction_with_cameras(&name, &files, cameras, &name_of(cameras_path))
-        .with_context(|| format!("reconstruction '{}'", input.recon.display()))
+    pipeline::read_reconstruction_with_cameras(name, &files, cameras, &name_of(cameras_path))
+        .with_context(|| format!("reconstruction '{}'", recon.display()))
+}
+
+/// `sfmeval export`: the points `eval` would evaluate (camera-centre points removed, in the
+/// file's order) as a float64 PLY, and the model's cameras as cameras.json, both in the
+/// reconstruction's frame. Without cameras, a cameras.json left in DIR by an earlier export is
+/// removed (the folder never mixes two reconstructions).
+fn export_cmd(args: &ExportArgs) -> Result<()> {
+    let recon = read_recon_at(
+        &args.recon,
+        args.recon_cameras.as_deref(),
+        &name_of(&args.recon),
+    )?;
+    std::fs::create_dir_all(&args.out)
+        .with_context(|| format!("creating the folder '{}'", args.out.display()))?;
+    let points = recon.cloud.points.as_f64();
+    let colors = recon.cloud.colors.as_deref();
+    write_atomic(
+        &args.out.join("points.ply"),
+        &export::points_ply_f64(&points, colors),
+    )?;
+    let cameras_path = args.out.join("cameras.json");
+    let images = match &recon.model {
+        Some(m) => {
+            let text = model::cameras_json::write_cameras_json(m, "reconstruction");
+            write_atomic(&cameras_path, text.as_bytes())?;
+            Some(m.images.len())
+        }
+        None => {
+            if cameras_path.exists() {
+                std::fs::remove_file(&cameras_path)
+                    .with_context(|| format!("removing the stale '{}'", cameras_path.display()))?;
+            }
+            None
+        }
+    };
+    for n in &recon.notes {
+        eprintln!("{}: {}", n.level.as_str(), n.message);
+    }
+    println!(
+        "{}: {} points{}, {} -> {}",
+        args.recon.display(),
+        points.len(),
+        if colors.is_some() {
+            " with colours"
+        } else {
+            ""
+        },
+        images.map_or("no cameras".to_string(), |n| format!("{n} images")),
+        args.out.display()
+    );
+    Ok(())
 }
 
 /// The ground truth (as [`dataset_paths`] finds it) and the reconstruction, read at the same
@@ -461,11 +546,13 @@ fn eval(args: &EvalArgs) -> Result<()> {
     Ok(())
 }
 
-fn align_cmd(input: &InputArgs, out: Option<&Path>, seed: u64) -> Result<()> {
+fn align_cmd(input: &InputArgs, out: Option<&Path>, seed: u64, samples: usize) -> Result<()> {
+    // The ground truth is sampled as `eval` samples it: the global search measures against
+    // those samples (one sample, as this once drew, is a ground truth of zero extent).
     let request = EvalRequest {
         align: align_request(input)?,
         eval: EvalOptions {
-            samples: 1,
+            samples,
             seed,
             ..EvalOptions::default()
         },

@@ -130,3 +130,77 @@ pub fn points_ply(points: &[[f64; 3]], colors: Option<&[[u8; 3]]>) -> Vec<u8> {
     }
     out
 }
+
+/// A binary little-endian PLY of points with `double` x, y, z (exact: every `f64` as it is),
+/// and `uchar` red, green, blue only when `colors` is given (one per point); what `sfmeval
+/// export` writes, so a front end evaluates the reconstruction's own positions, not a `float`
+/// copy of them.
+pub fn points_ply_f64(points: &[[f64; 3]], colors: Option<&[[u8; 3]]>) -> Vec<u8> {
+    let colors = colors.filter(|c| c.len() == points.len());
+    let mut out = format!(
+        "ply\nformat binary_little_endian 1.0\ncomment written by sfmeval {}\nelement vertex {}\nproperty double x\nproperty double y\nproperty double z\n{}end_header\n",
+        env!("CARGO_PKG_VERSION"),
+        points.len(),
+        if colors.is_some() {
+            "property uchar red\nproperty uchar green\nproperty uchar blue\n"
+        } else {
+            ""
+        }
+    )
+    .into_bytes();
+    out.reserve(points.len() * if colors.is_some() { 27 } else { 24 });
+    for (i, p) in points.iter().enumerate() {
+        for v in p {
+            out.extend_from_slice(&v.to_le_bytes());
+        }
+        if let Some(c) = colors.and_then(|c| c.get(i)) {
+            out.extend_from_slice(c);
+        }
+    }
+    out
+}
+
+#[cfg(test)]
+#[allow(clippy::unwrap_used)]
+mod tests {
+    use super::points_ply_f64;
+    use crate::io::ply::read_ply;
+
+    #[test]
+    fn points_ply_f64_keeps_every_bit_and_the_colours() {
+        let points = [
+            [0.1, -2.5e-9, 1.0 / 3.0],
+            [1.234_567_890_123_456_7e40, 7.0, -0.0],
+        ];
+        let colors = [[1u8, 2, 3], [250, 251, 252]];
+        for with in [false, true] {
+            let bytes = points_ply_f64(&points, with.then_some(&colors[..]));
+            let ply = read_ply(&bytes).unwrap();
+            let props: Vec<&str> = ply.vertex_properties.iter().map(String::as_str).collect();
+            let want: &[&str] = if with {
+                &["x", "y", "z", "red", "green", "blue"]
+            } else {
+                &["x", "y", "z"]
+            };
+            assert_eq!(props, want);
+            let header_end = bytes
+                .windows(11)
+                .position(|w| w == b"end_header\n")
+                .unwrap()
+                + 11;
+            let stride = if with { 27 } else { 24 };
+            assert_eq!(bytes.len(), header_end + 2 * stride);
+            for (i, p) in points.iter().enumerate() {
+                for (k, v) in p.iter().enumerate() {
+                    let at = header_end + i * stride + 8 * k;
+                    let got = f64::from_le_bytes(bytes[at..at + 8].try_into().unwrap());
+                    assert_eq!(got.to_bits(), v.to_bits());
+                }
+                if with {
+                    let at = header_end + i * stride + 24;
+                    assert_eq!(&bytes[at..at + 3], &colors[i]);
+                }
+            }
+        }
+    }
+}
