@@ -7,9 +7,8 @@
 import uPlot from 'uplot';
 import { Viewer } from './viewer.js';
 import { dropZone, entryFiles } from './files.js';
-
-const $ = (id) => document.getElementById(id);
-const esc = (s) => String(s).replace(/[&<>"]/g, (c) => ({ '&': '&amp;', '<': '&lt;', '>': '&gt;', '"': '&quot;' }[c]));
+import { $, esc } from './util.js';
+import { MSG } from './core.js';
 
 /** Files the runner evaluates in a run folder: `model/` (else `sparse.ply`). */
 const MODEL_EXT = /\.(bin|txt|nvm|out|json|ply)$/i;
@@ -184,7 +183,7 @@ export function setupCompare({ call, viewer, measureOptions, showError, download
           try { run = JSON.parse(runText); } catch (err) { throw new Error(`${it.path}run.json: ${err.message}`); }
         }
         if (run && run.status !== 'ok') {
-          const { row } = await call('runRowOnly', { runJson: runText });
+          const { row } = await call(MSG.runRowOnly, { runJson: runText });
           entries.push({ row, report: null, path: it.path });
           continue;
         }
@@ -194,7 +193,7 @@ export function setupCompare({ call, viewer, measureOptions, showError, download
         const recName = run ? `${run.dataset}/${run.pipeline}` : it.pipeline;
         try {
           if (!transfer.length) throw new Error('no model files (model/ or sparse.ply)');
-          const r = await call('compareRun', { files, name: recName, runJson: runText, dataset: name, options }, transfer);
+          const r = await call(MSG.compareRun, { files, name: recName, runJson: runText, dataset: name, options }, transfer);
           entries.push({ ...r, report: JSON.parse(r.reportJson), path: it.path });
         } catch (err) {
           if (err.name === 'Cancelled') throw err;
@@ -204,12 +203,12 @@ export function setupCompare({ call, viewer, measureOptions, showError, download
             dataset: name, pipeline: it.pipeline, tool: 'file', version: null, status: 'failed', reason: null,
             wall_seconds: 0, cpu_seconds: 0, peak_memory_bytes: 0, images_total: 0, images_registered: 0, points: 0,
           });
-          const { row } = await call('runRowOnly', { runJson: record });
+          const { row } = await call(MSG.runRowOnly, { runJson: record });
           entries.push({ row: { ...row, status: 'evaluation failed', reason: err.message }, report: null, path: it.path });
         }
       }
       state.entries = entries;
-      const { tables } = await call('comparisonTables', { rows: entries.map((e) => e.row) });
+      const { tables } = await call(MSG.comparisonTables, { rows: entries.map((e) => e.row) });
       state.tables = tables;
       render();
       $('compare-status').textContent = `compared ${entries.length} reconstruction${entries.length === 1 ? '' : 's'}${problems.length ? ` (${problems.length} could not be evaluated)` : ''}`;
