@@ -13,12 +13,18 @@ import { MSG } from './core.js';
 /** Files the runner evaluates in a run folder: `model/` (else `sparse.ply`). */
 const MODEL_EXT = /\.(bin|txt|nvm|out|json|ply)$/i;
 
+/** A COLMAP model's files: together they are one model (as the Reconstruction input reads them). */
+const COLMAP_FILE = /^(cameras|images|points3D|rigs|frames)\.(txt|bin)$/i;
+
 /**
  * Groups picked or dropped files (with `webkitRelativePath`-like names) into the items to
- * compare: `{name, dataset, runJson (File|null), files: {relName: File}}`. A folder holding
+ * compare: `{pipeline, runJson (File|null), files: {relName: File}, path}`. A folder holding
  * `run.json` files is a runs folder: each run folder is one item named by its pipeline, with
- * its `model/` files (or `sparse.ply`); otherwise each top-level model folder is one item, and
- * each loose file (no folder) is one item named by the file.
+ * its `model/` files (or `sparse.ply`). Otherwise each folder's COLMAP files
+ * (cameras/images/points3D .txt or .bin) are one model named by that folder (`model` for loose
+ * files, as the Reconstruction input names them), and every other model file (PLY, NVM, Bundler
+ * .out, sfm_data.json) is one item named by the file; a name that repeats is prefixed by the
+ * file's own folder.
  */
 export function groupItems(fileList) {
   const files = Array.from(fileList).map((f) => ({ f, path: (f.webkitRelativePath || f.name).replace(/^\/+/, '') }));
@@ -41,19 +47,38 @@ export function groupItems(fileList) {
       items.push({ pipeline: parts[parts.length - 1], runJson: r.f, files: model, path: dir });
     }
   } else {
+    // by each file's own folder ('' for loose files)
     const byFolder = new Map();
     for (const x of files) {
-      const parts = x.path.split('/');
-      if (parts.length === 1) { items.push({ pipeline: x.f.name, runJson: null, files: { [x.f.name]: x.f }, path: x.path }); continue; }
-      // a picked folder: its sub-folders are the models (or the folder itself is one model)
-      const key = parts.length > 2 ? parts.slice(0, 2).join('/') : parts[0];
-      if (!byFolder.has(key)) byFolder.set(key, {});
-      byFolder.get(key)[parts.slice(key.split('/').length).join('/')] = x.f;
+      const cut = x.path.lastIndexOf('/');
+      const dir = cut < 0 ? '' : x.path.slice(0, cut);
+      const name = x.path.slice(cut + 1);
+      if (!MODEL_EXT.test(name)) continue;
+      if (!byFolder.has(dir)) byFolder.set(dir, []);
+      byFolder.get(dir).push({ name, f: x.f });
     }
-    for (const [key, map] of byFolder) {
-      const m = Object.fromEntries(Object.entries(map).filter(([n]) => MODEL_EXT.test(n)));
-      if (Object.keys(m).length) items.push({ pipeline: key.split('/').pop(), runJson: null, files: m, path: `${key}/` });
+    for (const [dir, list] of byFolder) {
+      // COLMAP's sub-models sit in numbered folders (sparse/0): those keep their parent's name
+      const parts = dir ? dir.split('/') : [];
+      const folderName = parts.length > 1 && /^\d+$/.test(parts[parts.length - 1]) ? parts.slice(-2).join('/') : parts.pop() || '';
+      const colmap = list.filter((x) => COLMAP_FILE.test(x.name));
+      if (colmap.length) {
+        items.push({ pipeline: folderName || 'model', folder: dir, runJson: null, files: Object.fromEntries(colmap.map((x) => [x.name, x.f])), path: dir ? `${dir}/` : 'model/' });
+      }
+      for (const x of list.filter((y) => !COLMAP_FILE.test(y.name))) {
+        items.push({ pipeline: x.name, folder: dir, runJson: null, files: { [x.name]: x.f }, path: dir ? `${dir}/${x.name}` : x.name });
+      }
     }
+    // a name that repeats (two folders' sfm_data.json, two folders called sparse) gets its folder
+    const count = new Map();
+    for (const it of items) count.set(it.pipeline, (count.get(it.pipeline) || 0) + 1);
+    for (const it of items) {
+      if (count.get(it.pipeline) > 1 && it.folder) {
+        const parts = it.folder.split('/');
+        it.pipeline = it.files[it.pipeline] ? `${parts[parts.length - 1]}/${it.pipeline}` : parts.slice(-2).join('/');
+      }
+    }
+    for (const it of items) delete it.folder;
   }
   items.sort((a, b) => (a.path < b.path ? -1 : a.path > b.path ? 1 : 0));
   return items;
