@@ -6,7 +6,7 @@
 import { $, numList, download, matrixText, alignedTransform } from './util.js';
 import { call, MSG, Cancelled, initCore, onWorkerEvents, pollSharedProgress, restartWorker } from './core.js';
 import { state, viewer } from './state.js';
-import { showError, setRunNote, updateRunButton, showProgress, hideProgress, markStale } from './ui.js';
+import { showError, setRunNote, updateRunButton, showProgress, hideProgress, markStale, showView } from './ui.js';
 import { reloadInputs } from './inputs.js';
 import { alignMethod, refreshPoints } from './points.js';
 import { currentCrop, cropText } from './crop.js';
@@ -131,6 +131,7 @@ updateRunButton();
 const compare = setupCompare({
   call, viewer, measureOptions: options, showError, download,
   gtName: () => (state.gt ? state.gt.name : null),
+  showComparison: () => showView('comparison'),
   setRunning: (b) => {
     if (b && (state.running || state.restoring)) return false;
     state.running = b;

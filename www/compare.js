@@ -154,9 +154,10 @@ function curves(el, entries) {
  * Sets up the compare section. `call` talks to the worker, `viewer` is the page's viewer,
  * `options()` the Measure section's options, `showError(msg, target)` the banner and
  * `download(name, data, type)` saves a file, `setRunning(b)` tells the page a compare is under way
- * (progress bar and Cancel in the action bar) and returns false when another run already is.
+ * (progress bar and Cancel in the action bar) and returns false when another run already is,
+ * `showComparison()` turns the results pane to the comparison.
  */
-export function setupCompare({ call, viewer, measureOptions, showError, download, gtName, setRunning }) {
+export function setupCompare({ call, viewer, measureOptions, showError, download, gtName, setRunning, showComparison }) {
   const state = { items: [], entries: [], sort: null, tables: null, viewer2: null };
   const info = $('info-runs');
   const setItems = (items) => {
@@ -236,6 +237,8 @@ export function setupCompare({ call, viewer, measureOptions, showError, download
       const { tables } = await call(MSG.comparisonTables, { rows: entries.map((e) => e.row) });
       state.tables = tables;
       render();
+      // the results pane now shows the comparison, its table at the top (in view)
+      showComparison();
       $('compare-status').textContent = `compared ${entries.length} reconstruction${entries.length === 1 ? '' : 's'}${problems.length ? ` (${problems.length} could not be evaluated)` : ''}`;
       if (problems.length) {
         showError(`compare: ${problems.length} of ${entries.length} could not be evaluated (marked "evaluation failed" in the table): ${problems.join('; ')}`, 'file-runs');

@@ -3,7 +3,7 @@
 import { $, esc, g, numList, download, matrixText } from './util.js';
 import { call, MSG } from './core.js';
 import { state } from './state.js';
-import { clearStale } from './ui.js';
+import { clearStale, showView } from './ui.js';
 import { refreshPoints } from './points.js';
 import { reportNotes, notesHtml } from './notes.js';
 import { histogramPlot, curvesPlot, VIRIDIS } from './plots.js';
@@ -73,6 +73,7 @@ export function showResults(r) {
   state.curves = curvesPlot($('pr'), r);
   updateTau();
   drawColorbar(r.clip);
+  showView('evaluation');
 }
 
 // share strictly below tau in a sorted array (the core's share_below)

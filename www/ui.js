@@ -81,3 +81,20 @@ export function clearStale() {
   $('clip').disabled = false;
   delete document.body.dataset.stale;
 }
+
+/**
+ * Which results the pane shows: 'evaluation' (the last evaluation's) or 'comparison' (section 5's
+ * table); tabs above switch when there are both. Scrolled to the top, so that what was chosen
+ * starts in view.
+ */
+export function showView(which) {
+  const res = $('results');
+  res.dataset.view = which;
+  const hasComparison = !$('compare-results').hidden;
+  $('results-tabs').hidden = !(state.shownResult && hasComparison);
+  $('tab-evaluation').setAttribute('aria-pressed', String(which === 'evaluation'));
+  $('tab-comparison').setAttribute('aria-pressed', String(which === 'comparison'));
+  res.scrollTop = 0;
+}
+$('tab-evaluation').onclick = () => showView('evaluation');
+$('tab-comparison').onclick = () => showView('comparison');

@@ -337,6 +337,52 @@ try {
     check(`compare-picked-report-${name}-equals-cli`, json === want, json ? firstDiff(json, want) : 'no report');
   }
 
+  // 13. after Compare the comparison is in view, at 1366×768 and at 1920×1080: the results pane
+  //     shows it (not the previous evaluation, whose "Out of date" note is there to cover it), the
+  //     table's header and first row inside the window and the pane, nothing drawn over them
+  await page.setInputFiles('#file-recon', join(root, 'data/demo/sparse.ply'));
+  await page.waitForFunction(() => /sparse\.ply/.test(document.getElementById('info-recon').textContent));
+  for (const [w, h] of [[1366, 768], [1920, 1080]]) {
+    await page.setViewportSize({ width: w, height: h });
+    const evaluated = Number(await page.evaluate(() => document.body.dataset.evaluated || 0));
+    await page.click('#run');
+    await page.waitForFunction((n) => Number(document.body.dataset.evaluated || 0) > n, evaluated, { timeout: 300000 });
+    // an input changes: the evaluation goes out of date under its sticky note, then Compare
+    await page.setInputFiles('#file-recon', join(root, 'data/demo/sparse.ply'));
+    await page.waitForFunction(() => !document.getElementById('stale-note').hidden);
+    await page.evaluate(() => { document.getElementById('results').scrollTop = 1e6; });
+    await page.setInputFiles('#file-runs', [join(root, 'data/demo/sparse.ply'), join(root, 'tests/fixtures/global/pycolmap_points3D.ply')]);
+    await compareAgain();
+    await page.waitForTimeout(200);
+    const seen = await page.evaluate(() => {
+      const inside = (r, box) => r.top >= box.top && r.bottom <= box.bottom && r.left >= box.left && r.right <= box.right;
+      const win = { top: 0, left: 0, bottom: innerHeight, right: innerWidth };
+      const pane = document.getElementById('results').getBoundingClientRect();
+      const uncovered = (el) => {
+        const r = el.getBoundingClientRect();
+        const hit = document.elementFromPoint(r.left + Math.min(20, r.width / 2), r.top + r.height / 2);
+        return !!hit && el.contains(hit);
+      };
+      const head = document.querySelector('#cmp-table thead tr') || document.querySelector('#cmp-table tr');
+      const first = document.querySelector('#cmp-table tbody tr');
+      const visible = (id) => { const el = document.getElementById(id); return !!el && el.getClientRects().length > 0; };
+      return {
+        firstRow: !!first && inside(first.getBoundingClientRect(), win) && inside(first.getBoundingClientRect(), pane),
+        firstRowUncovered: !!first && uncovered(first.querySelector('td')),
+        headerUncovered: !!head && inside(head.getBoundingClientRect(), pane) && uncovered(head.querySelector('th')),
+        summaryShown: visible('summary'), staleShown: visible('stale-note'),
+        tabs: visible('results-tabs'), top: first ? Math.round(first.getBoundingClientRect().top) : null,
+      };
+    });
+    check(`compare-in-view-${w}x${h}`, seen.firstRow && seen.firstRowUncovered && seen.headerUncovered && !seen.summaryShown && !seen.staleShown && seen.tabs, JSON.stringify(seen));
+    await page.screenshot({ path: join(out, `compare-in-view-${w}x${h}.png`) });
+    // the tab brings the evaluation back, and the comparison again
+    await page.click('#tab-evaluation');
+    const back = await page.evaluate(() => [document.getElementById('summary').getClientRects().length > 0, document.getElementById('compare-results').getClientRects().length > 0]);
+    await page.click('#tab-comparison');
+    check(`results-tabs-switch-${w}x${h}`, back[0] && !back[1], JSON.stringify(back));
+  }
+
   check('compare-no-request-leaves-origin', requests.every((u) => u.startsWith(origin) || u.startsWith('blob:') || u.startsWith('data:')), requests.filter((u) => !u.startsWith(origin)).join(' '));
   check('compare-no-console-errors', consoleErrors.length === 0, consoleErrors.join(' | '));
 } catch (e) {
