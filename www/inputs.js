@@ -5,7 +5,7 @@ import { call, MSG } from './core.js';
 import { state, sources, viewer } from './state.js';
 import { showError, markStale, setBusy, hideProgress } from './ui.js';
 import { refreshPoints, updatePairs } from './points.js';
-import { scheduleKept } from './crop.js';
+import { scheduleKept, currentCrop } from './crop.js';
 import { dropZone, entryFiles } from './files.js';
 
 /** Reads dropped/picked files; a picked folder's files are keyed relative to that folder. */
@@ -57,7 +57,53 @@ export function inputFailed(kind, e) {
   showError(msg, INPUT_CONTROLS[kind][0]);
 }
 
-async function loadGt(fileList) {
+/**
+ * Resets what belonged to the earlier files: the ground-truth cameras, depth maps and crop. Called
+ * when a ground truth replaces another (they described that one; cameras or depth maps loaded while
+ * no ground truth was loaded are kept for the new one) and when the user's own ground truth or
+ * reconstruction follows the demo (its cameras would otherwise align the user's images named like
+ * the demo's, 0000.jpg…, and give wrong numbers). Says what was reset in one line under the input
+ * `kind` (`data-reset` lists it: cameras, depth, crop) and returns that list.
+ */
+async function resetEarlier(kind, { afterDemo, hadGt = false }) {
+  const reset = [];
+  const earlier = (src) => src && ((afterDemo && src.demo) || src.gtGen > 0);
+  if (earlier(sources.cams)) {
+    await call(MSG.clearCameras);
+    reset.push(['cams', `the ground-truth cameras '${state.camerasName}'`]);
+    state.camerasName = null;
+    sources.cams = null;
+    setInputInfo('cams', '—');
+  }
+  if (earlier(sources.depth)) {
+    await call(MSG.clearDepth);
+    reset.push(['depth', `${state.depthCount} depth maps`]);
+    state.depthCount = 0;
+    sources.depth = null;
+    setInputInfo('depth', '—');
+  }
+  const crop = currentCrop();
+  if ((afterDemo || hadGt) && (crop.volume || crop.max_distance !== undefined)) {
+    viewer.setCropKind('none');
+    $('crop-kind').value = 'none';
+    $('max-distance').value = '';
+    reset.push(['crop', 'the crop']);
+  }
+  // what stays now belongs to the ground truth about to be loaded
+  for (const src of [sources.cams, sources.depth]) if (src) src.gtGen = 0;
+  if (reset.length) {
+    const words = reset.map(([, w]) => w);
+    const list = words.length > 1 ? `${words.slice(0, -1).join(', ')} and ${words[words.length - 1]}` : words[0];
+    const line = document.createElement('div');
+    line.className = 'info';
+    line.dataset.reset = reset.map(([k]) => k).join(',');
+    line.textContent = `reset: ${list}, which belonged to the ${afterDemo ? "demo's files" : 'earlier ground truth'}`;
+    $(`notes-${kind}`).appendChild(line);
+  }
+  return reset.map(([k]) => k);
+}
+
+async function loadGt(fileList, { demo = false } = {}) {
   showError('');
   setBusy(true);
   setInputInfo('gt', 'reading…');
@@ -65,6 +111,11 @@ async function loadGt(fileList) {
     const { files, transfer } = await readFiles(fileList);
     const maxTriangles = Number($('max-triangles').value) || undefined;
     const gt = await call(MSG.loadGt, { files, maxTriangles }, transfer);
+    const afterDemo = state.demoLoaded && !demo;
+    const hadGt = (state.gtGen || 0) > 0;
+    state.gtGen = (state.gtGen || 0) + 1;
+    state.demoLoaded = false;
+    state.gtFromDemo = demo;
     state.gt = gt;
     sources.gt = { files: Array.from(fileList) };
     state.beside = null;
@@ -72,6 +123,8 @@ async function loadGt(fileList) {
     viewer.setCoverage(null);
     viewer.setGroundTruth(gt.vertices, gt.triangles, gt.bounds);
     setInputInfo('gt', `${gt.name} (${gt.format}): ${gt.vertexCount} vertices, ${gt.triangleCount} triangles`, { notes: gt.warnings });
+    viewer.framedCameras = false;
+    await resetEarlier('gt', { afterDemo, hadGt });
     markStale(`the ground truth is now '${gt.name}'`);
     refreshPoints();
     return true;
@@ -88,7 +141,7 @@ async function loadGt(fileList) {
   } finally { setBusy(false); }
 }
 
-async function loadRecon(fileList, name) {
+async function loadRecon(fileList, name, { demo = false } = {}) {
   showError('');
   setBusy(true);
   setInputInfo('recon', 'reading…');
@@ -109,6 +162,8 @@ async function loadRecon(fileList, name) {
       if (!name) name = folder ?? (names.length === 1 ? names[0] : 'model');
       r = await call(MSG.loadRecon, { files, name }, transfer);
     }
+    const afterDemo = state.demoLoaded && !demo;
+    state.demoLoaded = false;
     state.recon = r;
     sources.recon = { files: Array.from(fileList), name };
     state.beside = null;
@@ -117,6 +172,7 @@ async function loadRecon(fileList, name) {
     state.pairs = [];
     updatePairs();
     setInputInfo('recon', `${r.name} (${r.format}): ${r.count} points${r.images ? `, ${r.images} images` : ''}`, { notes: r.warnings });
+    if (afterDemo) await resetEarlier('recon', { afterDemo });
     markStale(`the reconstruction is now '${r.name}'`);
     refreshPoints();
     return true;
@@ -137,14 +193,14 @@ async function loadRecon(fileList, name) {
   } finally { setBusy(false); }
 }
 
-async function loadCams(fileList) {
+async function loadCams(fileList, { demo = false } = {}) {
   showError('');
   setBusy(true);
   try {
     const { files, transfer } = await readFiles(fileList);
     const c = await call(MSG.loadCameras, { files }, transfer);
     state.camerasName = Object.keys(files)[0];
-    sources.cams = { files: Array.from(fileList) };
+    sources.cams = { files: Array.from(fileList), gtGen: loadedWith(), demo };
     setInputInfo('cams', `${state.camerasName}: ${c.images} images`);
     markStale(`the ground-truth cameras are now '${state.camerasName}'`);
     return true;
@@ -159,6 +215,13 @@ async function loadCams(fileList) {
   } finally { setBusy(false); }
 }
 
+/**
+ * The ground truth cameras or depth maps loaded now belong to (its load's number), 0 for none: a
+ * later ground truth resets them. Not the demo's ground truth once the user's own files follow it
+ * (they are loaded for the user's coming ground truth).
+ */
+const loadedWith = () => (state.gt && !(state.gtFromDemo && !state.demoLoaded) ? state.gtGen : 0);
+
 async function loadDepth(fileList) {
   showError('');
   const npy = Array.from(fileList).filter((f) => /\.npy$/i.test(f.name));
@@ -169,7 +232,7 @@ async function loadDepth(fileList) {
     const { files, transfer } = await readFiles(npy);
     const d = await call(MSG.loadDepth, { files }, transfer);
     state.depthCount = d.count;
-    sources.depth = { files: npy };
+    sources.depth = { files: npy, gtGen: loadedWith() };
     setInputInfo('depth', `${d.count} depth maps${d.checked ? '' : ' (checked against cameras.json when evaluating)'}`);
     markStale(`${d.count} depth maps were loaded`);
   } catch (e) {
@@ -249,12 +312,14 @@ $('demo').onclick = async () => {
     const gtFiles = await Promise.all([].concat(m.ground_truth).map(fetchFile));
     const reconFiles = await Promise.all([].concat(m.reconstruction).map(fetchFile));
     // stop at the first failure, so that its message stays in the banner
-    if (!await loadGt(gtFiles) || !await loadRecon(reconFiles, m.reconstruction_name)) return;
+    if (!await loadGt(gtFiles, { demo: true }) || !await loadRecon(reconFiles, m.reconstruction_name, { demo: true })) return;
     if (m.gt_cameras) {
-      if (!await loadCams([await fetchFile(m.gt_cameras)])) return;
+      if (!await loadCams([await fetchFile(m.gt_cameras)], { demo: true })) return;
     } else {
       await $('clear-cams').onclick();
     }
+    // the next ground truth or reconstruction of the user's own resets what came with the demo
+    state.demoLoaded = true;
     if (m.transform) {
       const t = await (await fetchFile(m.transform)).text();
       $('transform').value = alignedTransform(t);

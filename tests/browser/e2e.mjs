@@ -277,6 +277,44 @@ try {
   await page.check('#show-recon');
   await page.click('#clear-depth');
 
+  // 4c. the demo-cameras trap: after the demo, the user's own ground truth and a COLMAP model whose
+  // images are named like the demo's (0000.jpg…, here the demo's model with its names shifted, as
+  // another scene shot by our generator) must not be aligned with the demo's cameras: loading them
+  // resets the demo's cameras.json (said in one line) and the report equals the CLI's without
+  // cameras, byte for byte.
+  await page.click('#clear-cams');
+  await page.waitForFunction(() => document.getElementById('info-cams').textContent === '—');
+  await page.click('#demo');
+  await page.waitForFunction(() => /^cameras\.json: 36 images/.test(document.getElementById('info-cams').textContent) && window.sfmeval.state.demoLoaded);
+  const own = join(out, 'own');
+  mkdirSync(join(own, 'mine'), { recursive: true });
+  writeFileSync(join(own, 'my_ground_truth.glb'), readFileSync(demo('ground_truth.glb')));
+  for (const f of ['cameras.txt', 'points3D.txt']) writeFileSync(join(own, 'mine', f), readFileSync(demo(`sparse/${f}`)));
+  writeFileSync(join(own, 'mine', 'images.txt'), readFileSync(demo('sparse/images.txt'), 'utf8')
+    .replace(/ (\d{4})\.jpg$/gm, (_, n) => ` ${String((Number(n) + 7) % 36).padStart(4, '0')}.jpg`));
+  await page.setInputFiles('#file-gt', join(own, 'my_ground_truth.glb'));
+  await page.waitForFunction(() => /my_ground_truth/.test(document.getElementById('info-gt').textContent));
+  await page.setInputFiles('#dir-recon', join(own, 'mine'));
+  await page.waitForFunction(() => /^mine \(/.test(document.getElementById('info-recon').textContent));
+  const resetNote = await page.evaluate(() => {
+    const el = document.querySelector('#notes-gt [data-reset], #notes-recon [data-reset]');
+    return el ? { codes: el.dataset.reset, text: el.textContent, lines: el.getClientRects().length } : null;
+  });
+  check('own-files-after-demo-reset-cameras', resetNote && resetNote.codes.split(',').includes('cams') && /cameras\.json/.test(resetNote.text)
+    && (await page.textContent('#info-cams')) === '—', JSON.stringify({ resetNote, cams: await page.textContent('#info-cams') }));
+  await evaluateAndWait();
+  const ownPage = await downloadText('#dl-report');
+  execFileSync(cli, ['eval', '--gt', join(own, 'my_ground_truth.glb'), '--recon', join(own, 'mine'), '--quiet', '--report', join(out, 'cli-own.json')]);
+  const ownCli = readFileSync(join(out, 'cli-own.json'), 'utf8');
+  check('own-files-after-demo-equal-cli-without-cameras', noteSame('own-files-after-demo-equal-cli-without-cameras', ownPage.text, ownCli) && !JSON.parse(ownPage.text).cameras,
+    `page ${ownPage.path} vs cli-own.json: ${firstDiff(ownPage.text, ownCli)}`);
+  // the trap is real: the demo's cameras give other numbers on these files
+  execFileSync(cli, ['eval', '--gt', join(own, 'my_ground_truth.glb'), '--recon', join(own, 'mine'), '--gt-cameras', demo('cameras.json'), '--quiet', '--report', join(out, 'cli-own-demo-cams.json')]);
+  const trap = JSON.parse(readFileSync(join(out, 'cli-own-demo-cams.json'), 'utf8'));
+  const fOf = (r) => r.thresholds.map((t) => t.f_score.toFixed(4)).join(' ');
+  check('demo-cameras-would-give-other-numbers', fOf(trap) !== fOf(JSON.parse(ownCli)), `F with the demo's cameras ${fOf(trap)}, without ${fOf(JSON.parse(ownCli))}`);
+  console.log(`note: own files after the demo: F ${fOf(JSON.parse(ownCli))} (the demo's cameras would give ${fOf(trap)})`);
+
   // 5. a broken file gives a readable error
   await page.setInputFiles('#file-gt', { name: 'broken.glb', mimeType: 'model/gltf-binary', buffer: Buffer.from('glTF\x02\0\0\0\x40\0\0\0garbage') });
   await page.waitForFunction(() => document.getElementById('error').textContent.length > 0);
