@@ -57,6 +57,8 @@ async function runEvaluation() {
     refreshPoints();
     viewer.setCoverage(r.samplePoints, r.sampleLabels);
     drawCameras(viewer, r.cameras);
+    // the first evaluation with cameras frames them (they stand well outside the object)
+    if (r.cameras && r.cameras.gtPoses && !viewer.framedCameras) { viewer.fitCameras(); viewer.framedCameras = true; }
     showCameraScale(r.cameras);
     $('show-coverage').disabled = !r.sampleLabels;
     $('show-coverage').checked = !!r.sampleLabels;

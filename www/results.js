@@ -8,6 +8,8 @@ import { refreshPoints } from './points.js';
 import { reportNotes, notesHtml } from './notes.js';
 import { histogramPlot, curvesPlot, VIRIDIS } from './plots.js';
 
+/** The alignment stages (`alignment.stages[].method`) in words. */
+const STAGE_LABEL = { cameras: 'camera centres', points: 'point pairs', global: 'global search', icp: 'ICP', given: 'given', none: 'none' };
 function showStages(report) {
   const a = report.alignment;
   // a stage's warnings (by their `values.stage`) mark its row; a rejected refinement says so
@@ -16,7 +18,7 @@ function showStages(report) {
     const own = notes.filter((n) => n.stage === s.method && n.level === 'warn');
     const rejected = own.some((n) => n.code === 'alignment.icp_rejected');
     const mark = own.length ? ` <span class="warn" data-stage-warnings="${own.length}" title="${own.length} warning(s) below">⚠</span>` : '';
-    return `<tr><td>${esc(s.method)}${mark}</td><td>${g(s.scale)}</td><td>${s.rmse == null ? '—' : g(s.rmse)}</td><td>${s.inlier_ratio == null ? '—' : s.inlier_ratio.toFixed(4)}</td><td>${s.iterations}</td><td>${rejected ? 'rejected' : s.converged ? 'yes' : 'no'}</td></tr>`;
+    return `<tr data-stage="${esc(s.method)}"><td>${esc(STAGE_LABEL[s.method] ?? s.method)}${mark}</td><td>${g(s.scale)}</td><td>${s.rmse == null ? '—' : g(s.rmse)}</td><td>${s.inlier_ratio == null ? '—' : s.inlier_ratio.toFixed(4)}</td><td>${s.iterations}</td><td>${rejected ? 'rejected' : s.converged ? 'yes' : 'no'}</td></tr>`;
   }).join('');
   $('stages').innerHTML = `<tr><th>stage</th><th>scale</th><th>rmse</th><th>inliers</th><th>iter</th><th>conv.</th></tr>${rows}`;
   $('matrix').textContent = matrixText(a.gt_from_recon);
@@ -24,9 +26,13 @@ function showStages(report) {
   $('matrix-wrap').hidden = false;
 }
 
+/** The statistics rows' headings (the report's keys stay in `data-row`). */
+const ROW_LABEL = { accuracy: 'accuracy', completeness: 'completeness', signed: 'signed accuracy', completeness_visible: 'completeness (visible)', track_error: 'track error' };
+/** The crop kinds (`crop.kind`) in words. */
+const CROP_KIND = { none: 'none', box: 'box', sphere: 'sphere', polygon_prism: 'polygon prism' };
 function statRow(label, st, extra) {
   const cells = [st.count, g(st.mean), g(st.median), g(st.rms), g(st.std), g(st.percentiles.p90), g(st.percentiles.p99), g(st.max)];
-  return `<tr data-row="${label}"><th>${label}</th>${cells.map((c, i) => `<td data-k="${['count', 'mean', 'median', 'rms', 'std', 'p90', 'p99', 'max'][i]}">${c}</td>`).join('')}<td class="muted">${esc(extra)}</td></tr>`;
+  return `<tr data-row="${label}"><th>${esc(ROW_LABEL[label] ?? label)}</th>${cells.map((c, i) => `<td data-k="${['count', 'mean', 'median', 'rms', 'std', 'p90', 'p99', 'max'][i]}">${c}</td>`).join('')}<td class="muted">${esc(extra)}</td></tr>`;
 }
 export function showResults(r) {
   const rep = r.report;
@@ -36,7 +42,7 @@ export function showResults(r) {
   const c = rep.crop;
   const a = rep.alignment;
   let h = `<div class="line">${esc(i.reconstruction.name)} (${esc(i.reconstruction.format)}, ${i.reconstruction.points} points) vs ${esc(i.ground_truth.name)} (${esc(i.ground_truth.format)}, ${i.ground_truth.vertices} vertices, ${i.ground_truth.triangles} triangles, bbox diagonal <span id="diag">${g(i.ground_truth.diagonal)}</span>) — ${r.ms.toFixed(0)} ms</div>`;
-  h += `<div class="line">crop <b>${esc(c.kind)}</b>: kept <b id="r-kept">${c.kept}</b>, discarded <span id="r-discarded">${c.discarded}</span> (outside volume ${c.discarded_outside_volume}, farther than max distance ${c.discarded_farther_than_max_distance})</div>`;
+  h += `<div class="line">crop <b>${esc(CROP_KIND[c.kind] ?? c.kind)}</b>: kept <b id="r-kept">${c.kept}</b>, discarded <span id="r-discarded">${c.discarded}</span> (outside volume ${c.discarded_outside_volume}, farther than max distance ${c.discarded_farther_than_max_distance})</div>`;
   h += `<div class="line">alignment <b id="r-align">${esc(a.method)}</b> (scale <span id="r-scale">${g(a.scale)}</span>${a.rmse != null ? `, rmse ${g(a.rmse)}` : ''})</div>`;
   h += '<table id="stats"><tr><td></td><th>count</th><th>mean</th><th>median</th><th>rms</th><th>std</th><th>p90</th><th>p99</th><th>max</th><th class="muted">notes</th></tr>';
   h += statRow('accuracy', rep.accuracy, `recon → GT, ${rep.accuracy.metric}`);
@@ -57,10 +63,7 @@ export function showResults(r) {
   }
   h += '</table>';
   if (cv) h += `<div class="line" id="r-visible">visible surface: <b id="r-visible-fraction">${(100 * cv.visible_fraction).toFixed(2)} %</b> of the ground truth (seen by ≥ ${cv.min_views} of ${cv.views} images); coverage colours at τ = ${g(cv.labels_tau)}</div>`;
-  if (rep.cameras) {
-    const cams = Object.entries(rep.cameras).filter(([, v]) => typeof v === 'number').map(([k, v]) => `${esc(k)} ${Number.isInteger(v) ? v : g(v)}`);
-    h += `<div class="line" id="r-cameras">cameras: ${cams.join(', ')}</div>`;
-  }
+  if (rep.cameras) h += `<div class="line" id="r-cameras">${cameraLine(rep.cameras)}</div>`;
   h += notesHtml(reportNotes(rep));
   $('summary').innerHTML = h;
   showStages(rep);
@@ -74,6 +77,19 @@ export function showResults(r) {
   updateTau();
   drawColorbar(r.clip);
   showView('evaluation');
+}
+
+/** The camera section's counts and headline errors in words (the report's keys are for programs). */
+function cameraLine(c) {
+  const parts = [`${c.registered} of ${c.ground_truth} ground-truth images registered`, `${c.matched} matched by name`];
+  if (c.unmatched_estimated) parts.push(`${c.unmatched_estimated} estimated without a ground-truth image`);
+  if (c.models > 1) parts.push(`${c.models} models (the largest measured)`);
+  if (c.matched) {
+    parts.push(`ATE (RMSE) ${g(c.ate_rmse)}`);
+    if (c.rotation_error_deg) parts.push(`rotation error median ${g(c.rotation_error_deg.median)}°`);
+    if (c.center_error) parts.push(`centre error median ${g(c.center_error.median)}`);
+  }
+  return `cameras: ${parts.join(', ')}`;
 }
 
 // share strictly below tau in a sorted array (the core's share_below)

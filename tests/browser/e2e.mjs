@@ -96,6 +96,23 @@ try {
   // the model's cameras as frusta: one per registered image, and the ground truth's
   const frusta = await page.evaluate(() => window.sfmevalViewer.cameraCounts());
   check('frusta-drawn', frusta.estCams && frusta.estCams.count === 36 && frusta.gtCams && frusta.gtCams.count === 36 && frusta.estCams.colors.length === 3 * 36, JSON.stringify({ est: frusta.estCams && frusta.estCams.count, gt: frusta.gtCams && frusta.gtCams.count }));
+  // one evaluation frames the frusta: every frustum's corners project inside the view
+  const framed = await page.evaluate(() => {
+    const v = window.sfmevalViewer;
+    v.camera.updateMatrixWorld();
+    let outside = 0, total = 0;
+    for (const o of [v.cams.gtCams, v.cams.estCams]) {
+      o.updateMatrixWorld(true);
+      const p = o.geometry.attributes.position.array;
+      for (let i = 0; i < p.length; i += 3) {
+        const q = v.camera.position.clone().set(p[i], p[i + 1], p[i + 2]).applyMatrix4(o.matrixWorld).project(v.camera);
+        total++;
+        if (!(Math.abs(q.x) <= 1 && Math.abs(q.y) <= 1 && q.z < 1)) outside++;
+      }
+    }
+    return { outside, total };
+  });
+  check('frusta-framed-after-one-evaluation', framed.total > 0 && framed.outside === 0, JSON.stringify(framed));
   check('report-model-auto-equals-cli', noteSame('report-model-auto-equals-cli', pageModel.text, expectedModel), `page ${pageModel.path} vs cli-model.json: ${firstDiff(pageModel.text, expectedModel)}`);
   const rep = JSON.parse(expectedModel);
   const cell = (row, k) => page.textContent(`#stats tr[data-row=${row}] td[data-k=${k}]`);
