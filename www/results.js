@@ -28,6 +28,8 @@ function showStages(report) {
 
 /** The statistics rows' headings (the report's keys stay in `data-row`). */
 const ROW_LABEL = { accuracy: 'accuracy', completeness: 'completeness', signed: 'signed accuracy', completeness_visible: 'completeness (visible)', track_error: 'track error' };
+/** The accuracy's distance (`accuracy.metric`) in words. */
+const METRIC = { point_to_triangle: 'to the nearest triangle', point_to_point: 'to the nearest ground-truth point' };
 /** The crop kinds (`crop.kind`) in words. */
 const CROP_KIND = { none: 'none', box: 'box', sphere: 'sphere', polygon_prism: 'polygon prism' };
 function statRow(label, st, extra) {
@@ -45,7 +47,7 @@ export function showResults(r) {
   h += `<div class="line">crop <b>${esc(CROP_KIND[c.kind] ?? c.kind)}</b>: kept <b id="r-kept">${c.kept}</b>, discarded <span id="r-discarded">${c.discarded}</span> (outside volume ${c.discarded_outside_volume}, farther than max distance ${c.discarded_farther_than_max_distance})</div>`;
   h += `<div class="line">alignment <b id="r-align">${esc(a.method)}</b> (scale <span id="r-scale">${g(a.scale)}</span>${a.rmse != null ? `, rmse ${g(a.rmse)}` : ''})</div>`;
   h += '<table id="stats"><tr><td></td><th>count</th><th>mean</th><th>median</th><th>rms</th><th>std</th><th>p90</th><th>p99</th><th>max</th><th class="muted">notes</th></tr>';
-  h += statRow('accuracy', rep.accuracy, `recon → GT, ${rep.accuracy.metric}`);
+  h += statRow('accuracy', rep.accuracy, `recon → GT, ${METRIC[rep.accuracy.metric] ?? rep.accuracy.metric}`);
   h += statRow('completeness', rep.completeness, `GT → recon, ${rep.completeness.samples} samples`);
   if (rep.accuracy.signed) h += statRow('signed', rep.accuracy.signed, 'signed accuracy');
   const cv = rep.completeness_visible;

@@ -288,6 +288,14 @@ try {
     const v = window.sfmevalViewer;
     return document.getElementById('show-coverage').checked && !!v.coverage && v.coverage.visible && v.coverage.geometry.attributes.position.count > 1000;
   }));
+  // words for people: no snake_case report key in the results or the stage table (file names
+  // and the core's own note messages aside); here with the visible-surface row
+  const keys = await page.evaluate(() => {
+    const text = (el) => { const c = el.cloneNode(true); c.querySelectorAll('[data-code]').forEach((n) => n.remove()); return c.innerText; };
+    return [...`${text(document.getElementById('summary'))}\n${text(document.getElementById('stages'))}`
+      .matchAll(/(?:^|[\s(,])([a-z0-9]+_[a-z0-9_]+)(?=[\s),:]|$)/gm)].map((m) => m[1]);
+  });
+  check('results-without-snake-case-keys', keys.length === 0 && /completeness \(visible\)/.test(await page.textContent('#stats')), keys.join(', '));
   await page.uncheck('#show-recon');
   await page.waitForTimeout(300);
   await page.screenshot({ path: join(out, 'page-coverage.png') });
@@ -331,6 +339,21 @@ try {
   const fOf = (r) => r.thresholds.map((t) => t.f_score.toFixed(4)).join(' ');
   check('demo-cameras-would-give-other-numbers', fOf(trap) !== fOf(JSON.parse(ownCli)), `F with the demo's cameras ${fOf(trap)}, without ${fOf(JSON.parse(ownCli))}`);
   console.log(`note: own files after the demo: F ${fOf(JSON.parse(ownCli))} (the demo's cameras would give ${fOf(trap)})`);
+
+  // 4d. a cameras.json of another schema (another tool's cameras, no "schema"): the page and the
+  //     CLI say which schema is expected and where it is documented, in the core's same words
+  const foreign = '{"camera_angle_x": 0.69,\n "frames": [{"file_path": "0000.jpg", "transform_matrix": [[1,0,0,0],[0,1,0,0],[0,0,1,0],[0,0,0,1]]}]}\n';
+  mkdirSync(join(out, 'foreign'), { recursive: true });
+  writeFileSync(join(out, 'foreign', 'cameras.json'), foreign);
+  await page.setInputFiles('#file-cams', { name: 'cameras.json', mimeType: 'application/json', buffer: Buffer.from(foreign) });
+  await page.waitForFunction(() => /not loaded/.test(document.getElementById('info-cams').textContent));
+  const camsErr = await page.textContent('#error');
+  let cliErr = '';
+  try { execFileSync(cli, ['eval', '--gt', demo('ground_truth.glb'), '--recon', demo('sparse'), '--gt-cameras', join(out, 'foreign', 'cameras.json'), '--quiet'], { stdio: 'pipe' }); } catch (e) { cliErr = String(e.stderr); }
+  const coreWords = (camsErr.match(/cameras\.json: .*$/) || [''])[0];
+  check('foreign-cameras-json-names-the-schema-and-its-docs', /sfmeval\.cameras\/1/.test(camsErr) && /docs\/cameras-json\.md/.test(camsErr) && !/missing field/.test(camsErr)
+    && coreWords.length > 0 && cliErr.includes(coreWords), JSON.stringify({ page: camsErr, cli: cliErr }));
+  await page.click('#banner-close');
 
   // 5. a broken file gives a readable error
   await page.setInputFiles('#file-gt', { name: 'broken.glb', mimeType: 'model/gltf-binary', buffer: Buffer.from('glTF\x02\0\0\0\x40\0\0\0garbage') });
