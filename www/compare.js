@@ -7,19 +7,24 @@
 import uPlot from 'uplot';
 import { Viewer } from './viewer.js';
 import { dropZone, entryFiles } from './files.js';
-
-const $ = (id) => document.getElementById(id);
-const esc = (s) => String(s).replace(/[&<>"]/g, (c) => ({ '&': '&amp;', '<': '&lt;', '>': '&gt;', '"': '&quot;' }[c]));
+import { $, esc } from './util.js';
+import { MSG } from './core.js';
 
 /** Files the runner evaluates in a run folder: `model/` (else `sparse.ply`). */
 const MODEL_EXT = /\.(bin|txt|nvm|out|json|ply)$/i;
 
+/** A COLMAP model's files: together they are one model (as the Reconstruction input reads them). */
+const COLMAP_FILE = /^(cameras|images|points3D|rigs|frames)\.(txt|bin)$/i;
+
 /**
  * Groups picked or dropped files (with `webkitRelativePath`-like names) into the items to
- * compare: `{name, dataset, runJson (File|null), files: {relName: File}}`. A folder holding
+ * compare: `{pipeline, runJson (File|null), files: {relName: File}, path}`. A folder holding
  * `run.json` files is a runs folder: each run folder is one item named by its pipeline, with
- * its `model/` files (or `sparse.ply`); otherwise each top-level model folder is one item, and
- * each loose file (no folder) is one item named by the file.
+ * its `model/` files (or `sparse.ply`). Otherwise each folder's COLMAP files
+ * (cameras/images/points3D .txt or .bin) are one model named by that folder (`model` for loose
+ * files, as the Reconstruction input names them), and every other model file (PLY, NVM, Bundler
+ * .out, sfm_data.json) is one item named by the file; a name that repeats is prefixed by the
+ * file's own folder.
  */
 export function groupItems(fileList) {
   const files = Array.from(fileList).map((f) => ({ f, path: (f.webkitRelativePath || f.name).replace(/^\/+/, '') }));
@@ -42,19 +47,38 @@ export function groupItems(fileList) {
       items.push({ pipeline: parts[parts.length - 1], runJson: r.f, files: model, path: dir });
     }
   } else {
+    // by each file's own folder ('' for loose files)
     const byFolder = new Map();
     for (const x of files) {
-      const parts = x.path.split('/');
-      if (parts.length === 1) { items.push({ pipeline: x.f.name, runJson: null, files: { [x.f.name]: x.f }, path: x.path }); continue; }
-      // a picked folder: its sub-folders are the models (or the folder itself is one model)
-      const key = parts.length > 2 ? parts.slice(0, 2).join('/') : parts[0];
-      if (!byFolder.has(key)) byFolder.set(key, {});
-      byFolder.get(key)[parts.slice(key.split('/').length).join('/')] = x.f;
+      const cut = x.path.lastIndexOf('/');
+      const dir = cut < 0 ? '' : x.path.slice(0, cut);
+      const name = x.path.slice(cut + 1);
+      if (!MODEL_EXT.test(name)) continue;
+      if (!byFolder.has(dir)) byFolder.set(dir, []);
+      byFolder.get(dir).push({ name, f: x.f });
     }
-    for (const [key, map] of byFolder) {
-      const m = Object.fromEntries(Object.entries(map).filter(([n]) => MODEL_EXT.test(n)));
-      if (Object.keys(m).length) items.push({ pipeline: key.split('/').pop(), runJson: null, files: m, path: `${key}/` });
+    for (const [dir, list] of byFolder) {
+      // COLMAP's sub-models sit in numbered folders (sparse/0): those keep their parent's name
+      const parts = dir ? dir.split('/') : [];
+      const folderName = parts.length > 1 && /^\d+$/.test(parts[parts.length - 1]) ? parts.slice(-2).join('/') : parts.pop() || '';
+      const colmap = list.filter((x) => COLMAP_FILE.test(x.name));
+      if (colmap.length) {
+        items.push({ pipeline: folderName || 'model', folder: dir, runJson: null, files: Object.fromEntries(colmap.map((x) => [x.name, x.f])), path: dir ? `${dir}/` : 'model/' });
+      }
+      for (const x of list.filter((y) => !COLMAP_FILE.test(y.name))) {
+        items.push({ pipeline: x.name, folder: dir, runJson: null, files: { [x.name]: x.f }, path: dir ? `${dir}/${x.name}` : x.name });
+      }
     }
+    // a name that repeats (two folders' sfm_data.json, two folders called sparse) gets its folder
+    const count = new Map();
+    for (const it of items) count.set(it.pipeline, (count.get(it.pipeline) || 0) + 1);
+    for (const it of items) {
+      if (count.get(it.pipeline) > 1 && it.folder) {
+        const parts = it.folder.split('/');
+        it.pipeline = it.files[it.pipeline] ? `${parts[parts.length - 1]}/${it.pipeline}` : parts.slice(-2).join('/');
+      }
+    }
+    for (const it of items) delete it.folder;
   }
   items.sort((a, b) => (a.path < b.path ? -1 : a.path > b.path ? 1 : 0));
   return items;
@@ -130,9 +154,10 @@ function curves(el, entries) {
  * Sets up the compare section. `call` talks to the worker, `viewer` is the page's viewer,
  * `options()` the Measure section's options, `showError(msg, target)` the banner and
  * `download(name, data, type)` saves a file, `setRunning(b)` tells the page a compare is under way
- * (progress bar and Cancel in the action bar) and returns false when another run already is.
+ * (progress bar and Cancel in the action bar) and returns false when another run already is,
+ * `showComparison()` turns the results pane to the comparison.
  */
-export function setupCompare({ call, viewer, measureOptions, showError, download, gtName, setRunning }) {
+export function setupCompare({ call, viewer, measureOptions, showError, download, gtName, setRunning, showComparison }) {
   const state = { items: [], entries: [], sort: null, tables: null, viewer2: null };
   const info = $('info-runs');
   const setItems = (items) => {
@@ -184,7 +209,7 @@ export function setupCompare({ call, viewer, measureOptions, showError, download
           try { run = JSON.parse(runText); } catch (err) { throw new Error(`${it.path}run.json: ${err.message}`); }
         }
         if (run && run.status !== 'ok') {
-          const { row } = await call('runRowOnly', { runJson: runText });
+          const { row } = await call(MSG.runRowOnly, { runJson: runText });
           entries.push({ row, report: null, path: it.path });
           continue;
         }
@@ -194,7 +219,7 @@ export function setupCompare({ call, viewer, measureOptions, showError, download
         const recName = run ? `${run.dataset}/${run.pipeline}` : it.pipeline;
         try {
           if (!transfer.length) throw new Error('no model files (model/ or sparse.ply)');
-          const r = await call('compareRun', { files, name: recName, runJson: runText, dataset: name, options }, transfer);
+          const r = await call(MSG.compareRun, { files, name: recName, runJson: runText, dataset: name, options }, transfer);
           entries.push({ ...r, report: JSON.parse(r.reportJson), path: it.path });
         } catch (err) {
           if (err.name === 'Cancelled') throw err;
@@ -204,14 +229,16 @@ export function setupCompare({ call, viewer, measureOptions, showError, download
             dataset: name, pipeline: it.pipeline, tool: 'file', version: null, status: 'failed', reason: null,
             wall_seconds: 0, cpu_seconds: 0, peak_memory_bytes: 0, images_total: 0, images_registered: 0, points: 0,
           });
-          const { row } = await call('runRowOnly', { runJson: record });
+          const { row } = await call(MSG.runRowOnly, { runJson: record });
           entries.push({ row: { ...row, status: 'evaluation failed', reason: err.message }, report: null, path: it.path });
         }
       }
       state.entries = entries;
-      const { tables } = await call('comparisonTables', { rows: entries.map((e) => e.row) });
+      const { tables } = await call(MSG.comparisonTables, { rows: entries.map((e) => e.row) });
       state.tables = tables;
       render();
+      // the results pane now shows the comparison, its table at the top (in view)
+      showComparison();
       $('compare-status').textContent = `compared ${entries.length} reconstruction${entries.length === 1 ? '' : 's'}${problems.length ? ` (${problems.length} could not be evaluated)` : ''}`;
       if (problems.length) {
         showError(`compare: ${problems.length} of ${entries.length} could not be evaluated (marked "evaluation failed" in the table): ${problems.join('; ')}`, 'file-runs');

@@ -298,6 +298,94 @@ try {
     check(`compare-cropped-${file}-equals-runner-crop`, got === want && got !== readFileSync(join(table, file), 'utf8'), firstDiff(got, want));
   }
 
+  // 12. COLMAP files are one model: the demo's cameras.txt, images.txt, points3D.txt picked as
+  //     loose files give one row (named 'model', as the Reconstruction input names them) whose
+  //     report equals `sfmeval eval` on that model; in a picked folder, the COLMAP folder is named
+  //     by itself and a loose file beside it by the file (not by the picked folder)
+  await page.selectOption('#crop-kind', 'none');
+  await page.fill('#max-distance', '');
+  const compareAgain = async () => {
+    const n = Number(await page.evaluate(() => document.body.dataset.compared || 0));
+    await page.click('#compare');
+    await page.waitForFunction((k) => Number(document.body.dataset.compared || 0) > k || document.getElementById('error').textContent, n, { timeout: 300000 });
+  };
+  const demoSparse = join(root, 'data/demo/sparse');
+  await page.setInputFiles('#file-runs', ['cameras.txt', 'images.txt', 'points3D.txt'].map((f) => join(demoSparse, f)));
+  check('compare-colmap-files-one-item', (await page.textContent('#info-runs')).startsWith('1 reconstruction: model'), await page.textContent('#info-runs'));
+  await compareAgain();
+  const colmapRows = await tableRows();
+  const colmapReport = await page.evaluate(() => window.sfmeval.compare.entries.map((e) => e.reportJson));
+  execFileSync(cli, ['eval', '--gt', join(dataset, 'ground_truth.glb'), '--gt-cameras', join(dataset, 'cameras.json'), '--recon', demoSparse, '--quiet', '--report', join(out, 'compare-cli-colmap.json')]);
+  const wantColmap = JSON.parse(readFileSync(join(out, 'compare-cli-colmap.json'), 'utf8'));
+  wantColmap.inputs.reconstruction.name = 'model'; // the CLI names it by its folder, 'sparse'
+  check('compare-colmap-files-one-row', colmapRows.length === 1 && colmapRows[0].pipeline === 'model' && colmapRows[0].cells.status.text === 'ok'
+    && colmapReport.length === 1 && colmapReport[0] && JSON.stringify(JSON.parse(colmapReport[0])) === JSON.stringify(wantColmap),
+  JSON.stringify({ rows: colmapRows.map((r) => [r.pipeline, r.cells.status.text]), diff: colmapReport[0] ? firstDiff(JSON.stringify(JSON.parse(colmapReport[0]), null, 1), JSON.stringify(wantColmap, null, 1)) : 'no report' }));
+  const picked = join(out, 'picked');
+  mkdirSync(join(picked, 'sparse'), { recursive: true });
+  for (const f of ['cameras.txt', 'images.txt', 'points3D.txt']) writeFileSync(join(picked, 'sparse', f), readFileSync(join(demoSparse, f)));
+  writeFileSync(join(picked, 'demo_points.ply'), readFileSync(join(root, 'data/demo/sparse.ply')));
+  await page.setInputFiles('#dir-runs', picked);
+  await compareAgain();
+  const pickedRows = (await tableRows()).map((r) => r.pipeline).sort();
+  check('compare-names-from-own-folder', pickedRows.join() === 'demo_points.ply,sparse', pickedRows.join());
+  const pickedReports = await page.evaluate(() => window.sfmeval.compare.entries.map((e) => [e.row.pipeline, e.reportJson]));
+  for (const [name, json] of pickedReports) {
+    const file = join(out, `compare-cli-picked-${name}.json`);
+    execFileSync(cli, ['eval', '--gt', join(dataset, 'ground_truth.glb'), '--gt-cameras', join(dataset, 'cameras.json'), '--recon', join(picked, name), '--quiet', '--report', file]);
+    const want = readFileSync(file, 'utf8');
+    check(`compare-picked-report-${name}-equals-cli`, json === want, json ? firstDiff(json, want) : 'no report');
+  }
+
+  // 13. after Compare the comparison is in view, at 1366×768 and at 1920×1080: the results pane
+  //     shows it (not the previous evaluation, whose "Out of date" note is there to cover it), the
+  //     table's header and first row inside the window and the pane, nothing drawn over them
+  await page.setInputFiles('#file-recon', join(root, 'data/demo/sparse.ply'));
+  await page.waitForFunction(() => /sparse\.ply/.test(document.getElementById('info-recon').textContent));
+  const clouds = [join(root, 'data/demo/sparse.ply'), join(root, 'tests/fixtures/global/pycolmap_points3D.ply')];
+  for (const [k, [w, h]] of [[1366, 768], [1920, 1080]].entries()) {
+    await page.setViewportSize({ width: w, height: h });
+    const evaluated = Number(await page.evaluate(() => document.body.dataset.evaluated || 0));
+    await page.click('#run');
+    await page.waitForFunction((n) => Number(document.body.dataset.evaluated || 0) > n, evaluated, { timeout: 300000 });
+    // an input changes: the evaluation goes out of date under its sticky note, then Compare
+    const next = clouds[(k + 1) % 2];
+    await page.setInputFiles('#file-recon', next);
+    await page.waitForFunction(() => !document.getElementById('stale-note').hidden);
+    await page.evaluate(() => { document.getElementById('results').scrollTop = 1e6; });
+    await page.setInputFiles('#file-runs', clouds);
+    await compareAgain();
+    await page.waitForTimeout(200);
+    const seen = await page.evaluate(() => {
+      // vertically inside, starting inside (a wide table scrolls sideways within the pane)
+      const inside = (r, box) => r.top >= box.top && r.bottom <= box.bottom && r.left >= box.left && r.left < box.right;
+      const win = { top: 0, left: 0, bottom: innerHeight, right: innerWidth };
+      const pane = document.getElementById('results').getBoundingClientRect();
+      const uncovered = (el) => {
+        const r = el.getBoundingClientRect();
+        const hit = document.elementFromPoint(r.left + Math.min(20, r.width / 2), r.top + r.height / 2);
+        return !!hit && el.contains(hit);
+      };
+      const head = document.querySelector('#cmp-table thead tr') || document.querySelector('#cmp-table tr');
+      const first = document.querySelector('#cmp-table tbody tr');
+      const visible = (id) => { const el = document.getElementById(id); return !!el && el.getClientRects().length > 0; };
+      return {
+        firstRow: !!first && inside(first.getBoundingClientRect(), win) && inside(first.getBoundingClientRect(), pane),
+        firstRowUncovered: !!first && uncovered(first.querySelector('td')),
+        headerUncovered: !!head && inside(head.getBoundingClientRect(), pane) && uncovered(head.querySelector('th')),
+        summaryShown: visible('summary'), staleShown: visible('stale-note'),
+        tabs: visible('results-tabs'), top: first ? Math.round(first.getBoundingClientRect().top) : null,
+      };
+    });
+    check(`compare-in-view-${w}x${h}`, seen.firstRow && seen.firstRowUncovered && seen.headerUncovered && !seen.summaryShown && !seen.staleShown && seen.tabs, JSON.stringify(seen));
+    await page.screenshot({ path: join(out, `compare-in-view-${w}x${h}.png`) });
+    // the tab brings the evaluation back, and the comparison again
+    await page.click('#tab-evaluation');
+    const back = await page.evaluate(() => [document.getElementById('summary').getClientRects().length > 0, document.getElementById('compare-results').getClientRects().length > 0]);
+    await page.click('#tab-comparison');
+    check(`results-tabs-switch-${w}x${h}`, back[0] && !back[1], JSON.stringify(back));
+  }
+
   check('compare-no-request-leaves-origin', requests.every((u) => u.startsWith(origin) || u.startsWith('blob:') || u.startsWith('data:')), requests.filter((u) => !u.startsWith(origin)).join(' '));
   check('compare-no-console-errors', consoleErrors.length === 0, consoleErrors.join(' | '));
 } catch (e) {

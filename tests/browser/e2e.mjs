@@ -96,6 +96,23 @@ try {
   // the model's cameras as frusta: one per registered image, and the ground truth's
   const frusta = await page.evaluate(() => window.sfmevalViewer.cameraCounts());
   check('frusta-drawn', frusta.estCams && frusta.estCams.count === 36 && frusta.gtCams && frusta.gtCams.count === 36 && frusta.estCams.colors.length === 3 * 36, JSON.stringify({ est: frusta.estCams && frusta.estCams.count, gt: frusta.gtCams && frusta.gtCams.count }));
+  // one evaluation frames the frusta: every frustum's corners project inside the view
+  const framed = await page.evaluate(() => {
+    const v = window.sfmevalViewer;
+    v.camera.updateMatrixWorld();
+    let outside = 0, total = 0;
+    for (const o of [v.cams.gtCams, v.cams.estCams]) {
+      o.updateMatrixWorld(true);
+      const p = o.geometry.attributes.position.array;
+      for (let i = 0; i < p.length; i += 3) {
+        const q = v.camera.position.clone().set(p[i], p[i + 1], p[i + 2]).applyMatrix4(o.matrixWorld).project(v.camera);
+        total++;
+        if (!(Math.abs(q.x) <= 1 && Math.abs(q.y) <= 1 && q.z < 1)) outside++;
+      }
+    }
+    return { outside, total };
+  });
+  check('frusta-framed-after-one-evaluation', framed.total > 0 && framed.outside === 0, JSON.stringify(framed));
   check('report-model-auto-equals-cli', noteSame('report-model-auto-equals-cli', pageModel.text, expectedModel), `page ${pageModel.path} vs cli-model.json: ${firstDiff(pageModel.text, expectedModel)}`);
   const rep = JSON.parse(expectedModel);
   const cell = (row, k) => page.textContent(`#stats tr[data-row=${row}] td[data-k=${k}]`);
@@ -271,11 +288,72 @@ try {
     const v = window.sfmevalViewer;
     return document.getElementById('show-coverage').checked && !!v.coverage && v.coverage.visible && v.coverage.geometry.attributes.position.count > 1000;
   }));
+  // words for people: no snake_case report key in the results or the stage table (file names
+  // and the core's own note messages aside); here with the visible-surface row
+  const keys = await page.evaluate(() => {
+    const text = (el) => { const c = el.cloneNode(true); c.querySelectorAll('[data-code]').forEach((n) => n.remove()); return c.innerText; };
+    return [...`${text(document.getElementById('summary'))}\n${text(document.getElementById('stages'))}`
+      .matchAll(/(?:^|[\s(,])([a-z0-9]+_[a-z0-9_]+)(?=[\s),:]|$)/gm)].map((m) => m[1]);
+  });
+  check('results-without-snake-case-keys', keys.length === 0 && /completeness \(visible\)/.test(await page.textContent('#stats')), keys.join(', '));
   await page.uncheck('#show-recon');
   await page.waitForTimeout(300);
   await page.screenshot({ path: join(out, 'page-coverage.png') });
   await page.check('#show-recon');
   await page.click('#clear-depth');
+
+  // 4c. the demo-cameras trap: after the demo, the user's own ground truth and a COLMAP model whose
+  // images are named like the demo's (0000.jpg…, here the demo's model with its names shifted, as
+  // another scene shot by our generator) must not be aligned with the demo's cameras: loading them
+  // resets the demo's cameras.json (said in one line) and the report equals the CLI's without
+  // cameras, byte for byte.
+  await page.click('#clear-cams');
+  await page.waitForFunction(() => document.getElementById('info-cams').textContent === '—');
+  await page.click('#demo');
+  await page.waitForFunction(() => /^cameras\.json: 36 images/.test(document.getElementById('info-cams').textContent) && window.sfmeval.state.demoLoaded);
+  const own = join(out, 'own');
+  mkdirSync(join(own, 'mine'), { recursive: true });
+  writeFileSync(join(own, 'my_ground_truth.glb'), readFileSync(demo('ground_truth.glb')));
+  for (const f of ['cameras.txt', 'points3D.txt']) writeFileSync(join(own, 'mine', f), readFileSync(demo(`sparse/${f}`)));
+  writeFileSync(join(own, 'mine', 'images.txt'), readFileSync(demo('sparse/images.txt'), 'utf8')
+    .replace(/ (\d{4})\.jpg$/gm, (_, n) => ` ${String((Number(n) + 7) % 36).padStart(4, '0')}.jpg`));
+  await page.setInputFiles('#file-gt', join(own, 'my_ground_truth.glb'));
+  await page.waitForFunction(() => /my_ground_truth/.test(document.getElementById('info-gt').textContent));
+  await page.setInputFiles('#dir-recon', join(own, 'mine'));
+  await page.waitForFunction(() => /^mine \(/.test(document.getElementById('info-recon').textContent));
+  const resetNote = await page.evaluate(() => {
+    const el = document.querySelector('#notes-gt [data-reset], #notes-recon [data-reset]');
+    return el ? { codes: el.dataset.reset, text: el.textContent, lines: el.getClientRects().length } : null;
+  });
+  check('own-files-after-demo-reset-cameras', resetNote && resetNote.codes.split(',').includes('cams') && /cameras\.json/.test(resetNote.text)
+    && (await page.textContent('#info-cams')) === '—', JSON.stringify({ resetNote, cams: await page.textContent('#info-cams') }));
+  await evaluateAndWait();
+  const ownPage = await downloadText('#dl-report');
+  execFileSync(cli, ['eval', '--gt', join(own, 'my_ground_truth.glb'), '--recon', join(own, 'mine'), '--quiet', '--report', join(out, 'cli-own.json')]);
+  const ownCli = readFileSync(join(out, 'cli-own.json'), 'utf8');
+  check('own-files-after-demo-equal-cli-without-cameras', noteSame('own-files-after-demo-equal-cli-without-cameras', ownPage.text, ownCli) && !JSON.parse(ownPage.text).cameras,
+    `page ${ownPage.path} vs cli-own.json: ${firstDiff(ownPage.text, ownCli)}`);
+  // the trap is real: the demo's cameras give other numbers on these files
+  execFileSync(cli, ['eval', '--gt', join(own, 'my_ground_truth.glb'), '--recon', join(own, 'mine'), '--gt-cameras', demo('cameras.json'), '--quiet', '--report', join(out, 'cli-own-demo-cams.json')]);
+  const trap = JSON.parse(readFileSync(join(out, 'cli-own-demo-cams.json'), 'utf8'));
+  const fOf = (r) => r.thresholds.map((t) => t.f_score.toFixed(4)).join(' ');
+  check('demo-cameras-would-give-other-numbers', fOf(trap) !== fOf(JSON.parse(ownCli)), `F with the demo's cameras ${fOf(trap)}, without ${fOf(JSON.parse(ownCli))}`);
+  console.log(`note: own files after the demo: F ${fOf(JSON.parse(ownCli))} (the demo's cameras would give ${fOf(trap)})`);
+
+  // 4d. a cameras.json of another schema (another tool's cameras, no "schema"): the page and the
+  //     CLI say which schema is expected and where it is documented, in the core's same words
+  const foreign = '{"camera_angle_x": 0.69,\n "frames": [{"file_path": "0000.jpg", "transform_matrix": [[1,0,0,0],[0,1,0,0],[0,0,1,0],[0,0,0,1]]}]}\n';
+  mkdirSync(join(out, 'foreign'), { recursive: true });
+  writeFileSync(join(out, 'foreign', 'cameras.json'), foreign);
+  await page.setInputFiles('#file-cams', { name: 'cameras.json', mimeType: 'application/json', buffer: Buffer.from(foreign) });
+  await page.waitForFunction(() => /not loaded/.test(document.getElementById('info-cams').textContent));
+  const camsErr = await page.textContent('#error');
+  let cliErr = '';
+  try { execFileSync(cli, ['eval', '--gt', demo('ground_truth.glb'), '--recon', demo('sparse'), '--gt-cameras', join(out, 'foreign', 'cameras.json'), '--quiet'], { stdio: 'pipe' }); } catch (e) { cliErr = String(e.stderr); }
+  const coreWords = (camsErr.match(/cameras\.json: .*$/) || [''])[0];
+  check('foreign-cameras-json-names-the-schema-and-its-docs', /sfmeval\.cameras\/1/.test(camsErr) && /docs\/cameras-json\.md/.test(camsErr) && !/missing field/.test(camsErr)
+    && coreWords.length > 0 && cliErr.includes(coreWords), JSON.stringify({ page: camsErr, cli: cliErr }));
+  await page.click('#banner-close');
 
   // 5. a broken file gives a readable error
   await page.setInputFiles('#file-gt', { name: 'broken.glb', mimeType: 'model/gltf-binary', buffer: Buffer.from('glTF\x02\0\0\0\x40\0\0\0garbage') });

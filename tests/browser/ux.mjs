@@ -82,9 +82,10 @@ async function axeScan(page, name) {
   check(name, bad.length === 0, JSON.stringify(bad));
 }
 
-async function newPage(w, h) {
+async function newPage(w, h, before = null) {
   const context = await browser.newContext({ viewport: { width: w, height: h } });
   context.on('request', (r) => requests.push(r.url()));
+  if (before) await before(context);
   const page = await context.newPage();
   page.on('console', (m) => { if (m.type() === 'error') consoleErrors.push(m.text()); });
   page.on('pageerror', (e) => consoleErrors.push(String(e)));
@@ -353,29 +354,57 @@ try {
   }
 
   // ---- the core's typed notes: the page shows them by code and level, never by their words ----
+  // The same evaluation twice (the demo's ground truth and its PLY cloud, auto: a global search
+  // with its notes): once as the core wrote the report, once with every note's message reworded
+  // by the page's own worker (its script served with a wrapper around `evaluate`). The page must
+  // show the same notes (code, level), the same stage marks and verdicts, each with the new words.
   {
-    const page = await newPage(1366, 768);
-    const notes = await page.evaluate(() => {
-      // messages reworded on purpose: the page must still show each note by its code and level
-      const rep = {
-        notes: [
-          { code: 'alignment.global_search_result', level: 'info', message: 'REWORDED search <b>', values: { stage: 'global', starts: 240 } },
-          { code: 'alignment.icp_rejected', level: 'warning', message: 'REWORDED refinement text', values: { stage: 'icp', reason: 'scale_drift' } },
-          { code: 'alignment.unsettled_tight_fit', level: 'info', message: 'REWORDED tight', values: { stage: 'icp', min_inlier_ratio: 0.5 } },
-          { code: 'input.model_no_points', level: 'warning', message: 'REWORDED no points' },
-        ],
-      };
-      return window.sfmeval.reportNotes(rep);
-    });
-    const want = [
-      ['alignment.global_search_result', 'info', 'global', 'note: REWORDED search &lt;b&gt;'],
-      ['alignment.icp_rejected', 'warn', 'icp', 'warning: REWORDED refinement text'],
-      ['alignment.unsettled_tight_fit', 'info', 'icp', 'note: REWORDED tight'],
-      ['input.model_no_points', 'warn', null, 'warning: REWORDED no points'],
-    ];
-    const got = notes.map((n) => [n.code, n.level, n.stage, n.html]);
-    check('notes-shown-by-code-and-level-with-the-core-words', JSON.stringify(got) === JSON.stringify(want), JSON.stringify(got));
-    await page.context().close();
+    const root = resolve(new URL('../..', import.meta.url).pathname);
+    const evaluateDemoPly = async (page) => {
+      await page.setInputFiles('#file-gt', join(root, 'data/demo/ground_truth.glb'));
+      await page.waitForFunction(() => /triangles/.test(document.getElementById('info-gt').textContent));
+      await page.setInputFiles('#file-recon', join(root, 'data/demo/sparse.ply'));
+      await page.waitForFunction(() => /sparse\.ply/.test(document.getElementById('info-recon').textContent));
+      await page.click('#run');
+      await page.waitForFunction(() => Number(document.body.dataset.evaluated || 0) > 0 || document.getElementById('error').textContent, null, { timeout: 300000 });
+      return page.evaluate(() => ({
+        report: window.sfmeval.state.result.reportJson,
+        notes: [...document.querySelectorAll('#summary [data-code]')].map((e) => [e.dataset.code, e.className, e.textContent]),
+        stages: [...document.querySelectorAll('#stages tr[data-stage]')].map((tr) => [tr.dataset.stage,
+          tr.querySelector('[data-stage-warnings]') ? tr.querySelector('[data-stage-warnings]').dataset.stageWarnings : '0', tr.lastElementChild.textContent]),
+        error: document.getElementById('error').textContent,
+      }));
+    };
+    const plain = await newPage(1366, 768);
+    const asWritten = await evaluateDemoPly(plain);
+    await plain.context().close();
+    const reworded = await newPage(1366, 768, (context) => context.route('**/worker.js', async (route) => {
+      const response = await route.fetch();
+      const body = `${await response.text()}
+;{ const evaluate = handlers.evaluate;
+  handlers.evaluate = async (msg) => {
+    const out = await evaluate(msg);
+    const rep = JSON.parse(out.reply.reportJson);
+    (rep.notes || []).forEach((n, i) => { n.message = \`REWORDED \${i} <i>\`; });
+    out.reply.reportJson = JSON.stringify(rep, null, 2);
+    return out;
+  };
+}`;
+      await route.fulfill({ response, body });
+    }));
+    const got = await evaluateDemoPly(reworded);
+    await reworded.context().close();
+    const codes = JSON.parse(asWritten.report).notes.map((n) => n.code);
+    const gotReport = JSON.parse(got.report);
+    check('notes-reworded-report-reached-the-page', !got.error && gotReport.notes.length === codes.length && gotReport.notes.every((n, i) => n.message === `REWORDED ${i} <i>`),
+      JSON.stringify({ error: got.error, notes: gotReport.notes }));
+    const strip = (list) => list.map(([code, cls]) => [code, cls]);
+    check('notes-shown-by-code-and-level-whatever-their-words', codes.length > 0 && JSON.stringify(strip(got.notes)) === JSON.stringify(strip(asWritten.notes))
+      && JSON.stringify(asWritten.notes.map(([c]) => c)) === JSON.stringify(codes)
+      && got.notes.every(([, , text], i) => text.endsWith(`REWORDED ${i} <i>`)),
+    JSON.stringify({ codes, asWritten: asWritten.notes, reworded: got.notes }));
+    check('stage-marks-by-code-whatever-the-words', asWritten.stages.length > 0 && JSON.stringify(got.stages) === JSON.stringify(asWritten.stages),
+      JSON.stringify({ asWritten: asWritten.stages, reworded: got.stages }));
   }
 } catch (e) {
   check('ux-run', false, e.stack || String(e));

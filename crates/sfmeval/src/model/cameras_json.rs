@@ -15,9 +15,20 @@ const FMT: &str = "cameras.json";
 /// The schema id this reader accepts.
 pub(crate) const SCHEMA: &str = "sfmeval.cameras/1";
 
+/// Where the expected format is described, appended to the schema errors.
+const EXPECTED: &str = " (the expected format, with its cameras and images, is documented in \
+                        docs/cameras-json.md)";
+
+/// The top-level `schema` field alone (any JSON type), read before the rest.
+#[derive(Deserialize)]
+struct SchemaProbe {
+    #[serde(default)]
+    schema: Option<serde_json::Value>,
+}
+
+/// The rest of the file (its `schema` checked by [`SchemaProbe`]).
 #[derive(Deserialize)]
 struct File {
-    schema: String,
     #[serde(default)]
     frame: Option<String>,
     #[serde(default)]
@@ -60,22 +71,35 @@ struct JsonPose {
 /// determinant +1, within a tolerance of 1e-4) and cameras and poses for sense
 /// ([`Reconstruction::validate`]).
 pub fn read_cameras_json(bytes: &[u8]) -> Result<Reconstruction> {
-    let file: File = serde_json::from_slice(bytes).map_err(|e| {
+    let json_error = |e: serde_json::Error| {
         if e.is_eof() {
             Error::truncated(FMT, e.to_string())
         } else {
             Error::malformed(FMT, e.to_string())
         }
-    })?;
-    if file.schema != SCHEMA {
-        return Err(Error::unsupported(
-            FMT,
-            format!(
-                "schema '{}' is not '{SCHEMA}'",
-                super::text::clip(&file.schema)
-            ),
-        ));
+    };
+    // The schema first, so that a JSON file of another kind (another tool's cameras, a report)
+    // is told what is expected instead of the first field it lacks.
+    let probe: SchemaProbe = serde_json::from_slice(bytes).map_err(json_error)?;
+    match probe.schema {
+        Some(serde_json::Value::String(s)) if s == SCHEMA => {}
+        Some(serde_json::Value::String(s)) => {
+            return Err(Error::unsupported(
+                FMT,
+                format!(
+                    "schema '{}' is not '{SCHEMA}'{EXPECTED}",
+                    super::text::clip(&s)
+                ),
+            ));
+        }
+        _ => {
+            return Err(Error::unsupported(
+                FMT,
+                format!("not an sfmeval cameras file: no \"schema\": \"{SCHEMA}\"{EXPECTED}"),
+            ));
+        }
     }
+    let file: File = serde_json::from_slice(bytes).map_err(json_error)?;
     if let Some(pc) = file.pixel_convention.as_ref().filter(|pc| *pc != "colmap") {
         return Err(Error::unsupported(
             FMT,
@@ -438,6 +462,25 @@ mod tests {
             ),
             Err(Error::Unsupported { .. })
         ));
+        // A JSON file of another kind names the expected schema and its documentation, not the
+        // first field it lacks (was: "missing field `schema` at line 2428").
+        for other in [
+            r#"{"frames":[{"file_path":"0000.jpg","transform_matrix":[]}],"camera_angle_x":0.7}"#,
+            r#"{"schema":7,"cameras":[]}"#,
+            r#"{"schema":"nerfstudio","cameras":[],"images":[]}"#,
+        ] {
+            let e = read_cameras_json(other.as_bytes()).unwrap_err();
+            assert_eq!(e.kind(), "unsupported", "{e}");
+            let msg = e.to_string();
+            assert!(
+                msg.starts_with("cameras.json: ")
+                    && (msg.contains("'sfmeval.cameras/1'")
+                        || msg.contains("\"sfmeval.cameras/1\""))
+                    && msg.contains("docs/cameras-json.md")
+                    && !msg.contains("missing field"),
+                "{msg}"
+            );
+        }
         let empty = read_cameras_json(ok.replace("IMG", "").as_bytes()).unwrap();
         assert!(empty.images.is_empty());
     }
