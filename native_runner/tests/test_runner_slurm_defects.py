@@ -9,6 +9,9 @@ slurm_testlib starts (slurmctld + slurmd + munged in a temporary folder):
   command, without --resume;
 - a request above what the partition's nodes have (CPUs, memory) is refused before anything
   is submitted, naming the stage and the nodes' size;
+- a task whose runner is killed with SIGKILL (as the kernel's OOM killer does) has its tool's
+  process group ended by the task's script, and its cell says so with Slurm's job state and
+  exit signal.
 
 No rendering and no SfM tool: `run` batches on a folder with one placeholder image, with a
 custom pipeline that sleeps (`--hold` in the wrapper keeps the jobs pending where they need
@@ -16,6 +19,7 @@ not run). Measured here (2 vCPUs, loaded): ~20 s for the four tests, half of it 
 start and the SIGKILL test's collect."""
 
 import os
+import signal
 import stat
 import time
 
@@ -152,3 +156,61 @@ def test_a_request_above_the_partitions_nodes_is_refused(runner_bin, cluster, tm
                 env=env)
     assert "submitted run 1/1" in p.stderr
     cancel_all(cluster)
+
+
+def processes():
+    """{pid: (pgid, cmdline)} of this machine."""
+    out = {}
+    for n in os.listdir("/proc"):
+        if not n.isdigit():
+            continue
+        try:
+            with open("/proc/%s/stat" % n) as f:
+                pgid = int(f.read().rsplit(")", 1)[1].split()[2])
+            with open("/proc/%s/cmdline" % n, "rb") as f:
+                cmd = f.read().split(b"\0")
+        except (OSError, IndexError, ValueError):
+            continue
+        out[int(n)] = (pgid, [c.decode(errors="replace") for c in cmd if c])
+    return out
+
+
+def test_a_task_killed_with_sigkill_ends_its_tools_and_says_why(runner_bin, cluster, tmp_path):
+    d1 = dataset(tmp_path, "d1")
+    out = tmp_path / "out"
+    env = {"SLURM_CONF": cluster.conf}
+    run_cli(runner_bin, "run", "--datasets", d1, *HANG, "--out", out, "--executor", "slurm",
+            *SMALL, env=env)
+    pgids = out / "slurm" / "logs" / "run-0.pgids"
+    plan = str(out / "slurm" / "plan.json")
+    deadline = time.time() + 120
+    while True:
+        procs = processes()
+        groups = [int(g) for g in pgids.read_text().split()] if pgids.is_file() else []
+        tool = [p for p, (g, c) in procs.items() if g in groups and c[:1] == ["sleep"]]
+        runner = [p for p, (g, c) in procs.items() if "slurm-task" in c and plan in c]
+        if tool and len(runner) == 1:
+            break
+        assert time.time() < deadline, (cluster.jobs(), cluster.log_tail())
+        time.sleep(0.1)
+    os.kill(runner[0], signal.SIGKILL)
+    cluster.wait_idle(120)
+    # the tool's whole process group is gone
+    left = [p for p, (g, _) in processes().items() if g in groups]
+    assert left == [], left
+    log = (out / "slurm" / "logs" / "run-0.out").read_text()
+    assert "# sfmeval-runner: run task 0: its runner was killed by signal 9 (SIGKILL); ended " \
+        "its tools' process group(s) %d (2 process(es))" % groups[0] in log, log
+    rec = load(out / "runs" / "d1" / "hang" / "run.json")
+    job = load(out / "slurm" / "jobs.json")[0]["stages"][0]["job"]
+    assert rec["status"] == "failed"
+    # the end reason as Slurm recorded it (state, exit signal) and the script's line
+    assert rec["reason"].startswith(
+        "Slurm run task 0: killed by signal 9 (SIGKILL: the kernel's out-of-memory killer, or a "
+        "kill outside Slurm; Slurm job %s_0: JobState=FAILED ExitCode=0:9); ended its tools' "
+        "process group(s) %d (2 process(es)); see " % (job, groups[0])), rec["reason"]
+    cell = (out / "table" / "table1.md").read_text()
+    assert "| failed: Slurm run task 0: killed by signal 9 (SIGKILL" in cell, cell
+    doc = load(out / "batch.json")
+    assert [(t["task"], t["status"]) for t in doc["tasks_without_result"]] == [(0, "failed")]
+    assert doc["executor"] == "slurm"

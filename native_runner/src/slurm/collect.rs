@@ -19,7 +19,8 @@ use crate::pipelines::{parse_customs, parse_list};
 use crate::report::{ReportArgs, report};
 use crate::run::{RunRecord, Status, read_record};
 use crate::slurm::plan::{CellPlan, Job, Plan, Stage};
-use crate::slurm::state::{dataset_done, end_reason, task_done};
+use crate::slurm::state::{dataset_done, end_reason, slurm_end, task_done};
+use crate::slurm::submit::{SubmissionRecord, job_of_task, read_records};
 use crate::summary::{
     BatchSummary, BatchTiming, Executor, Table1Summary, Table1Timing, TaskWithoutResult,
     render_times, write_summary,
@@ -28,9 +29,19 @@ use crate::sweep::variants::Variant;
 use crate::sweep::{Execution, SweepPlan, write_results};
 
 /// Why run task `k` has no result: its dataset's missing render or finalize task, or itself.
-fn why_missing(plan: &Plan, k: usize, cell: &CellPlan) -> (Status, String) {
+fn why_missing(
+    plan: &Plan,
+    records: &[SubmissionRecord],
+    k: usize,
+    cell: &CellPlan,
+) -> (Status, String) {
+    // how Slurm recorded the task's job, while it keeps the record
+    let ended = |stage: Stage, k: usize| {
+        let slurm = job_of_task(records, stage, k).and_then(|j| slurm_end(&j));
+        end_reason(&plan.log(stage, k), slurm.as_ref())
+    };
     if dataset_done(plan, &cell.dataset) {
-        let (st, why) = end_reason(&plan.log(Stage::Run, k));
+        let (st, why) = ended(Stage::Run, k);
         return (st, format!("Slurm run task {k}: {why}"));
     }
     let n = plan.render_shards;
@@ -51,7 +62,7 @@ fn why_missing(plan: &Plan, k: usize, cell: &CellPlan) -> (Status, String) {
         .unwrap_or(0);
     for r in d * n..(d + 1) * n {
         if !task_done(plan, Stage::Render, r) {
-            let (st, why) = end_reason(&plan.log(Stage::Render, r));
+            let (st, why) = ended(Stage::Render, r);
             return (
                 st,
                 format!(
@@ -61,7 +72,7 @@ fn why_missing(plan: &Plan, k: usize, cell: &CellPlan) -> (Status, String) {
             );
         }
     }
-    let (st, why) = end_reason(&plan.log(Stage::Finalize, d));
+    let (st, why) = ended(Stage::Finalize, d);
     (
         st,
         format!(
@@ -130,6 +141,7 @@ fn merge_runs(plan: &Plan, job: &Job) -> Result<Merged> {
     let customs = parse_customs(&job.tools().customs)?;
     let specs = parse_list(job.pipelines(), &customs)?;
     let runs = plan.out.join("runs");
+    let records = read_records(plan)?;
     let mut m = Merged {
         executed: BTreeMap::new(),
         without_result: Vec::new(),
@@ -156,7 +168,7 @@ fn merge_runs(plan: &Plan, job: &Job) -> Result<Merged> {
             }
             continue;
         }
-        let why = why_missing(plan, k, cell);
+        let why = why_missing(plan, &records, k, cell);
         eprintln!(
             "{}/{}: {}: {}",
             cell.dataset,
@@ -189,6 +201,20 @@ fn plan_render_times(plan: &Plan) -> (BTreeMap<String, f64>, BTreeMap<String, f6
             .iter()
             .map(|d| (d.name.as_str(), plan.dataset_dir(&d.name))),
     )
+}
+
+/// Seconds from the batch's first submission until now (the collect's own time when no
+/// submission is recorded).
+fn batch_seconds(plan: &Plan, t0: Instant) -> f64 {
+    let now = std::time::SystemTime::now()
+        .duration_since(std::time::UNIX_EPOCH)
+        .map(|d| d.as_secs_f64())
+        .unwrap_or(0.0);
+    read_records(plan)
+        .ok()
+        .and_then(|r| r.first().map(|r| now - r.submitted_unix))
+        .filter(|s| s.is_finite() && *s > 0.0)
+        .unwrap_or_else(|| t0.elapsed().as_secs_f64())
 }
 
 /// Merges the runs, marks the missing ones, evaluates and writes what the local command
@@ -279,7 +305,7 @@ fn table1_results(plan: &Plan, a: &Table1Args, merged: &Merged, t0: Instant) -> 
             render_seconds_per_view: per_view,
             runs_seconds: merged.runs_seconds,
             report_seconds,
-            total_seconds: t0.elapsed().as_secs_f64(),
+            total_seconds: batch_seconds(plan, t0),
         },
     };
     write_summary(&plan.out.join("table1.json"), &doc)
@@ -305,7 +331,7 @@ fn run_results(plan: &Plan, a: &RunArgs, merged: &Merged, t0: Instant) -> Result
         timing: BatchTiming {
             runs_seconds: merged.runs_seconds,
             report_seconds,
-            total_seconds: t0.elapsed().as_secs_f64(),
+            total_seconds: batch_seconds(plan, t0),
         },
     };
     write_summary(&plan.out.join("batch.json"), &doc)

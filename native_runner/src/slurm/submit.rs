@@ -10,7 +10,7 @@ use anyhow::{Context, Result, bail};
 use serde::{Deserialize, Serialize};
 use sfmeval_fs::write_atomic;
 
-use crate::slurm::plan::Plan;
+use crate::slurm::plan::{Plan, Stage};
 use crate::slurm::resources::slurm_program;
 use crate::slurm::script::{Submission, sbatch_args};
 
@@ -63,6 +63,19 @@ fn write_records(plan: &Plan, all: &[SubmissionRecord]) -> Result<()> {
     let mut text = serde_json::to_string_pretty(all)?;
     text.push('\n');
     write_atomic(&jobs_path(plan), text.as_bytes())
+}
+
+/// The Slurm job of task `k` of `stage` in its latest submission (`<job>_<k>` for an array,
+/// `<job>` for the collect), if it was ever queued.
+pub fn job_of_task(records: &[SubmissionRecord], stage: Stage, k: usize) -> Option<String> {
+    records
+        .iter()
+        .flat_map(|r| &r.stages)
+        .rfind(|q| q.stage == stage.name() && q.tasks.contains(&k))
+        .map(|q| match stage {
+            Stage::Collect => q.job.clone(),
+            _ => format!("{}_{k}", q.job),
+        })
 }
 
 /// The job id in `sbatch --parsable`'s output (`ID` or `ID;CLUSTER`).
@@ -205,7 +218,30 @@ mod tests {
     }
 
     #[test]
-    fn a_record_of_an_older_runner_was_complete() {
+    fn a_task_is_found_in_its_latest_submission() {
+        let q = |stage: &str, job: &str, tasks: Vec<usize>| QueuedJob {
+            stage: stage.into(),
+            label: stage.into(),
+            job: job.into(),
+            tasks,
+        };
+        let recs = vec![
+            SubmissionRecord {
+                submitted_unix: 1.0,
+                complete: true,
+                stages: vec![q("run", "10", vec![0, 1]), q("collect", "11", vec![0])],
+            },
+            SubmissionRecord {
+                submitted_unix: 2.0,
+                complete: false,
+                stages: vec![q("run", "20", vec![1])],
+            },
+        ];
+        assert_eq!(job_of_task(&recs, Stage::Run, 0).as_deref(), Some("10_0"));
+        assert_eq!(job_of_task(&recs, Stage::Run, 1).as_deref(), Some("20_1"));
+        assert_eq!(job_of_task(&recs, Stage::Collect, 0).as_deref(), Some("11"));
+        assert_eq!(job_of_task(&recs, Stage::Render, 0), None);
+        // a record of an older runner (no `complete`) was complete
         let old: Vec<SubmissionRecord> =
             serde_json::from_str(r#"[{"submitted_unix": 1, "stages": []}]"#).unwrap();
         assert!(old[0].complete);
