@@ -11,8 +11,8 @@
 //!    tables, as a local `table1` (or `run` + `report`) does.
 //!
 //! The modules: [`plan`] (what task k of a stage does, where it writes), [`resources`](mod@resources) (the
-//! per-stage `--cpus-per-task`, `--mem`, `--time`, partition, account), [`script`] (the sbatch
-//! scripts and `submit.sh`), [`submit`] (`sbatch` and `jobs.json`), [`state`] (which tasks left
+//! per-stage `--cpus-per-task`, `--mem`, `--time`, partition, account, checked against `sinfo`), [`script`] (the sbatch
+//! scripts and `submit.sh`), [`submit`] (`sbatch` and `jobs.json`, each job recorded as soon as it is queued), [`state`] (which tasks left
 //! their result, why one did not), [`task`] (running one task) and [`collect`].
 
 pub mod collect;

@@ -1,6 +1,6 @@
-//! Where a batch stands, from its files alone (no scheduler accounting needed): which tasks
-//! left their result, and why a task that left none ended (the last Slurm message in its
-//! output file: cancelled, time limit, node failure, out of memory).
+//! Where a batch stands: which tasks left their result (from its files alone), and why a task
+//! that left none ended (Slurm's last message in its output file — cancelled, time limit, node
+//! failure, out of memory — else Slurm's record of its job: state and exit signal).
 
 use std::path::Path;
 
