@@ -448,6 +448,10 @@ pub struct SlurmTaskArgs {
     /// The task's index in its stage (the array task id; 0 for collect).
     #[arg(long, default_value_t = 0)]
     pub index: usize,
+    /// The script's cleanup after the task's runner ended with this status (128 + N: killed
+    /// by signal N): ends what is left of its tools' process groups and says so in the log.
+    #[arg(long, value_name = "STATUS")]
+    pub ended: Option<i32>,
 }
 
 /// Arguments of `sweep`.

@@ -109,6 +109,20 @@ impl StepResult {
     }
 }
 
+/// The variable naming the file where every tool's process group is appended (set by a
+/// Slurm task's script, which ends those groups when the runner itself was killed).
+pub const PROCESS_GROUPS_VAR: &str = "SFMEVAL_PROCESS_GROUPS";
+
+/// Appends `pgid` to the file `$SFMEVAL_PROCESS_GROUPS` names, if any (best effort: the
+/// record only lets the task's script clean up after a killed runner).
+fn record_process_group(pgid: u32) {
+    if let Some(path) = std::env::var_os(PROCESS_GROUPS_VAR)
+        && let Ok(mut f) = File::options().create(true).append(true).open(path)
+    {
+        let _ = writeln!(f, "{pgid}");
+    }
+}
+
 /// Runs `step`, appending its output to `log`, until it exits or `deadline` passes.
 pub fn run_step(step: &Step, log: &Path, deadline: Instant) -> StepResult {
     let started = Instant::now();
@@ -156,6 +170,7 @@ pub fn run_step(step: &Step, log: &Path, deadline: Instant) -> StepResult {
         }
     };
     let pgid = Pid::from_raw(child.id() as i32);
+    record_process_group(child.id());
     // A watchdog thread enforces the deadline on the whole process group while this thread
     // blocks in wait4(2).
     let (done_tx, done_rx) = std::sync::mpsc::channel::<()>();

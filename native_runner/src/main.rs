@@ -25,6 +25,7 @@ mod report;
 mod run;
 mod setup;
 mod slurm;
+mod summary;
 mod sweep;
 mod table;
 mod table1;

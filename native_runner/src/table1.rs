@@ -9,11 +9,10 @@ use std::time::Instant;
 
 use anyhow::{Context, Result};
 
-use sfmeval_fs::write_atomic;
-
 use crate::args::Table1Args;
 use crate::dataset::Dataset;
 use crate::generator::{find_blender_scripts, render_dataset};
+use crate::summary::{Executor, Table1Summary, Table1Timing, render_times, write_summary};
 
 /// The seed paper's five datasets, as generator presets.
 pub const PRESETS: [&str; 5] = ["statue", "vase", "bicycle", "hydrant", "vehicle"];
@@ -101,8 +100,7 @@ pub fn table1(a: &Table1Args) -> Result<()> {
     let runs = out.join("runs");
     let table = out.join("table");
     std::fs::create_dir_all(&ds_root).with_context(|| format!("creating {}", ds_root.display()))?;
-    let mut timing = serde_json::Map::new();
-    let mut gen_times = serde_json::Map::new();
+    let mut gen_times = std::collections::BTreeMap::new();
     let mut datasets = Vec::new();
     for p in &presets {
         let name = dataset_name(p, a.quick);
@@ -112,7 +110,7 @@ pub fn table1(a: &Table1Args) -> Result<()> {
             eprintln!("table1: reusing {}", dest.display());
         } else {
             let secs = generate(&python, &scripts, p, a.quick, &a.generator.sets, &dest)?;
-            gen_times.insert(name.clone(), secs.into());
+            gen_times.insert(name.clone(), secs);
         }
         datasets.push(Dataset::open(&dest)?);
     }
@@ -128,7 +126,6 @@ pub fn table1(a: &Table1Args) -> Result<()> {
         datasets.push(ds);
     }
     let gen_seconds = t0.elapsed().as_secs_f64();
-    timing.insert("render_seconds".into(), gen_times.into());
     let customs = crate::pipelines::parse_customs(&a.tools.customs)?;
     let specs = crate::pipelines::parse_list(&a.pipelines, &customs)?;
     let env = crate::env::make_env(&a.tools, &runs)?;
@@ -139,21 +136,26 @@ pub fn table1(a: &Table1Args) -> Result<()> {
     let t_rep = Instant::now();
     let rows = crate::report::report(&a.eval.report_args(&runs, &table)?)?;
     let report_seconds = t_rep.elapsed().as_secs_f64();
-    timing.insert("datasets_seconds".into(), gen_seconds.into());
-    timing.insert("runs_seconds".into(), runs_seconds.into());
-    timing.insert("report_seconds".into(), report_seconds.into());
-    timing.insert("total_seconds".into(), t0.elapsed().as_secs_f64().into());
-    let doc = serde_json::json!({
-        "quick": a.quick,
-        "presets": presets,
-        "pipelines": specs.iter().map(|s| s.name.clone()).collect::<Vec<_>>(),
-        "runs_executed": summary.ran,
-        "runs_reused": summary.skipped,
-        "timing": timing,
-    });
-    let mut json = serde_json::to_string_pretty(&doc)?;
-    json.push('\n');
-    write_atomic(&out.join("table1.json"), json.as_bytes())?;
+    // per view: what the generator measured, for the datasets rendered now
+    let (_, per_view) = render_times(gen_times.keys().map(|n| (n.as_str(), ds_root.join(n))));
+    let doc = Table1Summary {
+        quick: a.quick,
+        presets,
+        pipelines: specs.iter().map(|s| s.name.clone()).collect(),
+        executor: Executor::Local,
+        runs_executed: summary.ran,
+        runs_reused: summary.skipped,
+        tasks_without_result: Vec::new(),
+        timing: Table1Timing {
+            render_seconds: gen_times,
+            render_seconds_per_view: per_view,
+            datasets_seconds: gen_seconds,
+            runs_seconds,
+            report_seconds,
+            total_seconds: t0.elapsed().as_secs_f64(),
+        },
+    };
+    write_summary(&out.join("table1.json"), &doc)?;
     let t1 = std::fs::read_to_string(table.join("table1.md")).unwrap_or_default();
     println!("{t1}");
     eprintln!(

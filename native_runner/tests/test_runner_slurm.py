@@ -125,9 +125,10 @@ def test_dry_run_writes_the_scripts_and_submits_nothing(runner_bin, cluster, tmp
     assert plan["cells"] == [{"dataset": NAME, "pipeline": "openmvg"},
                              {"dataset": NAME, "pipeline": "pycolmap"}]
     assert plan["render_shards"] == 2 and plan["datasets"][0]["name"] == NAME
-    # a planned batch is only resumed, with the same work
-    again = run_cli(runner_bin, *table1_args(out, *SLURM, "--dry-run"), env=env, check=False)
-    assert again.returncode == 1 and "holds a Slurm batch already" in again.stderr
+    # a dry run does not start the batch: the same command plans it again; other work is
+    # refused on --resume
+    again = run_cli(runner_bin, *table1_args(out, *SLURM, "--dry-run"), env=env)
+    assert "--dry-run: scripts in" in again.stderr
     three_shards = [a if a != "2" else "3" for a in SLURM]
     other = run_cli(runner_bin, *table1_args(out, *three_shards, "--resume", "--dry-run"),
                     env=env, check=False)
@@ -221,6 +222,17 @@ def test_slurm_gives_the_local_table_and_resume_completes_it(runner_bin, tools, 
         assert measures(load(out / rel)) == measures(load(local / rel)), pipe
     doc = load(out / "table1.json")
     assert doc["tasks_without_result"] == [] and doc["runs_executed"] == {"ok": 2}
+    # One summary type from both executors: the same keys, the same values but for where it
+    # ran and the measured times.
+    mine = load(local / "table1.json")
+    assert (doc["executor"], mine["executor"]) == ("slurm", "local")
+    assert sorted(doc) == sorted(mine) and sorted(doc["timing"]) == sorted(mine["timing"])
+    for k in doc:
+        if k not in ("executor", "timing"):
+            assert doc[k] == mine[k], (k, doc[k], mine[k])
+    for k in ("render_seconds", "render_seconds_per_view"):
+        assert sorted(doc["timing"][k]) == sorted(mine["timing"][k]) == [NAME], k
+        assert doc["timing"][k][NAME] > 0 and mine["timing"][k][NAME] > 0, k
 
     # Nothing missing: a third call only collects again.
     p = run_cli(runner_bin, *table1_args(out, *SLURM, "--resume"), env=env)
@@ -343,7 +355,16 @@ def test_a_sweep_through_slurm_equals_the_local_sweep(runner_bin, tools, cluster
             assert (out / "charts" / c).read_text() == (local / "charts" / c).read_text(), c
     doc = load(out / "sweep.json")
     assert [v["status"] for v in doc["variants"]] == ["rendered", "rendered"]
-    assert doc["timing"]["executor"] == "slurm" and doc["timing"]["tasks_without_result"] == []
+    assert doc["executor"] == "slurm" and doc["tasks_without_result"] == []
+    # the same summary as the local sweep's but for where it ran and the times
+    mine = load(local / "sweep.json")
+    assert sorted(doc) == sorted(mine) and sorted(doc["timing"]) == sorted(mine["timing"])
+    assert mine["executor"] == "local"
+    for k in doc:
+        if k not in ("executor", "timing", "command", "variants"):
+            assert doc[k] == mine[k], k
+    assert [{k: v for k, v in x.items() if k != "seconds"} for x in doc["variants"]] == \
+        [{k: v for k, v in x.items() if k != "seconds"} for x in mine["variants"]]
     for v in ["noise-0", "noise-8"]:
         a, b = files(local / "datasets" / v), files(out / "datasets" / v)
         assert [f for f in a if a[f] != b.get(f)] == ["timing.json"], v

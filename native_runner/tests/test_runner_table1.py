@@ -86,7 +86,10 @@ def test_table1_json_has_the_timings(table1):
     assert doc["quick"] is True and doc["presets"] == PRESETS and doc["pipelines"] == PIPES
     assert sum(doc["runs_executed"].values()) == len(PRESETS) * len(PIPES)
     assert doc["runs_reused"] == 0
+    assert doc["executor"] == "local" and doc["tasks_without_result"] == []
     t = doc["timing"]
+    assert sorted(t["render_seconds_per_view"]) == sorted(t["render_seconds"])
+    assert all(0 < v < t["render_seconds"][k] for k, v in t["render_seconds_per_view"].items())
     assert sorted(t["render_seconds"]) == ["%s-quick" % p for p in PRESETS]
     assert all(v > 0 for v in t["render_seconds"].values())
     for k in ["datasets_seconds", "runs_seconds", "report_seconds", "total_seconds"]:
@@ -106,7 +109,7 @@ def test_second_call_reuses_datasets_and_runs(table1, runner_bin):
     assert proc.stderr.count("table1: reusing") == len(PRESETS)
     doc = json.load(open(out / "table1.json"))
     assert doc["runs_executed"] == {} and doc["runs_reused"] == len(PRESETS) * len(PIPES)
-    assert doc["timing"]["render_seconds"] == {}
+    assert doc["timing"]["render_seconds"] == {} == doc["timing"]["render_seconds_per_view"]
     for p in PRESETS:  # the runs were not redone
         assert open(out / "runs" / ("%s-quick" % p) / "openmvg" / "run.json").read() == runs[p]
     assert (out / "table" / "table1.md").read_text() == before

@@ -19,14 +19,29 @@ use crate::pipelines::{parse_customs, parse_list};
 use crate::report::{ReportArgs, report};
 use crate::run::{RunRecord, Status, read_record};
 use crate::slurm::plan::{CellPlan, Job, Plan, Stage};
-use crate::slurm::state::{dataset_done, end_reason, task_done};
+use crate::slurm::state::{dataset_done, end_reason, slurm_end, task_done};
+use crate::slurm::submit::{SubmissionRecord, job_of_task, read_records};
+use crate::summary::{
+    BatchSummary, BatchTiming, Executor, Table1Summary, Table1Timing, TaskWithoutResult,
+    render_times, write_summary,
+};
 use crate::sweep::variants::Variant;
-use crate::sweep::{SweepPlan, write_results};
+use crate::sweep::{Execution, SweepPlan, write_results};
 
 /// Why run task `k` has no result: its dataset's missing render or finalize task, or itself.
-fn why_missing(plan: &Plan, k: usize, cell: &CellPlan) -> (Status, String) {
+fn why_missing(
+    plan: &Plan,
+    records: &[SubmissionRecord],
+    k: usize,
+    cell: &CellPlan,
+) -> (Status, String) {
+    // how Slurm recorded the task's job, while it keeps the record
+    let ended = |stage: Stage, k: usize| {
+        let slurm = job_of_task(records, stage, k).and_then(|j| slurm_end(&j));
+        end_reason(&plan.log(stage, k), slurm.as_ref())
+    };
     if dataset_done(plan, &cell.dataset) {
-        let (st, why) = end_reason(&plan.log(Stage::Run, k));
+        let (st, why) = ended(Stage::Run, k);
         return (st, format!("Slurm run task {k}: {why}"));
     }
     let n = plan.render_shards;
@@ -47,7 +62,7 @@ fn why_missing(plan: &Plan, k: usize, cell: &CellPlan) -> (Status, String) {
         .unwrap_or(0);
     for r in d * n..(d + 1) * n {
         if !task_done(plan, Stage::Render, r) {
-            let (st, why) = end_reason(&plan.log(Stage::Render, r));
+            let (st, why) = ended(Stage::Render, r);
             return (
                 st,
                 format!(
@@ -57,7 +72,7 @@ fn why_missing(plan: &Plan, k: usize, cell: &CellPlan) -> (Status, String) {
             );
         }
     }
-    let (st, why) = end_reason(&plan.log(Stage::Finalize, d));
+    let (st, why) = ended(Stage::Finalize, d);
     (
         st,
         format!(
@@ -115,7 +130,7 @@ struct Merged {
     /// Runs with a result, by status.
     executed: BTreeMap<String, usize>,
     /// The tasks without result (task, dataset, pipeline, status, reason).
-    without_result: Vec<serde_json::Value>,
+    without_result: Vec<TaskWithoutResult>,
     /// Wall seconds of the runs with a result.
     runs_seconds: f64,
 }
@@ -126,6 +141,7 @@ fn merge_runs(plan: &Plan, job: &Job) -> Result<Merged> {
     let customs = parse_customs(&job.tools().customs)?;
     let specs = parse_list(job.pipelines(), &customs)?;
     let runs = plan.out.join("runs");
+    let records = read_records(plan)?;
     let mut m = Merged {
         executed: BTreeMap::new(),
         without_result: Vec::new(),
@@ -152,7 +168,7 @@ fn merge_runs(plan: &Plan, job: &Job) -> Result<Merged> {
             }
             continue;
         }
-        let why = why_missing(plan, k, cell);
+        let why = why_missing(plan, &records, k, cell);
         eprintln!(
             "{}/{}: {}: {}",
             cell.dataset,
@@ -160,10 +176,13 @@ fn merge_runs(plan: &Plan, job: &Job) -> Result<Merged> {
             why.0.label(),
             why.1
         );
-        m.without_result
-            .push(json!({"task": k, "dataset": cell.dataset,
-                                     "pipeline": cell.pipeline, "status": why.0.label(),
-                                     "reason": why.1}));
+        m.without_result.push(TaskWithoutResult {
+            task: k,
+            dataset: cell.dataset.clone(),
+            pipeline: cell.pipeline.clone(),
+            status: why.0.label().to_string(),
+            reason: why.1.clone(),
+        });
         let spec = specs.iter().find(|s| s.name == cell.pipeline);
         let kind_tool = match spec.map(|s| (s, s.adapter(&customs))) {
             Some((s, Ok(ad))) => (s.kind.clone(), ad.tool().to_string()),
@@ -175,27 +194,27 @@ fn merge_runs(plan: &Plan, job: &Job) -> Result<Merged> {
     Ok(m)
 }
 
-/// Render times as the generator measured them (`timing.json`): (total, mean per view) per
-/// dataset.
-fn render_times(
-    plan: &Plan,
-) -> (
-    serde_json::Map<String, serde_json::Value>,
-    serde_json::Map<String, serde_json::Value>,
-) {
-    let mut frame_seconds = serde_json::Map::new();
-    let mut per_view = serde_json::Map::new();
-    for d in &plan.datasets {
-        let p = plan.dataset_dir(&d.name).join("timing.json");
-        if let Some(t) = std::fs::read(&p)
-            .ok()
-            .and_then(|b| serde_json::from_slice::<serde_json::Value>(&b).ok())
-        {
-            frame_seconds.insert(d.name.clone(), t["render_seconds_total"].clone());
-            per_view.insert(d.name.clone(), t["render_seconds_mean"].clone());
-        }
-    }
-    (frame_seconds, per_view)
+/// Render times as the generator's parts measured them: (total, mean per view) per dataset.
+fn plan_render_times(plan: &Plan) -> (BTreeMap<String, f64>, BTreeMap<String, f64>) {
+    render_times(
+        plan.datasets
+            .iter()
+            .map(|d| (d.name.as_str(), plan.dataset_dir(&d.name))),
+    )
+}
+
+/// Seconds from the batch's first submission until now (the collect's own time when no
+/// submission is recorded).
+fn batch_seconds(plan: &Plan, t0: Instant) -> f64 {
+    let now = std::time::SystemTime::now()
+        .duration_since(std::time::UNIX_EPOCH)
+        .map(|d| d.as_secs_f64())
+        .unwrap_or(0.0);
+    read_records(plan)
+        .ok()
+        .and_then(|r| r.first().map(|r| now - r.submitted_unix))
+        .filter(|s| s.is_finite() && *s > 0.0)
+        .unwrap_or_else(|| t0.elapsed().as_secs_f64())
 }
 
 /// Merges the runs, marks the missing ones, evaluates and writes what the local command
@@ -215,7 +234,7 @@ pub fn collect(plan: &Plan) -> Result<()> {
 /// The sweep's outputs: a variant whose dataset was not finalized is a failed variant.
 fn sweep_results(plan: &Plan, a: &SweepArgs, merged: &Merged, t0: Instant) -> Result<()> {
     let sweep_plan = SweepPlan::new(a, &plan.python, plan.blender_scripts()?)?;
-    let (frame_seconds, _) = render_times(plan);
+    let (frame_seconds, _) = plan_render_times(plan);
     let variants: Vec<Variant> = sweep_plan
         .planned
         .iter()
@@ -228,7 +247,7 @@ fn sweep_results(plan: &Plan, a: &SweepArgs, merged: &Merged, t0: Instant) -> Re
                 status: if done { "rendered" } else { "failed" }.into(),
                 reason: (!done)
                     .then(|| "not rendered by its Slurm tasks (see OUT/slurm/logs/)".into()),
-                seconds: frame_seconds.get(&pl.dataset).and_then(|v| v.as_f64()),
+                seconds: frame_seconds.get(&pl.dataset).copied(),
             }
         })
         .collect();
@@ -239,9 +258,12 @@ fn sweep_results(plan: &Plan, a: &SweepArgs, merged: &Merged, t0: Instant) -> Re
         &plan.pipelines,
         &plan.out,
         t0,
-        json!({"executor": "slurm", "render_frame_seconds": frame_seconds,
-               "runs_seconds": merged.runs_seconds,
-               "tasks_without_result": merged.without_result}),
+        Execution {
+            executor: Executor::Slurm,
+            tasks_without_result: merged.without_result.clone(),
+            timing: json!({"datasets_seconds": frame_seconds.values().sum::<f64>(),
+                           "runs_seconds": merged.runs_seconds}),
+        },
     )
 }
 
@@ -262,37 +284,31 @@ fn write_tables(plan: &Plan, args: &ReportArgs, merged: &Merged) -> Result<f64> 
     Ok(seconds)
 }
 
-/// Writes `doc` as `OUT/<name>`.
-fn write_json(plan: &Plan, name: &str, doc: &serde_json::Value) -> Result<()> {
-    let mut text = serde_json::to_string_pretty(doc)?;
-    text.push('\n');
-    write_atomic(&plan.out.join(name), text.as_bytes())
-}
-
 /// `table/` and `table1.json`.
 fn table1_results(plan: &Plan, a: &Table1Args, merged: &Merged, t0: Instant) -> Result<()> {
     let args = a
         .eval
         .report_args(&plan.out.join("runs"), &plan.out.join("table"))?;
     let report_seconds = write_tables(plan, &args, merged)?;
-    let (frame_seconds, per_view) = render_times(plan);
-    let doc = json!({
-        "quick": a.quick,
-        "presets": plan.datasets.iter().map(|d| d.preset.clone()).collect::<Vec<_>>(),
-        "pipelines": plan.pipelines,
-        "executor": "slurm",
-        "runs_executed": merged.executed,
-        "runs_reused": 0,
-        "tasks_without_result": merged.without_result,
-        "timing": {
-            "render_frame_seconds": frame_seconds,
-            "render_seconds_per_view": per_view,
-            "runs_seconds": merged.runs_seconds,
-            "report_seconds": report_seconds,
-            "collect_seconds": t0.elapsed().as_secs_f64(),
+    let (render_seconds, per_view) = plan_render_times(plan);
+    let doc = Table1Summary {
+        quick: a.quick,
+        presets: plan.datasets.iter().map(|d| d.preset.clone()).collect(),
+        pipelines: plan.pipelines.clone(),
+        executor: Executor::Slurm,
+        runs_executed: merged.executed.clone(),
+        runs_reused: 0,
+        tasks_without_result: merged.without_result.clone(),
+        timing: Table1Timing {
+            datasets_seconds: render_seconds.values().sum(),
+            render_seconds,
+            render_seconds_per_view: per_view,
+            runs_seconds: merged.runs_seconds,
+            report_seconds,
+            total_seconds: batch_seconds(plan, t0),
         },
-    });
-    write_json(plan, "table1.json", &doc)
+    };
+    write_summary(&plan.out.join("table1.json"), &doc)
 }
 
 /// `run`'s batch: `report`'s `table/` and `batch.json` (the datasets, pipelines, tasks without
@@ -302,17 +318,21 @@ fn run_results(plan: &Plan, a: &RunArgs, merged: &Merged, t0: Instant) -> Result
         .eval
         .report_args(&plan.out.join("runs"), &plan.out.join("table"))?;
     let report_seconds = write_tables(plan, &args, merged)?;
-    let doc = json!({
-        "executor": "slurm",
-        "datasets": plan.datasets.iter().map(|d| plan.dataset_dir(&d.name)).collect::<Vec<_>>(),
-        "pipelines": plan.pipelines,
-        "runs_executed": merged.executed,
-        "tasks_without_result": merged.without_result,
-        "timing": {
-            "runs_seconds": merged.runs_seconds,
-            "report_seconds": report_seconds,
-            "collect_seconds": t0.elapsed().as_secs_f64(),
+    let doc = BatchSummary {
+        executor: Executor::Slurm,
+        datasets: plan
+            .datasets
+            .iter()
+            .map(|d| plan.dataset_dir(&d.name))
+            .collect(),
+        pipelines: plan.pipelines.clone(),
+        runs_executed: merged.executed.clone(),
+        tasks_without_result: merged.without_result.clone(),
+        timing: BatchTiming {
+            runs_seconds: merged.runs_seconds,
+            report_seconds,
+            total_seconds: batch_seconds(plan, t0),
         },
-    });
-    write_json(plan, "batch.json", &doc)
+    };
+    write_summary(&plan.out.join("batch.json"), &doc)
 }

@@ -11,8 +11,8 @@
 //!    tables, as a local `table1` (or `run` + `report`) does.
 //!
 //! The modules: [`plan`] (what task k of a stage does, where it writes), [`resources`](mod@resources) (the
-//! per-stage `--cpus-per-task`, `--mem`, `--time`, partition, account), [`script`] (the sbatch
-//! scripts and `submit.sh`), [`submit`] (`sbatch` and `jobs.json`), [`state`] (which tasks left
+//! per-stage `--cpus-per-task`, `--mem`, `--time`, partition, account, checked against `sinfo`), [`script`] (the sbatch
+//! scripts and `submit.sh`), [`submit`] (`sbatch` and `jobs.json`, each job recorded as soon as it is queued), [`state`] (which tasks left
 //! their result, why one did not), [`task`] (running one task) and [`collect`].
 
 pub mod collect;
@@ -271,19 +271,26 @@ fn submit_plan(plan: &Plan, slurm: &SlurmArgs, resume: bool, fresh: bool) -> Res
     }
     let res = resources(slurm)?;
     let plan_path = Plan::path(&plan.out);
-    if plan_path.is_file() {
+    let planned = plan_path.is_file();
+    if planned {
         let old = Plan::read(&plan_path)?;
-        if !resume {
+        let records = submit::read_records(plan)?;
+        // A batch is started once one submission queued every job it meant to; before that
+        // (a dry run, a first submission that failed) the same command tries again.
+        let started = records.iter().any(|r| r.complete);
+        let queued_any = records.iter().any(|r| !r.stages.is_empty());
+        if started && !resume {
             bail!(
                 "{} holds a Slurm batch already: add --resume to submit what is missing, or \
                  choose another --out",
                 plan.out.display()
             );
         }
-        if !old.same_work(plan) {
+        if !old.same_work(plan) && (resume || queued_any) {
             bail!(
-                "--resume: {} was planned with other presets, datasets, pipelines or \
+                "{}{} was planned with other presets, datasets, pipelines or \
                  --render-shards; give the same ones, or choose another --out",
+                if resume { "--resume: " } else { "" },
                 plan.out.display()
             );
         }
@@ -294,15 +301,23 @@ fn submit_plan(plan: &Plan, slurm: &SlurmArgs, resume: bool, fresh: bool) -> Res
             plan_path.display()
         );
     }
-    if resume && !slurm.dry_run {
+    if planned && !slurm.dry_run {
         let queued = submit::still_queued(plan, &slurm.sbatch)?;
         if !queued.is_empty() {
             bail!(
-                "--resume: jobs {} of this batch are still in the queue: wait for them (or \
-                 scancel them), then resume",
-                queued.join(" ")
+                "jobs {} of this batch in {} are still in the queue: wait for them (or \
+                 scancel them), then run the command again",
+                queued.join(" "),
+                plan.out.display()
             );
         }
+    }
+    if !slurm.dry_run {
+        let stages: Vec<Stage> = Stage::ALL
+            .into_iter()
+            .filter(|&st| plan.task_count(st) > 0)
+            .collect();
+        resources::check_partitions(&res, &stages, &slurm.sbatch)?;
     }
     let mut dirs = vec![plan.slurm_dir().join("logs")];
     if plan.render_shards > 0 {
@@ -350,8 +365,7 @@ fn submit_plan(plan: &Plan, slurm: &SlurmArgs, resume: bool, fresh: bool) -> Res
         );
         return Ok(());
     }
-    let jobs = submit::submit(plan, &subs, &slurm.sbatch)?;
-    submit::record(plan, &subs, &jobs)?;
+    submit::submit(plan, &subs, &slurm.sbatch)?;
     eprintln!(
         "slurm: submitted {} (tasks to run / in the stage); the table will be in {} (logs in {})",
         summary.join(", "),

@@ -260,6 +260,16 @@ impl Plan {
         }
     }
 
+    /// Where a task's runner records its tools' process groups (`$SFMEVAL_PROCESS_GROUPS`),
+    /// so that the task's script can end them when the runner was killed.
+    pub fn process_groups(&self, stage: Stage, k: usize) -> PathBuf {
+        let logs = self.slurm_dir().join("logs");
+        match stage {
+            Stage::Collect => logs.join("collect.pgids"),
+            _ => logs.join(format!("{}-{k}.pgids", stage.name())),
+        }
+    }
+
     /// The sbatch script of a stage.
     pub fn script(&self, stage: Stage) -> PathBuf {
         self.slurm_dir().join(format!("{}.sbatch", stage.name()))

@@ -2,6 +2,7 @@
 //! Defaults per stage, `--partition`/`--account` for all, `--stage STAGE:key=value,...` for one.
 
 use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result, bail};
 
@@ -102,11 +103,228 @@ pub fn resources(a: &SlurmArgs) -> Result<BTreeMap<Stage, Resources>> {
     Ok(out)
 }
 
+/// A Slurm client program (`squeue`, `sinfo`, `scontrol`): beside the given sbatch when it
+/// is there, else on PATH.
+pub fn slurm_program(sbatch: &str, name: &str) -> PathBuf {
+    let sbatch_path = Path::new(sbatch);
+    match sbatch_path.parent() {
+        Some(dir) if !dir.as_os_str().is_empty() && dir.join(name).is_file() => dir.join(name),
+        _ => PathBuf::from(name),
+    }
+}
+
+/// Megabytes of a Slurm memory value (`--mem`: a number with an optional K, M, G or T
+/// suffix, megabytes without one).
+pub fn mem_megabytes(v: &str) -> Option<f64> {
+    let v = v.trim();
+    let (num, scale) = match v.chars().last()?.to_ascii_uppercase() {
+        'K' => (&v[..v.len() - 1], 1.0 / 1024.0),
+        'M' => (&v[..v.len() - 1], 1.0),
+        'G' => (&v[..v.len() - 1], 1024.0),
+        'T' => (&v[..v.len() - 1], 1024.0 * 1024.0),
+        _ => (v, 1.0),
+    };
+    num.parse::<f64>()
+        .ok()
+        .filter(|x| x.is_finite() && *x >= 0.0)
+        .map(|x| x * scale)
+}
+
+/// Seconds of a Slurm time value (`MM`, `MM:SS`, `HH:MM:SS`, `D-HH`, `D-HH:MM`,
+/// `D-HH:MM:SS`); `None` for no limit (`infinite`, `UNLIMITED`) or what does not parse.
+pub fn time_seconds(v: &str) -> Option<u64> {
+    let v = v.trim();
+    let (days, rest) = match v.split_once('-') {
+        Some((d, r)) => (d.parse::<u64>().ok()?, Some(r)),
+        None => (0, None),
+    };
+    let parts: Vec<u64> = rest
+        .unwrap_or(v)
+        .split(':')
+        .map(|p| p.parse::<u64>().ok())
+        .collect::<Option<_>>()?;
+    let hms = match (rest.is_some(), parts.as_slice()) {
+        (false, [m]) => m * 60,
+        (false, [m, s]) => m * 60 + s,
+        (false, [h, m, s]) | (true, [h, m, s]) => h * 3600 + m * 60 + s,
+        (true, [h]) => h * 3600,
+        (true, [h, m]) => h * 3600 + m * 60,
+        _ => return None,
+    };
+    Some(days * 86400 + hms)
+}
+
+/// One node of a partition as `sinfo -h -N -o '%P|%c|%m|%l'` lists it.
+#[derive(Debug, Clone, PartialEq)]
+struct PartitionNode {
+    /// The partition (without the `*` of the default one).
+    partition: String,
+    /// Whether it is the default partition.
+    default: bool,
+    /// CPUs of the node.
+    cpus: u32,
+    /// Memory of the node in megabytes.
+    mem_mb: f64,
+    /// The partition's time limit in seconds (`None`: none).
+    time_limit: Option<u64>,
+}
+
+fn parse_sinfo(text: &str) -> Vec<PartitionNode> {
+    text.lines()
+        .filter_map(|l| {
+            let f: Vec<&str> = l.trim().split('|').collect();
+            let [p, c, m, t] = f.as_slice() else {
+                return None;
+            };
+            Some(PartitionNode {
+                partition: p.trim_end_matches('*').to_string(),
+                default: p.ends_with('*'),
+                cpus: c.trim_end_matches('+').parse().ok()?,
+                mem_mb: m.trim_end_matches('+').parse().ok()?,
+                time_limit: time_seconds(t),
+            })
+        })
+        .collect()
+}
+
+/// Refuses a stage whose request no node of its partition can give (more CPUs or memory
+/// than any node has, a time above the partition's limit): Slurm would queue it and it
+/// would wait forever. `sinfo` is the text of `sinfo -h -N -o '%P|%c|%m|%l'`.
+fn check_against(res: &BTreeMap<Stage, Resources>, stages: &[Stage], sinfo: &str) -> Result<()> {
+    let nodes = parse_sinfo(sinfo);
+    for stage in stages {
+        let Some(r) = res.get(stage) else { continue };
+        let name = stage.name();
+        let part: Vec<&PartitionNode> = nodes
+            .iter()
+            .filter(|n| match &r.partition {
+                Some(p) => &n.partition == p,
+                None => n.default,
+            })
+            .collect();
+        let which = r
+            .partition
+            .as_deref()
+            .map_or("the default partition".to_string(), |p| {
+                format!("partition {p}")
+            });
+        if part.is_empty() {
+            let mut known: Vec<&str> = nodes.iter().map(|n| n.partition.as_str()).collect();
+            known.dedup();
+            bail!(
+                "stage {name}: sinfo lists no node in {which} (partitions: {})",
+                known.join(", ")
+            );
+        }
+        let mem = mem_megabytes(&r.mem)
+            .with_context(|| format!("stage {name}: mem={} is not a Slurm memory size", r.mem))?;
+        let time = time_seconds(&r.time)
+            .with_context(|| format!("stage {name}: time={} is not a Slurm time", r.time))?;
+        if !part.iter().any(|n| n.cpus >= r.cpus && n.mem_mb >= mem) {
+            let most_cpus = part.iter().map(|n| n.cpus).max().unwrap_or(0);
+            let most_mem = part.iter().map(|n| n.mem_mb).fold(0.0, f64::max);
+            bail!(
+                "stage {name} asks for {} CPUs and {} of memory per task, more than any node of \
+                 {which} has (at most {most_cpus} CPUs, {most_mem:.0}M): Slurm would queue it \
+                 forever; lower it with --stage {name}:cpus=N,mem=SIZE or choose another \
+                 --partition",
+                r.cpus,
+                r.mem
+            );
+        }
+        if let Some(limit) = part.iter().filter_map(|n| n.time_limit).max()
+            && part.iter().all(|n| n.time_limit.is_some())
+            && time > limit
+        {
+            bail!(
+                "stage {name} asks for time={} ({time} s), above the time limit of {which} \
+                 ({limit} s): lower it with --stage {name}:time=...",
+                r.time
+            );
+        }
+    }
+    Ok(())
+}
+
+/// [`check_against`] the nodes `sinfo` (beside `sbatch`, else on PATH) lists.
+pub fn check_partitions(
+    res: &BTreeMap<Stage, Resources>,
+    stages: &[Stage],
+    sbatch: &str,
+) -> Result<()> {
+    let sinfo = slurm_program(sbatch, "sinfo");
+    let out = std::process::Command::new(&sinfo)
+        .args(["-h", "-N", "-o", "%P|%c|%m|%l"])
+        .output()
+        .with_context(|| {
+            format!(
+                "running {} to check the stages' resources against the partition",
+                sinfo.display()
+            )
+        })?;
+    if !out.status.success() {
+        bail!(
+            "{} failed ({}): {}",
+            sinfo.display(),
+            out.status,
+            String::from_utf8_lossy(&out.stderr).trim()
+        );
+    }
+    check_against(res, stages, &String::from_utf8_lossy(&out.stdout))
+}
+
 #[cfg(test)]
 #[allow(clippy::unwrap_used, clippy::expect_used)]
 mod tests {
     use super::*;
     use clap::Parser;
+
+    #[test]
+    fn slurm_sizes_and_times_parse() {
+        assert_eq!(mem_megabytes("8G"), Some(8192.0));
+        assert_eq!(mem_megabytes("500"), Some(500.0));
+        assert_eq!(mem_megabytes("1t"), Some(1048576.0));
+        assert_eq!(mem_megabytes("x"), None);
+        assert_eq!(time_seconds("30"), Some(1800));
+        assert_eq!(time_seconds("30:15"), Some(1815));
+        assert_eq!(time_seconds("04:00:00"), Some(14400));
+        assert_eq!(time_seconds("1-00:00:00"), Some(86400));
+        assert_eq!(time_seconds("2-3"), Some(2 * 86400 + 3 * 3600));
+        assert_eq!(time_seconds("infinite"), None);
+    }
+
+    #[test]
+    fn requests_above_every_node_of_the_partition_are_refused() {
+        let sinfo = "debug*|2|8000|infinite\nshort|16|64000|5:00:00\n";
+        let r = parse(&["--stage", "run:cpus=2,mem=7G"]).unwrap();
+        assert!(check_against(&r, &[Stage::Run], sinfo).is_ok());
+        let r = parse(&["--stage", "run:cpus=3"]).unwrap();
+        let e = format!("{:#}", check_against(&r, &[Stage::Run], sinfo).unwrap_err());
+        assert!(
+            e.contains("stage run asks for 3 CPUs") && e.contains("at most 2 CPUs"),
+            "{e}"
+        );
+        // the default 16G of memory fits no node of `debug`, every node of `short`
+        let r = parse(&["--stage", "run:cpus=1,partition=short"]).unwrap();
+        assert!(check_against(&r, &[Stage::Run], sinfo).is_ok());
+        let e = format!(
+            "{:#}",
+            check_against(&r, &[Stage::Collect], sinfo).unwrap_err()
+        );
+        assert!(
+            e.contains("16G of memory") && e.contains("default partition"),
+            "{e}"
+        );
+        let r = parse(&["--partition", "short", "--stage", "run:time=06:00:00"]).unwrap();
+        let e = format!("{:#}", check_against(&r, &[Stage::Run], sinfo).unwrap_err());
+        assert!(e.contains("above the time limit of partition short"), "{e}");
+        let r = parse(&["--partition", "gpu"]).unwrap();
+        let e = format!("{:#}", check_against(&r, &[Stage::Run], sinfo).unwrap_err());
+        assert!(
+            e.contains("no node in partition gpu (partitions: debug, short)"),
+            "{e}"
+        );
+    }
 
     #[derive(Parser)]
     struct T {

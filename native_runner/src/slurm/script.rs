@@ -117,11 +117,28 @@ pub fn sbatch_script(plan: &Plan, stage: Stage, res: &Resources) -> Result<Strin
             "${SLURM_ARRAY_TASK_ID}".to_string()
         }
     ));
+    let pgids = match stage {
+        Stage::Collect => "collect.pgids".to_string(),
+        _ => format!("{name}-${{SLURM_ARRAY_TASK_ID}}.pgids"),
+    };
     s.push_str(&format!(
-        "exec {} slurm-task --plan {} --stage {name} --index {index}\n",
+        "export {}={}/{pgids}\n",
+        crate::exec::PROCESS_GROUPS_VAR,
+        sbatch_path(&logs)?
+    ));
+    let task = format!(
+        "{} slurm-task --plan {} --stage {name} --index {index}",
         shell_quote(&plan.runner.to_string_lossy()),
         shell_quote(&Plan::path(&plan.out).to_string_lossy()),
-    ));
+    );
+    // A runner killed outside Slurm (SIGKILL by the kernel for memory) leaves its tools'
+    // process groups behind: the script ends them, says so in the log, and ends by the same
+    // signal, so that Slurm records it (ExitCode 0:<signal>).
+    s.push_str(&format!("{task} && exit 0\n"));
+    s.push_str("rc=$?\n");
+    s.push_str(&format!("{task} --ended \"$rc\" || true\n"));
+    s.push_str("if [ \"$rc\" -gt 128 ]; then kill -\"$((rc - 128))\" \"$$\"; fi\n");
+    s.push_str("exit \"$rc\"\n");
     Ok(s)
 }
 

@@ -34,6 +34,7 @@ use crate::generator::{find_blender_scripts, resolved_config};
 use crate::pipelines::{parse_customs, parse_list};
 use crate::report::{ReportArgs, report};
 use crate::run::run_batch;
+use crate::summary::{Executor, TaskWithoutResult};
 use crate::sweep::factor::{Factor, parse_factor};
 use crate::sweep::metrics::metric_file;
 use sfmeval_table::Row;
@@ -127,12 +128,27 @@ pub fn sweep(a: &SweepArgs) -> Result<()> {
         &pipes,
         &out,
         t0,
-        serde_json::json!({"datasets_seconds": render_seconds, "runs_seconds": runs_seconds}),
+        Execution {
+            executor: Executor::Local,
+            tasks_without_result: Vec::new(),
+            timing: serde_json::json!({"datasets_seconds": render_seconds, "runs_seconds": runs_seconds}),
+        },
     )
 }
 
+/// How a sweep's runs were executed, for `sweep.json`.
+pub struct Execution {
+    /// Where.
+    pub executor: Executor,
+    /// The Slurm tasks that left no result (none locally).
+    pub tasks_without_result: Vec<TaskWithoutResult>,
+    /// The times measured before the report (`datasets_seconds`, `runs_seconds`).
+    pub timing: serde_json::Value,
+}
+
 /// After the runs: evaluates them (unless no variant rendered) and writes `table/`,
-/// `sweep.csv`, `charts/`, `sweep.html` and `sweep.json` (`timing` plus the report's and the
+/// `sweep.csv`, `charts/`, `sweep.html` and `sweep.json` (where it ran, the Slurm tasks
+/// without result, `timing` plus the report's and the
 /// total seconds since `t0`).
 pub fn write_results(
     a: &SweepArgs,
@@ -141,8 +157,13 @@ pub fn write_results(
     pipes: &[String],
     out: &Path,
     t0: Instant,
-    timing: serde_json::Value,
+    execution: Execution,
 ) -> Result<()> {
+    let Execution {
+        executor,
+        tasks_without_result: without_result,
+        timing,
+    } = execution;
     let (factor, values) = (plan.factor, &plan.values);
     let runs = out.join("runs");
     let table_dir = out.join("table");
@@ -197,6 +218,8 @@ pub fn write_results(
         "base_generator_args": plan.base_args,
         "variants": variants,
         "pipelines": pipes,
+        "executor": executor,
+        "tasks_without_result": without_result,
         "metrics": metrics.iter().map(|m| serde_json::json!({"path": m.path, "label": m.label, "chart": metric_file(&m.path) + ".svg"})).collect::<Vec<_>>(),
         "command": command,
         "timing": timing,
