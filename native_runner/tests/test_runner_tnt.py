@@ -41,7 +41,7 @@ def test_runs_are_evaluated_with_the_protocol(scene_report, batch):
     assert "pycolmap" in ok and "colmap" in ok, rows
     for p in ok:
         rep = load(table / "reports" / batch["name"] / f"{p}.json")
-        assert rep["schema"] == "sfmeval.tanksandtemples/1"
+        assert rep["schema"] == "sfmeval.tanksandtemples/2"
         assert rep["protocol"]["tau"] == scene_report["tau"]
         assert rep["registration"]["mode"] == "protocol"
         assert rep["registration"]["trajectory_alignment"]["fitness"] > 0.9, p

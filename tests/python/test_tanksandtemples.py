@@ -140,6 +140,27 @@ def test_crops_equal_open3d(scene, sfmeval_bin, tmp_path):
     assert crop["kept"] == len(vol.crop_point_cloud(recon).points)
 
 
+def test_notes_are_typed(scene, sfmeval_bin, tmp_path):
+    """A reconstruction moved out of the crop: precision, recall and F are 0 and the report says
+    why in a typed note (code, level, values), which the summary prints at its level."""
+    far = scene["gt_from_recon"].copy()
+    far[:3, 3] += 1000.0 * scene["tau"]
+    transform = tmp_path / "far.txt"
+    np.savetxt(transform, far)
+    rep = ours(sfmeval_bin, scene, scene["recon"] / "dense.ply", tmp_path / "o", "--transform", transform)
+    assert rep["precision"]["value"] == rep["recall"]["value"] == rep["f_score"] == 0
+    codes = [n["code"] for n in rep["notes"]]
+    assert "tanksandtemples.nothing_in_crop" in codes, rep["notes"]
+    note = rep["notes"][codes.index("tanksandtemples.nothing_in_crop")]
+    assert note["level"] == "warning" and "crop" in note["message"]
+    p = subprocess.run([sfmeval_bin, "tnt", "--scene", str(scene["scene"]), "--recon",
+                        str(scene["recon"] / "dense.ply"), "--tau", str(scene["tau"]),
+                        "--transform", str(transform), "--out", str(tmp_path / "o2")],
+                       capture_output=True, text=True)
+    assert p.returncode == 0, p.stderr
+    assert f"warning: {note['message']}" in p.stdout, p.stdout
+
+
 def test_whole_protocol_within_half_a_point(scene, sfmeval_bin, tmp_path):
     recon = scene["recon"] / "dense.ply"
     theirs = toolbox("run", scene["scene"], scene["log"], recon, tmp_path / "toolbox", scene["tau"])

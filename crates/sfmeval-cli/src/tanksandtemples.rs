@@ -126,10 +126,7 @@ pub fn tnt_cmd(args: &TntArgs) -> Result<()> {
     };
     std::fs::create_dir_all(&out).with_context(|| format!("cannot create '{}'", out.display()))?;
     let mut evaluation = evaluation;
-    evaluation
-        .report
-        .warnings
-        .extend(recon.notes.into_iter().map(|n| n.message));
+    evaluation.report.notes.splice(0..0, recon.notes);
     let report = &evaluation.report;
     let json = evaluation.report_json();
     write_atomic(&out.join("report.json"), json.as_bytes())?;
@@ -179,8 +176,8 @@ fn summary(r: &tnt::TntReport, out: &Path) -> String {
         "  precision {:.4}  recall {:.4}  F-score {:.4}  ({} reconstruction / {} ground-truth points measured)\n",
         r.precision.value, r.recall.value, r.f_score, r.precision.points, r.recall.points
     );
-    for w in &r.warnings {
-        s += &format!("  note: {w}\n");
+    for n in &r.notes {
+        s += &format!("  {}: {}\n", n.level.as_str(), n.message);
     }
     s += &format!("  written to {}\n", out.display());
     s

@@ -23,6 +23,7 @@ use super::voxel::voxel_down_sample;
 use sfmeval::crop::{Axis, Volume};
 use sfmeval::distance::{KdCloud, NO_POINT};
 use sfmeval::geometry::Point3;
+use sfmeval::note::{Code, Note};
 use sfmeval::parallel;
 use sfmeval::progress::{Progress, Stage};
 use sfmeval::report::Tool;
@@ -187,7 +188,7 @@ pub fn evaluate(
             Ok(pts)
         }
     };
-    let mut warnings = Vec::new();
+    let mut notes = Vec::new();
 
     progress.start(Stage::Alignment, 5);
     let gt_cropped = nonempty(crop(&scene.ground_truth), "ground-truth")?;
@@ -252,11 +253,21 @@ pub fn evaluate(
             stage_results.push(StageResult::of_icp(source.len(), index.len(), &r, t));
             progress.advance(1);
             if aligned.fitness < 0.5 {
-                warnings.push(format!(
-                    "trajectory alignment: only {:.0} % of the cameras came within {} of the reference",
-                    100.0 * aligned.fitness,
-                    options.max_correspondence_distance
-                ));
+                notes.push(
+                    Note::new(
+                        Code::TrajectoryPoorlyAligned,
+                        format!(
+                            "trajectory alignment: only {:.0} % of the cameras came within {} of the reference",
+                            100.0 * aligned.fitness,
+                            options.max_correspondence_distance
+                        ),
+                    )
+                    .with_number("fitness", aligned.fitness)
+                    .with_number(
+                        "max_correspondence_distance",
+                        options.max_correspondence_distance,
+                    ),
+                );
             }
             let registered = trajectory
                 .iter()
@@ -286,9 +297,10 @@ pub fn evaluate(
     let precision_distances = nearest_distances(&precision_points, &gt_half_index, progress);
     progress.finish();
     let recall_distances = if precision_points.is_empty() {
-        warnings.push(
-            "no reconstructed point lies inside the crop: precision, recall and F are 0".into(),
-        );
+        notes.push(Note::new(
+            Code::NothingInSceneCrop,
+            "no reconstructed point lies inside the crop: precision, recall and F are 0",
+        ));
         Vec::new()
     } else {
         let recon_index = KdCloud::new(&precision_points)?;
@@ -396,7 +408,7 @@ pub fn evaluate(
             precision: precision_curve,
             recall: recall_curve,
         },
-        warnings,
+        notes,
     };
     Ok(TntEvaluation {
         report,

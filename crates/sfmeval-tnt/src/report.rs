@@ -1,4 +1,4 @@
-//! The protocol's report, `sfmeval.tanksandtemples/1`: the protocol and every parameter, the
+//! The protocol's report, `sfmeval.tanksandtemples/2`: the protocol and every parameter, the
 //! inputs, each registration step with its transform and score, precision / recall / F at the
 //! scene's τ, and the cumulative curves. Matrices are row-major 4×4.
 
@@ -7,10 +7,11 @@ use serde::{Deserialize, Serialize};
 use super::icp::{IcpCriteria, IcpResult};
 use super::matrix::Matrix4;
 use super::trajectory_alignment::{TrajectoryAlignment, TrajectoryAlignmentOptions};
+use sfmeval::note::Note;
 use sfmeval::report::Tool;
 
 /// Schema id of the report.
-pub const TNT_SCHEMA: &str = "sfmeval.tanksandtemples/1";
+pub const TNT_SCHEMA: &str = "sfmeval.tanksandtemples/2";
 
 /// The whole report.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -33,8 +34,9 @@ pub struct TntReport {
     pub f_score: f64,
     /// Cumulative distance curves (the toolbox's `cum_source` / `cum_target`).
     pub curves: CurvesSection,
-    /// Notes on the inputs.
-    pub warnings: Vec<String>,
+    /// What the reader should know besides the numbers: typed notes (`sfmeval::note`), the
+    /// reading's and the protocol's (`/1` had them as strings, in `warnings`).
+    pub notes: Vec<Note>,
 }
 
 /// The protocol's parameters.

@@ -170,6 +170,11 @@ codes! {
     NoTrackError = "measure.no_track_error", Info;
     /// No point could be measured by its track.
     NoTrackMeasured = "measure.no_track_measured", Warning;
+    // ---- Tanks and Temples --------------------------------------------------------------
+    /// The trajectory alignment brought fewer than half the cameras near the reference.
+    TrajectoryPoorlyAligned = "tanksandtemples.trajectory_poorly_aligned", Warning;
+    /// No reconstructed point lies inside the scene's crop: precision, recall and F are 0.
+    NothingInSceneCrop = "tanksandtemples.nothing_in_crop", Warning;
 }
 
 impl Serialize for Code {

@@ -393,7 +393,7 @@ impl Report {
 /// that variable the test fails when the file is stale.
 #[cfg(all(test, feature = "ts"))]
 mod typescript {
-    use std::collections::HashMap;
+    use std::collections::BTreeMap;
 
     use ts_rs::{Config, TS, TypeVisitor};
 
@@ -402,12 +402,13 @@ mod typescript {
     /// The package file, from this crate's folder.
     const FILE: &str = "../sfmeval-wasm/js/report.d.ts";
 
-    /// Every declarable type reachable from the visited ones, each once, in the order first met.
+    /// Every declarable type reachable from the visited ones, each once, by name: the file lists
+    /// them `Report` first, then by name, so that its text depends on the types alone (ts-rs
+    /// visits dependencies in an order that changes with the build, e.g. the checkout's path).
     struct Declarations<'a> {
         cfg: &'a Config,
-        /// Declarations by name.
-        seen: HashMap<String, String>,
-        out: String,
+        /// The declaration text (doc comment, `export type ...`) by name.
+        by_name: BTreeMap<String, (String, String)>,
     }
 
     impl TypeVisitor for Declarations<'_> {
@@ -418,25 +419,19 @@ mod typescript {
             }
             // one declaration a name (serde_json's `Value` and `Map` both declare `JsonValue`)
             let decl = T::decl(self.cfg);
-            match self.seen.get(&T::ident(self.cfg)) {
-                Some(earlier) => {
-                    assert_eq!(
-                        *earlier,
-                        decl,
-                        "two report types named {}",
-                        T::ident(self.cfg)
-                    );
-                    return;
-                }
-                None => self.seen.insert(T::ident(self.cfg), decl.clone()),
-            };
-            self.out.push('\n');
-            if let Some(docs) = T::docs() {
-                self.out.push_str(&docs);
+            let name = T::ident(self.cfg);
+            if let Some((earlier, _)) = self.by_name.get(&name) {
+                assert_eq!(*earlier, decl, "two report types named {name}");
+                return;
             }
-            self.out.push_str("export ");
-            self.out.push_str(&decl);
-            self.out.push('\n');
+            let mut text = String::from("\n");
+            if let Some(docs) = T::docs() {
+                text.push_str(&docs);
+            }
+            text.push_str("export ");
+            text.push_str(&decl);
+            text.push('\n');
+            self.by_name.insert(name, (decl, text));
             T::visit_dependencies(self);
         }
     }
@@ -446,18 +441,19 @@ mod typescript {
         let cfg = Config::new().with_large_int("number");
         let mut d = Declarations {
             cfg: &cfg,
-            seen: HashMap::new(),
-            out: format!(
-                "// The `{REPORT_SCHEMA}` report's types, generated from the Rust types of\n\
-                 // crates/sfmeval (feature `ts`, ts-rs) by scripts/gen-report-types.sh: do not edit.\n"
-            ),
+            by_name: BTreeMap::new(),
         };
         d.visit::<Report>();
+        let mut out = format!(
+            "// The `{REPORT_SCHEMA}` report's types, generated from the Rust types of\n\
+             // crates/sfmeval (feature `ts`, ts-rs) by scripts/gen-report-types.sh: do not edit.\n"
+        );
+        let report = d.by_name.remove("Report");
+        for (_, text) in report.into_iter().chain(d.by_name.into_values()) {
+            out.push_str(&text);
+        }
         // ts-rs leaves a space at the end of each field's line
-        d.out
-            .lines()
-            .map(|l| format!("{}\n", l.trim_end()))
-            .collect()
+        out.lines().map(|l| format!("{}\n", l.trim_end())).collect()
     }
 
     #[test]
