@@ -24,5 +24,6 @@ fi
 if [ -d crates/sfmeval-py/examples ]; then
   mypy=${MYPY:-.venv/bin/mypy}
   MYPYPATH= "$mypy" --strict --python-executable "$venv/bin/python" crates/sfmeval-py/examples
+  for example in crates/sfmeval-py/examples/*.py; do "$venv/bin/python" "$example" . >/dev/null; done
 fi
 echo "check-python-package: done in $((SECONDS - t0)) s"

@@ -16,7 +16,9 @@ import numpy as np
 
 from ._sfmeval import InputError, _evaluate, align_modes, version
 
-__all__ = ["InputError", "Note", "Report", "Section", "align_modes", "evaluate", "version"]
+__all__ = [
+    "InputError", "Note", "Report", "Section", "PathLike", "align_modes", "evaluate", "version",
+]
 __version__: str = version()
 
 PathLike = Union[str, "os.PathLike[str]"]
