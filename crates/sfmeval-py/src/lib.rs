@@ -18,6 +18,7 @@ use sfmeval::align::{AlignMode, AlignRequest, PointPair, parse_point_pairs};
 use sfmeval::crop::Crop;
 use sfmeval::dataset::{DatasetPaths, Part};
 use sfmeval::evaluate::{EvalOptions, PointStatus};
+use sfmeval::export;
 use sfmeval::io::ReadLimits;
 use sfmeval::model;
 use sfmeval::pipeline::{self, EvalRequest, ReconInput};
@@ -78,6 +79,7 @@ fn existing(path: &Path) -> Result<&Path, Failure> {
 struct Inputs {
     gt: PathBuf,
     recon: PathBuf,
+    recon_points: Option<Vec<[f64; 3]>>,
     name: Option<String>,
     gt_cameras: Option<PathBuf>,
     recon_cameras: Option<PathBuf>,
@@ -155,6 +157,16 @@ fn dataset_paths(inputs: &Inputs) -> Result<DatasetPaths, Failure> {
 
 /// The reconstruction, read as `sfmeval eval --recon [--recon-cameras]` reads it.
 fn read_recon(inputs: &Inputs) -> Result<ReconInput, Failure> {
+    if let Some(points) = &inputs.recon_points {
+        // an array from Python: the float64 PLY `sfmeval export` writes, read as that file is
+        let name = inputs
+            .name
+            .clone()
+            .unwrap_or_else(|| "points.ply".to_string());
+        let files = [(name.clone(), export::points_ply_f64(points, None))].into();
+        return Ok(pipeline::read_reconstruction(&name, &files)
+            .with_context(|| format!("reconstruction '{name}' (an array of points)"))?);
+    }
     let recon = existing(&inputs.recon)?;
     let name = inputs.name.clone().unwrap_or_else(|| name_of(recon));
     let Some(cameras_path) = &inputs.recon_cameras else {
@@ -182,6 +194,28 @@ fn native_bytes(values: &[f64]) -> Vec<u8> {
     values.iter().flat_map(|v| v.to_ne_bytes()).collect()
 }
 
+/// `x0 y0 z0 x1 ...` float64 in native order (a C-contiguous `(N, 3)` numpy array's bytes).
+fn points_of(bytes: &[u8]) -> PyResult<Vec<[f64; 3]>> {
+    if !bytes.len().is_multiple_of(24) {
+        return Err(InputError::new_err(format!(
+            "recon: {} bytes are not whole points of three float64",
+            bytes.len()
+        )));
+    }
+    Ok(bytes
+        .chunks_exact(24)
+        .map(|p| {
+            let mut xyz = [0.0; 3];
+            for (v, b) in xyz.iter_mut().zip(p.chunks_exact(8)) {
+                let mut word = [0u8; 8];
+                word.copy_from_slice(b);
+                *v = f64::from_ne_bytes(word);
+            }
+            xyz
+        })
+        .collect())
+}
+
 /// The whole evaluation, without the GIL: the CLI's `eval` on the same inputs.
 fn evaluate_inputs(inputs: &Inputs) -> Result<Outcome, Failure> {
     let eval = EvalOptions {
@@ -203,14 +237,17 @@ fn evaluate_inputs(inputs: &Inputs) -> Result<Outcome, Failure> {
     let limits = ReadLimits::triangles(inputs.max_triangles);
     let mut dataset = sfmeval_fs::read_dataset(&paths, &limits)?;
     let recon = read_recon(inputs)?;
+    let what = match &inputs.recon_points {
+        Some(_) => recon.name.clone(),
+        None => inputs.recon.display().to_string(),
+    };
     let evaluation =
         pipeline::run_owned(&mut dataset, recon, &request, &NoProgress).map_err(|e| {
             match (&inputs.pairs, e.concerns_point_pairs()) {
                 (Some(p), true) => {
                     anyhow::Error::new(e).context(format!("point pairs '{}'", p.display()))
                 }
-                _ => anyhow::Error::new(e)
-                    .context(format!("evaluating '{}'", inputs.recon.display())),
+                _ => anyhow::Error::new(e).context(format!("evaluating '{what}'")),
             }
         })?;
     Ok(Outcome {
@@ -239,7 +276,7 @@ type Returned<'py> = (
 /// kept flag per point (uint8). Arguments are the wrapper's normalised ones
 /// (`python/sfmeval/__init__.py`).
 #[pyfunction]
-#[pyo3(signature = (gt, recon, *, name=None, gt_cameras=None, recon_cameras=None, align=None,
+#[pyo3(signature = (gt, recon, *, recon_points=None, name=None, gt_cameras=None, recon_cameras=None, align=None,
     transform_path=None, transform_json=None, pairs=None, crop_path=None, crop_json=None,
     max_distance=None, tau=Vec::new(), tau_percent=Vec::new(),
     samples=sfmeval::evaluate::DEFAULT_SAMPLES, seed=0, signed=false,
@@ -249,6 +286,7 @@ fn _evaluate<'py>(
     py: Python<'py>,
     gt: PathBuf,
     recon: PathBuf,
+    recon_points: Option<Vec<u8>>,
     name: Option<String>,
     gt_cameras: Option<PathBuf>,
     recon_cameras: Option<PathBuf>,
@@ -266,9 +304,11 @@ fn _evaluate<'py>(
     signed: bool,
     max_triangles: u64,
 ) -> PyResult<Returned<'py>> {
+    let recon_points = recon_points.map(|bytes| points_of(&bytes)).transpose()?;
     let inputs = Inputs {
         gt,
         recon,
+        recon_points,
         name,
         gt_cameras,
         recon_cameras,

@@ -247,3 +247,54 @@ def test_align_modes_and_version_are_the_cores():
     assert "auto" in modes and "cameras+icp" in modes
     p = subprocess.run([str(BIN), "--version"], capture_output=True, text=True)
     assert p.stdout.split()[-1] == sfmeval.version() == sfmeval.__version__
+
+
+def export_points(tmp_path: Path, recon: Path) -> tuple[Path, np.ndarray]:
+    """`sfmeval export`'s float64 PLY of a reconstruction and its points read with numpy."""
+    out = tmp_path / "export"
+    p = subprocess.run([str(BIN), "export", str(recon), "--out", str(out)], capture_output=True,
+                       text=True)
+    assert p.returncode == 0, p.stderr
+    data = (out / "points.ply").read_bytes()
+    end = data.index(b"end_header\n") + len(b"end_header\n")
+    header = data[:end].decode()
+    count = int(header.split("element vertex ")[1].split()[0])
+    fields = [("x", "<f8"), ("y", "<f8"), ("z", "<f8")]
+    if "property uchar red" in header:
+        fields += [("red", "u1"), ("green", "u1"), ("blue", "u1")]
+    rows = np.frombuffer(data, dtype=np.dtype(fields), count=count, offset=end)
+    return out / "points.ply", np.stack([rows["x"], rows["y"], rows["z"]], axis=1)
+
+
+@pytest.mark.parametrize("dtype", [np.float64, np.float32])
+def test_points_array_gives_the_report_of_the_same_points_as_a_file(tmp_path, dtype):
+    ply, points = export_points(tmp_path, DEMO / "sparse.ply")
+    points = points.astype(dtype)
+    if dtype == np.float32:
+        # the file the CLI reads holds the float32 values widened, as the array's are
+        ply = tmp_path / "points.ply"
+        header = (f"ply\nformat binary_little_endian 1.0\nelement vertex {len(points)}\n"
+                  "property double x\nproperty double y\nproperty double z\nend_header\n")
+        ply.write_bytes(header.encode() + points.astype("<f8").tobytes())
+    transform = tmp_path / "transform.json"
+    transform.write_text(json.dumps(DEMO_START))
+    want = cli_report(tmp_path, "--gt", DEMO / "ground_truth.glb", "--recon", ply,
+                      "--transform", transform, "--samples", 50_000)
+    r = sfmeval.evaluate(DEMO / "ground_truth.glb", points, transform=DEMO_START,
+                         samples=50_000)
+    assert r.to_json().encode() == want
+    assert r.inputs.reconstruction.points == len(points)
+    # Fortran order and a strided view are the same points
+    f = sfmeval.evaluate(DEMO / "ground_truth.glb", np.asfortranarray(points),
+                         transform=DEMO_START, samples=50_000)
+    assert f.to_json() == r.to_json()
+
+
+def test_bad_points_arrays_are_input_errors():
+    for bad in [np.zeros((4, 2)), np.zeros(9), np.zeros((3, 3), dtype=np.int64)]:
+        with pytest.raises(sfmeval.InputError, match="recon"):
+            sfmeval.evaluate(DEMO / "ground_truth.glb", bad, align="none")
+    nan = np.zeros((5, 3))
+    nan[2, 1] = np.nan
+    with pytest.raises(sfmeval.InputError, match="non-finite"):
+        sfmeval.evaluate(DEMO / "ground_truth.glb", nan, align="none")

@@ -183,7 +183,7 @@ def _floats(value: Union[None, float, Sequence[float]]) -> List[float]:
 
 def evaluate(
     gt: PathLike,
-    recon: PathLike,
+    recon: Union[PathLike, np.ndarray],
     *,
     gt_cameras: Optional[PathLike] = None,
     recon_cameras: Optional[PathLike] = None,
@@ -206,7 +206,8 @@ def evaluate(
     ``gt`` is a GLB, glTF, OBJ or PLY file, or a dataset folder (``ground_truth.glb``, with its
     ``cameras.json`` and ``depth/`` when present, as ``--dataset``). ``recon`` is a PLY cloud, a
     COLMAP model folder, an ``.nvm``, a Bundler ``.out``, an OpenMVG ``sfm_data.json`` or a
-    ``cameras.json``. ``align`` is one of ``align_modes()`` (default: ``given`` with a
+    ``cameras.json``, or an ``(N, 3)`` float32/float64 array of points (evaluated as the float64
+    PLY ``sfmeval export`` writes, named ``name``, default ``points.ply``). ``align`` is one of ``align_modes()`` (default: ``given`` with a
     ``transform``, else ``auto``). ``transform`` is a file or a 4×4 ``gt_from_recon``; ``crop``
     a crop file or its JSON as a dict. The GIL is released while the core works.
 
@@ -226,9 +227,22 @@ def evaluate(
         crop_path = os.fspath(crop)
     elif crop is not None:
         crop_json = json.dumps(dict(crop))
+    recon_points: Optional[bytes] = None
+    recon_path: Optional[str]
+    if isinstance(recon, (str, os.PathLike)):
+        recon_path = os.fspath(recon)
+    else:
+        points = np.asarray(recon)
+        if points.ndim != 2 or points.shape[1] != 3 or points.dtype.kind != "f":
+            raise InputError(
+                f"recon: an (N, 3) array of floats is needed, got shape {points.shape} of {points.dtype}"
+            )
+        recon_points = np.ascontiguousarray(points, dtype=np.float64).tobytes()
+        recon_path = ""
     report_json, distances, signed_bytes, kept = _evaluate(
         _path(gt, "gt"),
-        _path(recon, "recon"),
+        recon_path,
+        recon_points=recon_points,
         name=name,
         gt_cameras=_path(gt_cameras, "gt_cameras"),
         recon_cameras=_path(recon_cameras, "recon_cameras"),

@@ -9,6 +9,7 @@ def _evaluate(
     gt: str,
     recon: str,
     *,
+    recon_points: Optional[bytes] = ...,
     name: Optional[str] = ...,
     gt_cameras: Optional[str] = ...,
     recon_cameras: Optional[str] = ...,
