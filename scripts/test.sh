@@ -102,6 +102,10 @@ while read -r line; do skip "bench-compare-quick" "$line"; done < <(
 # The Tanks and Temples protocol against the benchmark's own toolbox, quick mode.
 check bench-tnt-quick .venv/bin/python bench/tanksandtemples.py --quick
 
+# The Python package (crates/sfmeval-py): its wheel built, installed in a fresh venv and tested
+# against the CLI's reports byte for byte.
+check python-package scripts/check-python-package.sh
+
 # Python tests (reference tools, real files).
 export SFMEVAL_BIN="$PWD/target/release/sfmeval" SFMEVAL_RUNNER_BIN="$PWD/target/release/sfmeval-runner"
 pytest_dirs=()
