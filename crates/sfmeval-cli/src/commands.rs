@@ -7,7 +7,7 @@ use anyhow::{Context as _, Result, bail};
 use clap::builder::PossibleValuesParser;
 use clap::{Args, Parser, Subcommand};
 use sfmeval::AlignInputProblem;
-use sfmeval::align::{AlignMode, AlignRequest, PointPair, parse_point_pairs};
+use sfmeval::align::{AlignMode, AlignRequest, PointPair};
 use sfmeval::crop::{Crop, Volume};
 use sfmeval::dataset::{Dataset, DatasetPaths, Part};
 use sfmeval::evaluate::{DEFAULT_SAMPLES, EvalOptions};
@@ -17,8 +17,10 @@ use sfmeval::io::{self, ReadLimits};
 use sfmeval::model;
 use sfmeval::pipeline::{self, EvalRequest, ReconInput, read_reconstruction};
 use sfmeval::pose::PoseOptions;
-use sfmeval::transform::Similarity;
-use sfmeval_fs::{Disk, name_of, path_str, read, read_input_files, write_atomic};
+use sfmeval_fs::{
+    Disk, name_of, path_str, read, read_input_files, read_point_pairs,
+    read_reconstruction_with_cameras, read_transform, write_atomic,
+};
 
 use crate::concurrent::side_by_side;
 use crate::progress::Bars;
@@ -338,17 +340,11 @@ fn crop_from_args(args: &EvalArgs) -> Result<Crop> {
     Ok(crop)
 }
 
-/// Reads a `gt_from_recon` file (JSON or 16 numbers), naming it in errors.
-fn read_transform(path: &Path) -> Result<Similarity> {
-    Similarity::parse(&read(path)?).with_context(|| format!("transform file '{}'", path.display()))
-}
-
 /// The alignment request of `--align`, `--transform` and `--pairs`.
 fn align_request(input: &InputArgs) -> Result<AlignRequest> {
     let transform = input.transform.as_deref().map(read_transform).transpose()?;
     let pairs: Vec<PointPair> = match &input.pairs {
-        Some(p) => parse_point_pairs(&read(p)?)
-            .with_context(|| format!("point pairs '{}'", p.display()))?,
+        Some(p) => read_point_pairs(p)?,
         None => Vec::new(),
     };
     let mode = input.align.as_deref().map(AlignMode::parse).transpose()?;
@@ -418,19 +414,7 @@ fn run_error(e: sfmeval::Error, input: &InputArgs) -> anyhow::Error {
 /// in pieces, so a dense cloud is never in memory twice (file bytes and points).
 fn read_recon(input: &InputArgs) -> Result<ReconInput> {
     let name = input.name.clone().unwrap_or_else(|| name_of(&input.recon));
-    read_recon_at(&input.recon, input.recon_cameras.as_deref(), &name)
-}
-
-/// Reads the reconstruction at `recon`, with the cameras of the model at `cameras_path`.
-fn read_recon_at(recon: &Path, cameras_path: Option<&Path>, name: &str) -> Result<ReconInput> {
-    let Some(cameras_path) = cameras_path else {
-        return sfmeval_fs::read_reconstruction(recon, name);
-    };
-    let files = read_input_files(recon)?;
-    let cameras = model::read_model_files(&read_input_files(cameras_path)?)
-        .with_context(|| format!("reconstruction cameras '{}'", cameras_path.display()))?;
-    pipeline::read_reconstruction_with_cameras(name, &files, cameras, &name_of(cameras_path))
-        .with_context(|| format!("reconstruction '{}'", recon.display()))
+    read_reconstruction_with_cameras(&input.recon, input.recon_cameras.as_deref(), &name)
 }
 
 /// `sfmeval export`: the points `eval` would evaluate (camera-centre points removed, in the
@@ -438,7 +422,7 @@ fn read_recon_at(recon: &Path, cameras_path: Option<&Path>, name: &str) -> Resul
 /// reconstruction's frame. Without cameras, a cameras.json left in DIR by an earlier export is
 /// removed (the folder never mixes two reconstructions).
 fn export_cmd(args: &ExportArgs) -> Result<()> {
-    let recon = read_recon_at(
+    let recon = read_reconstruction_with_cameras(
         &args.recon,
         args.recon_cameras.as_deref(),
         &name_of(&args.recon),

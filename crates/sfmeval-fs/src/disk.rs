@@ -4,9 +4,11 @@ use std::collections::BTreeMap;
 use std::path::Path;
 
 use anyhow::{Context as _, Result};
+use sfmeval::align::{PointPair, parse_point_pairs};
 use sfmeval::dataset::{Dataset, DatasetPaths};
 use sfmeval::files::FileSource;
 use sfmeval::io::ReadLimits;
+use sfmeval::transform::Similarity;
 
 /// The real filesystem. Paths are read as given (relative to the working directory or
 /// absolute).
@@ -107,6 +109,16 @@ pub fn image_names(dir: &Path) -> Result<Vec<String>> {
 /// Reads a ground truth and its optional parts from disk ([`Dataset::read_with_limits`]).
 pub fn read_dataset(paths: &DatasetPaths, limits: &ReadLimits) -> Result<Dataset> {
     Ok(Dataset::read_with_limits(&Disk, paths, limits)?)
+}
+
+/// The `gt_from_recon` file at `path` (JSON or 16 numbers); errors name it.
+pub fn read_transform(path: &Path) -> Result<Similarity> {
+    Similarity::parse(&read(path)?).with_context(|| format!("transform file '{}'", path.display()))
+}
+
+/// The point pairs file at `path`; errors name it.
+pub fn read_point_pairs(path: &Path) -> Result<Vec<PointPair>> {
+    parse_point_pairs(&read(path)?).with_context(|| format!("point pairs '{}'", path.display()))
 }
 
 #[cfg(test)]

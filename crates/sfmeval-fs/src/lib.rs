@@ -10,6 +10,7 @@ mod write;
 
 pub use disk::{
     Disk, IMAGE_EXTENSIONS, image_names, name_of, path_str, read, read_dataset, read_input_files,
+    read_point_pairs, read_transform,
 };
-pub use stream::read_reconstruction;
+pub use stream::{read_reconstruction, read_reconstruction_with_cameras};
 pub use write::write_atomic;

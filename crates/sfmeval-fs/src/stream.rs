@@ -8,6 +8,7 @@ use std::path::Path;
 use anyhow::{Context as _, Result};
 use sfmeval::io::ply::PlyData;
 use sfmeval::io::ply_stream::{HEAD_BYTES, PlyCloudStream};
+use sfmeval::model;
 use sfmeval::pipeline::{self, ReconInput};
 
 use crate::disk::{name_of, read_input_files};
@@ -59,6 +60,23 @@ pub fn read_reconstruction(path: &Path, name: &str) -> Result<ReconInput> {
         return Ok(pipeline::reconstruction_from_cloud(name, loaded));
     }
     pipeline::read_reconstruction(name, &read_input_files(path)?).with_context(context)
+}
+
+/// [`read_reconstruction`], with the cameras of the model at `cameras_path` when given (a PLY
+/// cloud evaluated with the cameras of the SfM model beside it, `--recon-cameras`).
+pub fn read_reconstruction_with_cameras(
+    path: &Path,
+    cameras_path: Option<&Path>,
+    name: &str,
+) -> Result<ReconInput> {
+    let Some(cameras_path) = cameras_path else {
+        return read_reconstruction(path, name);
+    };
+    let files = read_input_files(path)?;
+    let cameras = model::read_model_files(&read_input_files(cameras_path)?)
+        .with_context(|| format!("reconstruction cameras '{}'", cameras_path.display()))?;
+    pipeline::read_reconstruction_with_cameras(name, &files, cameras, &name_of(cameras_path))
+        .with_context(|| format!("reconstruction '{}'", path.display()))
 }
 
 /// Whether `path` is a file named `*.ply` (any case).

@@ -14,18 +14,19 @@ use pyo3::create_exception;
 use pyo3::exceptions::{PyFileNotFoundError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::PyBytes;
-use sfmeval::align::{AlignMode, AlignRequest, PointPair, parse_point_pairs};
+use sfmeval::align::{AlignMode, AlignRequest, PointPair};
 use sfmeval::crop::Crop;
 use sfmeval::dataset::{DatasetPaths, Part};
 use sfmeval::evaluate::{EvalOptions, PointStatus};
 use sfmeval::export;
 use sfmeval::io::ReadLimits;
-use sfmeval::model;
 use sfmeval::pipeline::{self, EvalRequest, ReconInput};
 use sfmeval::pose::PoseOptions;
 use sfmeval::progress::NoProgress;
 use sfmeval::transform::Similarity;
-use sfmeval_fs::{name_of, path_str, read, read_input_files};
+use sfmeval_fs::{
+    name_of, path_str, read, read_point_pairs, read_reconstruction_with_cameras, read_transform,
+};
 
 create_exception!(
     sfmeval,
@@ -119,16 +120,12 @@ fn crop_of(inputs: &Inputs) -> Result<Crop, Failure> {
 /// else `auto`).
 fn align_of(inputs: &Inputs) -> Result<AlignRequest, Failure> {
     let transform = match (&inputs.transform_path, &inputs.transform_json) {
-        (Some(path), _) => Some(
-            Similarity::parse(&read(existing(path)?)?)
-                .with_context(|| format!("transform file '{}'", path.display()))?,
-        ),
+        (Some(path), _) => Some(read_transform(existing(path)?)?),
         (None, Some(text)) => Some(Similarity::parse(text.as_bytes()).context("transform")?),
         (None, None) => None,
     };
     let pairs: Vec<PointPair> = match &inputs.pairs {
-        Some(p) => parse_point_pairs(&read(existing(p)?)?)
-            .with_context(|| format!("point pairs '{}'", p.display()))?,
+        Some(p) => read_point_pairs(existing(p)?)?,
         None => Vec::new(),
     };
     let mode = inputs
@@ -169,17 +166,12 @@ fn read_recon(inputs: &Inputs) -> Result<ReconInput, Failure> {
     }
     let recon = existing(&inputs.recon)?;
     let name = inputs.name.clone().unwrap_or_else(|| name_of(recon));
-    let Some(cameras_path) = &inputs.recon_cameras else {
-        return Ok(sfmeval_fs::read_reconstruction(recon, &name)?);
-    };
-    let cameras_path = existing(cameras_path)?;
-    let files = read_input_files(recon)?;
-    let cameras = model::read_model_files(&read_input_files(cameras_path)?)
-        .with_context(|| format!("reconstruction cameras '{}'", cameras_path.display()))?;
-    Ok(
-        pipeline::read_reconstruction_with_cameras(&name, &files, cameras, &name_of(cameras_path))
-            .with_context(|| format!("reconstruction '{}'", recon.display()))?,
-    )
+    let cameras_path = inputs.recon_cameras.as_deref().map(existing).transpose()?;
+    Ok(read_reconstruction_with_cameras(
+        recon,
+        cameras_path,
+        &name,
+    )?)
 }
 
 /// What one evaluation hands back to Python.
