@@ -180,6 +180,37 @@ def test_whole_protocol_within_half_a_point(scene, sfmeval_bin, tmp_path):
     assert np.median(np.linalg.norm(moved - expected, axis=1)) < 2 * scene["tau"]
 
 
+def test_trajectory_longer_than_the_reference_as_the_toolbox(scene, sfmeval_bin, tmp_path):
+    """A `.log` with frames beyond the reference's (here four of its frames again at the end):
+    the toolbox pairs the first frames with the reference's and scores every frame; so do we."""
+    lines = scene["log"].read_text().splitlines(keepends=True)
+    longer = tmp_path / "longer.log"
+    longer.write_text("".join(lines + lines[:4 * 5]))
+    recon = scene["recon"] / "dense.ply"
+    theirs = toolbox("run", scene["scene"], longer, recon, tmp_path / "toolbox", scene["tau"])
+    rep = ours(sfmeval_bin, scene, recon, tmp_path / "ours", "--trajectory", longer)
+    reg = rep["registration"]
+    # the repeated frames lie on their reference centres: all 40 count and all match
+    assert reg["trajectory_alignment"]["fitness"] == 1.0, reg["trajectory_alignment"]
+    for key, mine in [("precision", rep["precision"]["value"]), ("recall", rep["recall"]["value"]),
+                      ("f_score", rep["f_score"])]:
+        assert abs(mine - theirs[key]) <= 0.005, (key, mine, theirs[key])
+    # The precision/recall plot under the toolbox's name, as SVG and PNG.
+    from PIL import Image
+    import xml.etree.ElementTree as ET
+    stems = {p.stem for p in (tmp_path / "toolbox").glob("PR_*.png")}
+    assert stems and stems == {p.stem for p in (tmp_path / "ours").glob("PR_*.png")}
+    stem = stems.pop()
+    assert Image.open(tmp_path / "ours" / f"{stem}.png").size == (720, 480)
+    svg = ET.parse(tmp_path / "ours" / f"{stem}.svg").getroot()
+    paths = [e for e in svg.iter() if e.tag.endswith("path")]
+    # one vertex per curve value, for each of the two curves
+    assert [len(p.get("d").split("L")) for p in paths] == [len(rep["curves"]["precision"]),
+                                                           len(rep["curves"]["recall"])]
+    title = "".join(e.text or "" for e in svg.iter() if e.tag.endswith("text"))
+    assert f"{rep['f_score'] * 100:.2f} f-score" in title
+
+
 def test_errors_name_the_file(scene, sfmeval_bin, tmp_path):
     import shutil
 

@@ -3,7 +3,7 @@
 //! precision, recall and F-score compare with the benchmark's leaderboard: the scene's files
 //! ([`scene`]), the `.log` trajectories ([`trajectory`]), the trajectory alignment, the three
 //! ICP refinements, crop, voxel down-sampling, distances both ways, the scores and curves
-//! ([`curves`]) and the coloured clouds.
+//! ([`curves`]), the coloured clouds and the precision/recall plot ([`pr_svg`]).
 //!
 //! Where sfmeval can differ from the toolbox at all: the trajectory alignment is a RANSAC over
 //! random samples (seeded here, unseeded in the toolbox), so the final transform can differ
@@ -15,6 +15,7 @@ mod colors;
 pub mod curves;
 mod icp;
 pub mod matrix;
+mod plot;
 mod protocol;
 mod report;
 pub mod scene;
@@ -24,6 +25,9 @@ mod voxel;
 
 pub use colors::hot_r;
 pub use icp::IcpCriteria;
+#[cfg(feature = "png")]
+pub use plot::svg_to_png;
+pub use plot::{PLOT_SIZE, plot_stem, pr_svg};
 pub use protocol::{
     PLOT_STRETCH, Registration, TntEvaluation, TntRequest, UNIFORM_MAX_POINTS, evaluate,
 };

@@ -15,6 +15,7 @@ use super::colors;
 use super::curves::{self, Scores};
 use super::icp::{IcpCriteria, registration_icp};
 use super::matrix::{self, Matrix4};
+use super::plot;
 use super::report::*;
 use super::scene::{Scene, scene_tau};
 use super::trajectory::{LogFrame, MAPPING_ABOVE_FRAMES};
@@ -105,7 +106,8 @@ impl TntEvaluation {
 
     /// Every file the toolbox writes beside the report, by file name, encoded (the two clouds
     /// side by side): `<scene>.precision.ply`, `<scene>.recall.ply`, the curves and
-    /// `<scene>.prf_tau_plotstr.txt`. What `sfmeval tnt` writes into its output folder and the
+    /// `<scene>.prf_tau_plotstr.txt`, and the precision/recall plot `PR_<scene>_@d_th_0_<τ>.svg`
+    /// (and `.png` with the `png` feature, where the system has a font). What `sfmeval tnt` writes into its output folder and the
     /// runner into a run's report folder.
     pub fn output_files(&self) -> Vec<(String, Vec<u8>)> {
         let name = &self.report.protocol.scene;
@@ -117,6 +119,13 @@ impl TntEvaluation {
         for (suffix, text) in self.toolbox_texts() {
             files.push((format!("{name}{suffix}"), text.into_bytes()));
         }
+        let stem = plot::plot_stem(name, self.report.protocol.tau);
+        let svg = plot::pr_svg(&self.report);
+        #[cfg(feature = "png")]
+        if let Some(png) = plot::svg_to_png(&svg) {
+            files.push((format!("{stem}.png"), png));
+        }
+        files.push((format!("{stem}.svg"), svg.into_bytes()));
         files
     }
 

@@ -62,17 +62,21 @@ pub struct TrajectoryAlignment {
     pub iterations: u32,
 }
 
-/// Aligns `recon_centers` to `reference_in_gt` (same length, frame `i` ↔ frame `i`).
+/// Aligns `recon_centers` to `reference_in_gt`, frame `i` ↔ frame `i`, as the toolbox's
+/// correspondence RANSAC does: samples pair the first `reference_in_gt.len()` frames with the
+/// reference's, and every reconstruction centre counts in the fitness (matched centres over all
+/// of them), so a trajectory with frames beyond the reference's is scored with its extra
+/// frames, as the toolbox scores it. Fewer frames than the reference is an error.
 pub fn align_trajectories(
     recon_centers: &[Point3],
     reference_in_gt: &[Point3],
     options: &TrajectoryAlignmentOptions,
 ) -> Result<TrajectoryAlignment> {
     let n = reference_in_gt.len();
-    if recon_centers.len() != n {
+    let m = recon_centers.len();
+    if m < n {
         return Err(Error::InvalidContent(format!(
-            "the trajectory has {} frames and the reference trajectory {n}: the .log needs one frame per reference image, in the reference's order",
-            recon_centers.len()
+            "the trajectory has {m} frames and the reference trajectory {n}: the .log needs one frame per reference image, in the reference's order"
         )));
     }
     if n < options.ransac_n || options.ransac_n < 3 || options.max_iterations == 0 {
@@ -103,7 +107,7 @@ pub fn align_trajectories(
                 error2 += d2;
             }
             if let Some((best_matched, best_error2)) = bound {
-                let reachable = matched + (n - k - 1);
+                let reachable = matched + (m - k - 1);
                 if reachable < best_matched || (reachable == best_matched && error2 > best_error2) {
                     return None;
                 }
@@ -132,7 +136,7 @@ pub fn align_trajectories(
         }
     }
     let (best, scores) = best.map_or((0, (0, 0.0)), |b| b);
-    let (fitness, inlier_rmse) = (scores.0 as f64 / n as f64, rmse(scores));
+    let (fitness, inlier_rmse) = (scores.0 as f64 / m as f64, rmse(scores));
     if fitness == 0.0 {
         return Err(Error::Geometry(format!(
             "trajectory alignment: no sample brought any camera within {} of the reference (is the trajectory in the reference's frame order?)",
@@ -177,7 +181,10 @@ impl<'a> Reference<'a> {
     /// distance is then computed as the search computes it, without a search. Most frames of a
     /// good sample are such.
     fn nearest2(&self, k: usize, q: Point3) -> f64 {
-        let own = self.centres[k];
+        let Some(&own) = self.centres.get(k) else {
+            // A frame beyond the reference's has no own centre.
+            return self.index.nearest_squared(q).0;
+        };
         let d2 = (own[0] - q[0]) * (own[0] - q[0])
             + (own[1] - q[1]) * (own[1] - q[1])
             + (own[2] - q[2]) * (own[2] - q[2]);
@@ -237,6 +244,21 @@ mod tests {
             .unwrap_err()
             .to_string();
         assert!(e.contains("39 frames"), "{e}");
+        // Frames beyond the reference's (as the toolbox takes them): samples pair the first 40,
+        // all 45 count in the fitness; three extras lie on reference centres, two far away.
+        let mut longer = recon.clone();
+        longer.extend(
+            reference[20..23]
+                .iter()
+                .map(|p| [p[1] / s + 1.0, -p[0] / s - 2.0, p[2] / s + 0.5]),
+        );
+        longer.extend([[50.0, 0.0, 0.0], [0.0, -70.0, 3.0]]);
+        let b = align_trajectories(&longer, &reference, &o).unwrap();
+        assert!((b.fitness - 31.0 / 45.0).abs() < 1e-12, "{}", b.fitness);
+        for (p, r) in recon.iter().zip(&reference).skip(12) {
+            let q = matrix::apply(&b.gt_from_recon, *p);
+            assert!((0..3).all(|k| (q[k] - r[k]).abs() < 1e-9));
+        }
     }
 
     /// The shortcut through a frame's own reference centre gives the search's distance to the
