@@ -78,7 +78,8 @@ enum Command {
     Info {
         /// A PLY, GLB, glTF or OBJ file.
         file: PathBuf,
-        /// Refuse a mesh with more triangles than this once every glTF node instance is expanded.
+        /// Refuse a glTF mesh with more triangles than this once every node instance is expanded
+        /// (PLY and OBJ meshes are read whatever their size).
         #[arg(long, value_name = "N", default_value_t = ReadLimits::DEFAULT_MAX_TRIANGLES)]
         max_triangles: u64,
     },
@@ -147,8 +148,9 @@ struct InputArgs {
     /// Point pairs for `--align points`: `{"pairs": [{"recon": [x,y,z], "gt": [x,y,z]}, ...]}`.
     #[arg(long, value_name = "FILE")]
     pairs: Option<PathBuf>,
-    /// Refuse a ground-truth mesh with more triangles than this once every glTF node instance
-    /// is expanded (checked before anything is allocated; raise it for a trusted large file).
+    /// Refuse a glTF ground truth with more triangles than this once every node instance is
+    /// expanded (checked before anything is allocated; raise it for a trusted large file). PLY
+    /// and OBJ meshes are read whatever their size: their triangles are in the file.
     #[arg(long, value_name = "N", default_value_t = ReadLimits::DEFAULT_MAX_TRIANGLES)]
     max_triangles: u64,
 }

@@ -11,6 +11,8 @@
 //! recomputes the same clouds in every step), and one k-d tree serves the τ/2 refinement and the
 //! evaluation.
 
+use std::borrow::Cow;
+
 use super::colors;
 use super::curves::{self, Scores};
 use super::icp::{IcpCriteria, registration_icp};
@@ -248,8 +250,10 @@ pub fn evaluate(
                 stage_results.push(StageResult::of_icp(source.len(), index.len(), &r, t));
                 progress.advance(1);
             }
-            let source = uniform_down_sample(nonempty(crop_moved(&t), "reconstructed")?);
-            let index = KdCloud::new(&uniform_down_sample(gt_cropped.clone()))?;
+            let source = nonempty(crop_moved(&t), "reconstructed")?;
+            let source = uniform_down_sample(&source);
+            // Indexed in place: no copy of the cropped ground truth within the budget.
+            let index = KdCloud::new(&uniform_down_sample(&gt_cropped))?;
             let r = registration_icp(&source, &index, 2.0 * tau, request.icp);
             t = matrix::mul(&r.transformation, &t);
             stage_params.push(StageParams::new(
@@ -476,15 +480,15 @@ fn trajectory_centers(scene: &Scene, trajectory: &[LogFrame]) -> Result<(Vec<Poi
 
 /// The toolbox's `uniform` down-sampling: every k-th point with `k = round(n / 4e6)` (Python's
 /// round, halves to even) when `n` exceeds the budget.
-fn uniform_down_sample(points: Vec<Point3>) -> Vec<Point3> {
+fn uniform_down_sample(points: &[Point3]) -> Cow<'_, [Point3]> {
     let n = points.len() as u64;
     if n <= UNIFORM_MAX_POINTS {
-        return points;
+        return Cow::Borrowed(points);
     }
     let k = (n as f64 / UNIFORM_MAX_POINTS as f64)
         .round_ties_even()
         .max(1.0) as usize;
-    points.into_iter().step_by(k).collect()
+    Cow::Owned(points.iter().step_by(k).copied().collect())
 }
 
 /// One side's section: the mean sums `distances` in their order; the median is taken of the

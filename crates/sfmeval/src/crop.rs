@@ -189,16 +189,17 @@ fn in_prism(polygon: &[Point3], axis: Axis, axis_min: f64, axis_max: f64, p: Poi
     }
     let mut below = 0usize;
     // Edge i runs from vertex i to the next (the last to the first), without a modulo a vertex.
+    // Branch-free: the tests are combined with `&` and `|`, not `&&` and `||`, and the crossing
+    // is computed for every edge (a division by zero on an edge the row does not cross gives
+    // ±∞ or NaN, which its mask discards), so the same edges count as with the branches, and a
+    // cloud's points, each crossing a few edges at random, cost no mispredictions.
     for (&a, &b) in polygon
         .iter()
         .zip(polygon.iter().skip(1).chain(polygon.first()))
     {
-        if (a[v] < p[v] && b[v] >= p[v]) || (b[v] < p[v] && a[v] >= p[v]) {
-            let node = a[u] + (p[v] - a[v]) / (b[v] - a[v]) * (b[u] - a[u]);
-            if node < p[u] {
-                below += 1;
-            }
-        }
+        let crosses = ((a[v] < p[v]) & (b[v] >= p[v])) | ((b[v] < p[v]) & (a[v] >= p[v]));
+        let node = a[u] + (p[v] - a[v]) / (b[v] - a[v]) * (b[u] - a[u]);
+        below += usize::from(crosses & (node < p[u]));
     }
     below % 2 == 1
 }

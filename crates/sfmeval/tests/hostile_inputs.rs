@@ -920,6 +920,57 @@ fn gltf_body() -> usize {
     n
 }
 
+/// The triangle limit guards glTF instancing only: a PLY or OBJ mesh's triangles are in the file,
+/// so a mesh with more of them than the limit is read whole (a plain scan needs no flag), while a
+/// glTF of the same triangles is refused.
+#[test]
+fn ply_and_obj_meshes_are_not_held_to_the_triangle_limit() {
+    let limits = ReadLimits::triangles(2);
+    let vertices = [
+        [0.0, 0.0, 0.0],
+        [1.0, 0.0, 0.0],
+        [0.0, 1.0, 0.0],
+        [1.0, 1.0, 0.5],
+        [2.0, 0.0, 0.0],
+    ];
+    let triangles = [[0u32, 1, 2], [1, 3, 2], [1, 4, 3]];
+    let mut ply = format!(
+        "ply\nformat ascii 1.0\nelement vertex {}\nproperty float x\nproperty float y\nproperty float z\n\
+         element face {}\nproperty list uchar int vertex_indices\nend_header\n",
+        vertices.len(),
+        triangles.len()
+    );
+    let mut obj = String::new();
+    for v in vertices {
+        writeln!(ply, "{} {} {}", v[0], v[1], v[2]).unwrap();
+        writeln!(obj, "v {} {} {}", v[0], v[1], v[2]).unwrap();
+    }
+    for t in triangles {
+        writeln!(ply, "3 {} {} {}", t[0], t[1], t[2]).unwrap();
+        writeln!(obj, "f {} {} {}", t[0] + 1, t[1] + 1, t[2] + 1).unwrap();
+    }
+    for (name, bytes) in [("gt.ply", ply.into_bytes()), ("gt.obj", obj.into_bytes())] {
+        let g = io::read_ground_truth_with_limits(name, &bytes, &BTreeMap::new(), &limits)
+            .unwrap_or_else(|e| panic!("{name}: {e}"));
+        match g.ground_truth {
+            GroundTruth::Mesh(m) => assert_eq!(m.triangles, triangles, "{name}"),
+            GroundTruth::Cloud(_) => panic!("{name}: a mesh"),
+        }
+    }
+    // The same three triangles as a glTF are refused at this limit.
+    let bin: Vec<u8> = vertices
+        .iter()
+        .flat_map(|v| v.iter().flat_map(|&c| (c as f32).to_le_bytes()))
+        .chain(triangles.iter().flatten().flat_map(|i| i.to_le_bytes()))
+        .collect();
+    let json = r#"{"asset":{"version":"2.0"},"scene":0,"scenes":[{"nodes":[0]}],"nodes":[{"mesh":0}],"meshes":[{"primitives":[{"attributes":{"POSITION":0},"indices":1}]}],"accessors":[{"bufferView":0,"componentType":5126,"count":5,"type":"VEC3","min":[0,0,0],"max":[2,1,0.5]},{"bufferView":1,"componentType":5125,"count":9,"type":"SCALAR"}],"bufferViews":[{"buffer":0,"byteLength":60},{"buffer":0,"byteOffset":60,"byteLength":36}],"buffers":[{"byteLength":96}]}"#;
+    let e =
+        io::read_ground_truth_with_limits("gt.glb", &glb(json, &bin), &BTreeMap::new(), &limits)
+            .unwrap_err();
+    assert_eq!(e.kind(), "limit_exceeded", "{e}");
+    assert!(e.to_string().contains("max-triangles"), "{e}");
+}
+
 #[test]
 fn hostile_gltf() {
     guarded("hostile_gltf", 350, gltf_body);
