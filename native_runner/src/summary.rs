@@ -78,11 +78,11 @@ pub struct Table1Summary {
 /// The times of a `run` batch (seconds).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct BatchTiming {
-    /// The sum of the runs' wall times.
+    /// The runs (locally their wall time; on Slurm the sum of the runs' wall times).
     pub runs_seconds: f64,
     /// Evaluating the runs and writing the tables.
     pub report_seconds: f64,
-    /// The whole batch (from its first submission to the end of the collect).
+    /// The whole batch (on Slurm: from its first submission to the end of the collect).
     pub total_seconds: f64,
 }
 
@@ -95,7 +95,7 @@ pub struct BatchSummary {
     pub datasets: Vec<PathBuf>,
     /// The pipeline names, in table order.
     pub pipelines: Vec<String>,
-    /// Runs executed, by status.
+    /// Runs executed by this batch, by status.
     pub runs_executed: BTreeMap<String, usize>,
     /// Slurm tasks that left no result.
     pub tasks_without_result: Vec<TaskWithoutResult>,
@@ -132,4 +132,12 @@ pub fn write_summary<T: Serialize>(path: &Path, doc: &T) -> Result<()> {
     let mut text = serde_json::to_string_pretty(doc)?;
     text.push('\n');
     write_atomic(path, text.as_bytes())
+}
+
+/// Now, in seconds since the Unix epoch.
+pub fn unix_now() -> f64 {
+    std::time::SystemTime::now()
+        .duration_since(std::time::UNIX_EPOCH)
+        .map(|d| d.as_secs_f64())
+        .unwrap_or(0.0)
 }
