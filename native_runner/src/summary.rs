@@ -1,6 +1,6 @@
-//! The summary documents of a batch — `table1.json` and, for a `run` batch through Slurm,
-//! `batch.json` — one type each, written by both executors (local and Slurm) with the same
-//! keys; only the measured times and `executor` differ between them.
+//! The summary documents of a batch — `table1.json` and, for a `run` batch, `batch.json` — one
+//! type each, written by both executors (local and Slurm) with the same keys; only the measured
+//! times and `executor` differ between them.
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -80,13 +80,14 @@ pub struct Table1Summary {
 pub struct BatchTiming {
     /// The runs (locally their wall time; on Slurm the sum of the runs' wall times).
     pub runs_seconds: f64,
-    /// Evaluating the runs and writing the tables.
-    pub report_seconds: f64,
+    /// Evaluating the runs and writing the tables (null for a local `run`, which does not
+    /// evaluate: `report` does).
+    pub report_seconds: Option<f64>,
     /// The whole batch (on Slurm: from its first submission to the end of the collect).
     pub total_seconds: f64,
 }
 
-/// `OUT/batch.json` of `run --executor slurm`.
+/// `OUT/batch.json` of `run`.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct BatchSummary {
     /// Where it ran.
@@ -97,7 +98,10 @@ pub struct BatchSummary {
     pub pipelines: Vec<String>,
     /// Runs executed by this batch, by status.
     pub runs_executed: BTreeMap<String, usize>,
-    /// Slurm tasks that left no result.
+    /// Finished runs reused (locally: `--resume`; a Slurm task with its result is not run again
+    /// and counts as executed).
+    pub runs_reused: usize,
+    /// Slurm tasks that left no result (always empty locally).
     pub tasks_without_result: Vec<TaskWithoutResult>,
     /// The times.
     pub timing: BatchTiming,

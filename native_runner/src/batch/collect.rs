@@ -1,8 +1,8 @@
 //! The last stage of a batch, whichever executor ran it: the runs in the plan's runs folder
 //! are evaluated and the command's outputs written from what the executor says happened (an
 //! [`Outcome`]): `table/` and `table1.json` for `table1`; `table/`, `sweep.csv`, `charts/`,
-//! `sweep.html` and `sweep.json` for `sweep`; on Slurm, `report`'s `table/` and `batch.json`
-//! for `run` (a local `run` does not evaluate).
+//! `sweep.html` and `sweep.json` for `sweep`; `batch.json` (and, on Slurm, `report`'s
+//! `table/`) for `run`.
 
 use std::collections::BTreeMap;
 
@@ -184,28 +184,32 @@ pub fn results(plan: &Plan, job: &Job, outcome: &Outcome, sweep: Option<&SweepPl
         }
         Job::Run(a) => {
             // A local `run` does not evaluate (`report` does); the Slurm batch ends with it.
-            if outcome.executor == Executor::Local {
-                let ran = &outcome.runs_executed;
-                eprintln!(
-                    "run: {} in {:.1} s; skipped {} finished run(s); output {}",
-                    if ran.is_empty() {
-                        "nothing to do".to_string()
-                    } else {
-                        ran.iter()
-                            .map(|(k, v)| format!("{v} {k}"))
-                            .collect::<Vec<_>>()
-                            .join(", ")
-                    },
-                    outcome.runs_seconds,
-                    outcome.runs_reused,
-                    plan.out.display()
-                );
-                return Ok(());
-            }
-            let args = a
-                .eval
-                .report_args(&plan.out.join("runs"), &plan.out.join("table"))?;
-            let report_seconds = write_tables(plan, job, &args, outcome)?;
+            let report_seconds = match outcome.executor {
+                Executor::Local => {
+                    let ran = &outcome.runs_executed;
+                    eprintln!(
+                        "run: {} in {:.1} s; skipped {} finished run(s); output {}",
+                        if ran.is_empty() {
+                            "nothing to do".to_string()
+                        } else {
+                            ran.iter()
+                                .map(|(k, v)| format!("{v} {k}"))
+                                .collect::<Vec<_>>()
+                                .join(", ")
+                        },
+                        outcome.runs_seconds,
+                        outcome.runs_reused,
+                        plan.out.display()
+                    );
+                    None
+                }
+                Executor::Slurm => {
+                    let args = a
+                        .eval
+                        .report_args(&plan.out.join("runs"), &plan.out.join("table"))?;
+                    Some(write_tables(plan, job, &args, outcome)?)
+                }
+            };
             let doc = BatchSummary {
                 executor: outcome.executor,
                 datasets: plan
@@ -215,6 +219,7 @@ pub fn results(plan: &Plan, job: &Job, outcome: &Outcome, sweep: Option<&SweepPl
                     .collect(),
                 pipelines: plan.pipelines.clone(),
                 runs_executed: outcome.runs_executed.clone(),
+                runs_reused: outcome.runs_reused,
                 tasks_without_result: outcome.tasks_without_result.clone(),
                 timing: BatchTiming {
                     runs_seconds: outcome.runs_seconds,
