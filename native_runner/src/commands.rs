@@ -1,55 +1,34 @@
-//! The subcommands without a module of their own — `run`, `merge`, `report`, `pipelines`:
-//! each turns its arguments into the library calls and prints one summary line.
+//! The subcommands: the batches (`table1`, `sweep`, `run`: a plan and an executor), `merge`,
+//! `report` and `pipelines`; each turns its arguments into the library calls.
 
-use anyhow::{Context, Result};
+use anyhow::Result;
 
 use crate::adapters::{self, Availability};
-use crate::args::{MergeArgs, PipelinesArgs, ReportCmd, RunArgs};
-use crate::dataset::Dataset;
+use crate::args::{MergeArgs, PipelinesArgs, ReportCmd};
+use crate::batch::plan::{Job, Plan};
 use crate::env::make_env;
-use crate::pipelines::{parse_customs, parse_list};
+use crate::local;
+use crate::pipelines::parse_customs;
 use crate::report::ReportArgs;
+use crate::slurm;
+use crate::summary::{Executor, unix_now};
 
-/// `run`: every (dataset, pipeline) of the grid into `OUT/<dataset>/<pipeline>/`.
-pub fn run(a: &RunArgs) -> Result<()> {
-    a.slurm.check_local(false)?;
-    if !a.eval.is_default() {
-        anyhow::bail!(
-            "--crop, --samples, --tau, --tau-percent, --align and --eval-seed go with --executor \
-             slurm (a local run does not evaluate: give them to `report`)"
-        );
+/// `table1`, `sweep` and `run`: the command's plan, run by the executor it names (locally
+/// stage by stage, or submitted to Slurm).
+pub fn batch(job: Job) -> Result<()> {
+    let started_unix = unix_now();
+    match job.executor() {
+        Executor::Local => {
+            local::check(&job)?;
+            let (plan, sweep) = Plan::of(&job)?;
+            local::execute(&plan, &job, sweep.as_ref(), started_unix)
+        }
+        Executor::Slurm => {
+            slurm::check(&job)?;
+            let (plan, _) = Plan::of(&job)?;
+            slurm::submit_plan(&plan, &job)
+        }
     }
-    let customs = parse_customs(&a.batch.tools.customs)?;
-    let specs = parse_list(&a.batch.pipelines, &customs)?;
-    let datasets: Vec<Dataset> = a
-        .datasets
-        .iter()
-        .map(|d| Dataset::open(d))
-        .collect::<Result<_>>()?;
-    // Absolute: the tools run inside their run folders, so a relative OUT (and the adapter
-    // scripts installed under it) would resolve against the wrong folder.
-    let out = std::path::absolute(&a.out)
-        .with_context(|| format!("output folder {}", a.out.display()))?;
-    let opts = a.batch.batch_options(&out)?;
-    let env = make_env(&a.batch.tools, &out)?;
-    let t = std::time::Instant::now();
-    let s = crate::run::run_batch(&datasets, &specs, &customs, &env, &opts)?;
-    eprintln!(
-        "run: {} in {:.1} s; skipped {} finished run(s); output {}",
-        if s.ran.is_empty() {
-            "nothing to do".to_string()
-        } else {
-            s.ran
-                .iter()
-                .map(|(k, v)| format!("{v} {k}"))
-                .collect::<Vec<_>>()
-                .join(", ")
-        },
-        t.elapsed().as_secs_f64(),
-        s.skipped,
-        a.out.display()
-    );
-    Ok(())
 }
 
 /// `merge`: the shards' run folders joined into one.

@@ -12,6 +12,7 @@
 
 mod adapters;
 mod args;
+mod batch;
 mod chart;
 mod commands;
 mod dataset;
@@ -20,6 +21,7 @@ mod exec;
 mod files;
 mod generator;
 mod html;
+mod local;
 mod pipelines;
 mod report;
 mod run;
@@ -36,20 +38,18 @@ use std::process::ExitCode;
 use clap::Parser;
 
 use crate::args::{Cli, Command};
+use crate::batch::plan::Job;
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Setup(a) => setup::setup(&a.venv, &a.python),
-        Command::Run(a) if a.slurm.is_slurm() => slurm::submit_run(&a),
-        Command::Run(a) => commands::run(&a),
+        Command::Run(a) => commands::batch(Job::Run(Box::new(a))),
         Command::Merge(a) => commands::merge(&a),
         Command::Report(a) => commands::report(&a),
-        Command::Table1(a) if a.slurm.is_slurm() => slurm::submit_table1(&a),
-        Command::Table1(a) => table1::table1(&a),
+        Command::Table1(a) => commands::batch(Job::Table1(Box::new(a))),
         Command::SlurmTask(a) => slurm::task::slurm_task(&a),
-        Command::Sweep(a) if a.slurm.is_slurm() => slurm::submit_sweep(&a),
-        Command::Sweep(a) => sweep::sweep(&a),
+        Command::Sweep(a) => commands::batch(Job::Sweep(Box::new(a))),
         Command::Pipelines(a) => commands::pipelines(&a),
     };
     match result {

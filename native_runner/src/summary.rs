@@ -1,6 +1,6 @@
-//! The summary documents of a batch — `table1.json` and, for a `run` batch through Slurm,
-//! `batch.json` — one type each, written by both executors (local and Slurm) with the same
-//! keys; only the measured times and `executor` differ between them.
+//! The summary documents of a batch — `table1.json` and, for a `run` batch, `batch.json` — one
+//! type each, written by both executors (local and Slurm) with the same keys; only the measured
+//! times and `executor` differ between them.
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -78,15 +78,16 @@ pub struct Table1Summary {
 /// The times of a `run` batch (seconds).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct BatchTiming {
-    /// The sum of the runs' wall times.
+    /// The runs (locally their wall time; on Slurm the sum of the runs' wall times).
     pub runs_seconds: f64,
-    /// Evaluating the runs and writing the tables.
-    pub report_seconds: f64,
-    /// The whole batch (from its first submission to the end of the collect).
+    /// Evaluating the runs and writing the tables (null for a local `run`, which does not
+    /// evaluate: `report` does).
+    pub report_seconds: Option<f64>,
+    /// The whole batch (on Slurm: from its first submission to the end of the collect).
     pub total_seconds: f64,
 }
 
-/// `OUT/batch.json` of `run --executor slurm`.
+/// `OUT/batch.json` of `run`.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct BatchSummary {
     /// Where it ran.
@@ -95,9 +96,12 @@ pub struct BatchSummary {
     pub datasets: Vec<PathBuf>,
     /// The pipeline names, in table order.
     pub pipelines: Vec<String>,
-    /// Runs executed, by status.
+    /// Runs executed by this batch, by status.
     pub runs_executed: BTreeMap<String, usize>,
-    /// Slurm tasks that left no result.
+    /// Finished runs reused (locally: `--resume`; a Slurm task with its result is not run again
+    /// and counts as executed).
+    pub runs_reused: usize,
+    /// Slurm tasks that left no result (always empty locally).
     pub tasks_without_result: Vec<TaskWithoutResult>,
     /// The times.
     pub timing: BatchTiming,
@@ -132,4 +136,12 @@ pub fn write_summary<T: Serialize>(path: &Path, doc: &T) -> Result<()> {
     let mut text = serde_json::to_string_pretty(doc)?;
     text.push('\n');
     write_atomic(path, text.as_bytes())
+}
+
+/// Now, in seconds since the Unix epoch.
+pub fn unix_now() -> f64 {
+    std::time::SystemTime::now()
+        .duration_since(std::time::UNIX_EPOCH)
+        .map(|d| d.as_secs_f64())
+        .unwrap_or(0.0)
 }

@@ -262,8 +262,14 @@ def test_shards_and_merge_give_the_same_table(runner_bin, batch, tmp_path):
     cells = []
     for i in range(2):
         run_cli(runner_bin, "run", *common, "--shard", "%d/2" % i, "--out", tmp_path / ("s%d" % i))
-        cells.append({(d, p) for d in os.listdir(tmp_path / ("s%d" % i)) if not d.startswith(".")
-                      for p in os.listdir(tmp_path / ("s%d" % i) / d)})
+        shard = tmp_path / ("s%d" % i)
+        cells.append({(d, p) for d in os.listdir(shard)
+                      if not d.startswith(".") and (shard / d).is_dir()
+                      for p in os.listdir(shard / d)})
+        # each shard sums itself up: its own runs, by status
+        doc = load(shard / "batch.json")
+        assert doc["executor"] == "local" and doc["runs_reused"] == 0
+        assert sum(doc["runs_executed"].values()) == len(cells[-1])
     assert cells[0] and cells[1] and not (cells[0] & cells[1])
     assert len(cells[0] | cells[1]) == 6 and abs(len(cells[0]) - len(cells[1])) <= 1
     run_cli(runner_bin, "merge", tmp_path / "s0", tmp_path / "s1", "--out", tmp_path / "merged")

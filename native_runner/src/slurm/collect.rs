@@ -1,32 +1,25 @@
-//! The last stage of a batch: every run task's result is merged into `OUT/runs/`; a task that
-//! left none (cancelled, timed out, its node failed, its dataset never rendered) becomes a run
-//! with status `failed` or `timeout` and the reason from its Slurm output file, so the table
-//! is written with that cell marked; then every run is evaluated and the tables written, as a
-//! local `table1`, `sweep` or `run` + `report` does.
+//! The collect task of a Slurm batch: every run task's result is merged into `OUT/runs/`; a
+//! task that left none (cancelled, timed out, its node failed, its dataset never rendered)
+//! becomes a run with status `failed` or `timeout` and the reason from its Slurm output file,
+//! so the table is written with that cell marked; then the batch's outputs are written by the
+//! one collect both executors use ([`crate::batch::collect::results`]).
 
 use std::collections::BTreeMap;
 use std::path::Path;
-use std::time::Instant;
 
 use anyhow::{Context, Result};
-use serde_json::json;
 use sfmeval_fs::write_atomic;
 
-use crate::args::{RunArgs, SweepArgs, Table1Args};
+use crate::batch::collect::{DatasetOutcome, Outcome, results};
+use crate::batch::plan::{CellPlan, Job, Plan, Stage};
+use crate::batch::state::{dataset_done, task_done};
 use crate::dataset::Dataset;
 use crate::files::{copy_dir, partial_name, replace_dir};
 use crate::pipelines::{parse_customs, parse_list};
-use crate::report::{ReportArgs, report};
 use crate::run::{RunRecord, Status, read_record};
-use crate::slurm::plan::{CellPlan, Job, Plan, Stage};
-use crate::slurm::state::{dataset_done, end_reason, slurm_end, task_done};
+use crate::slurm::state::{end_reason, slurm_end};
 use crate::slurm::submit::{SubmissionRecord, job_of_task, read_records};
-use crate::summary::{
-    BatchSummary, BatchTiming, Executor, Table1Summary, Table1Timing, TaskWithoutResult,
-    render_times, write_summary,
-};
-use crate::sweep::variants::Variant;
-use crate::sweep::{Execution, SweepPlan, write_results};
+use crate::summary::{Executor, TaskWithoutResult, render_times, unix_now};
 
 /// Why run task `k` has no result: its dataset's missing render or finalize task, or itself.
 fn why_missing(
@@ -92,10 +85,7 @@ fn write_missing_run(
     dest: &Path,
 ) -> Result<()> {
     let dataset_dir = plan.dataset_dir(&cell.dataset);
-    let now = std::time::SystemTime::now()
-        .duration_since(std::time::UNIX_EPOCH)
-        .map(|d| d.as_secs_f64())
-        .unwrap_or(0.0);
+    let now = unix_now();
     let rec = RunRecord {
         status,
         reason: Some(reason.clone()),
@@ -194,145 +184,48 @@ fn merge_runs(plan: &Plan, job: &Job) -> Result<Merged> {
     Ok(m)
 }
 
-/// Render times as the generator's parts measured them: (total, mean per view) per dataset.
-fn plan_render_times(plan: &Plan) -> (BTreeMap<String, f64>, BTreeMap<String, f64>) {
-    render_times(
+/// Merges the runs, marks the missing ones and writes the batch's outputs (the datasets'
+/// render times as the generator's parts measured them; the total from the batch's first
+/// submission).
+pub fn collect(plan: &Plan) -> Result<()> {
+    let now = unix_now();
+    let job = plan.job()?;
+    let merged = merge_runs(plan, &job)?;
+    let (render_seconds, _) = render_times(
         plan.datasets
             .iter()
             .map(|d| (d.name.as_str(), plan.dataset_dir(&d.name))),
-    )
-}
-
-/// Seconds from the batch's first submission until now (the collect's own time when no
-/// submission is recorded).
-fn batch_seconds(plan: &Plan, t0: Instant) -> f64 {
-    let now = std::time::SystemTime::now()
-        .duration_since(std::time::UNIX_EPOCH)
-        .map(|d| d.as_secs_f64())
-        .unwrap_or(0.0);
-    read_records(plan)
-        .ok()
-        .and_then(|r| r.first().map(|r| now - r.submitted_unix))
-        .filter(|s| s.is_finite() && *s > 0.0)
-        .unwrap_or_else(|| t0.elapsed().as_secs_f64())
-}
-
-/// Merges the runs, marks the missing ones, evaluates and writes what the local command
-/// writes: `table/` and `table1.json` for `table1`; `table/`, `sweep.csv`, `charts/`,
-/// `sweep.html` and `sweep.json` for `sweep`; `report`'s `table/` and `batch.json` for `run`.
-pub fn collect(plan: &Plan) -> Result<()> {
-    let t0 = Instant::now();
-    let job = plan.job()?;
-    let merged = merge_runs(plan, &job)?;
-    match &job {
-        Job::Table1(a) => table1_results(plan, a, &merged, t0),
-        Job::Sweep(a) => sweep_results(plan, a, &merged, t0),
-        Job::Run(a) => run_results(plan, a, &merged, t0),
-    }
-}
-
-/// The sweep's outputs: a variant whose dataset was not finalized is a failed variant.
-fn sweep_results(plan: &Plan, a: &SweepArgs, merged: &Merged, t0: Instant) -> Result<()> {
-    let sweep_plan = SweepPlan::new(a, &plan.python, plan.blender_scripts()?)?;
-    let (frame_seconds, _) = plan_render_times(plan);
-    let variants: Vec<Variant> = sweep_plan
-        .planned
+    );
+    let datasets = plan
+        .datasets
         .iter()
-        .map(|pl| {
-            let done = dataset_done(plan, &pl.dataset);
-            Variant {
-                value: pl.text.clone(),
-                dataset: pl.dataset.clone(),
-                overrides: pl.overrides.clone(),
-                status: if done { "rendered" } else { "failed" }.into(),
-                reason: (!done)
-                    .then(|| "not rendered by its Slurm tasks (see OUT/slurm/logs/)".into()),
-                seconds: frame_seconds.get(&pl.dataset).copied(),
-            }
+        .map(|d| {
+            let o = if d.dir.is_some() {
+                DatasetOutcome::given()
+            } else if dataset_done(plan, &d.name) {
+                DatasetOutcome::rendered(render_seconds.get(&d.name).copied())
+            } else {
+                DatasetOutcome::failed(
+                    "not rendered by its Slurm tasks (see OUT/slurm/logs/)".into(),
+                )
+            };
+            (d.name.clone(), o)
         })
         .collect();
-    write_results(
-        a,
-        &sweep_plan,
-        &variants,
-        &plan.pipelines,
-        &plan.out,
-        t0,
-        Execution {
-            executor: Executor::Slurm,
-            tasks_without_result: merged.without_result.clone(),
-            timing: json!({"datasets_seconds": frame_seconds.values().sum::<f64>(),
-                           "runs_seconds": merged.runs_seconds}),
-        },
-    )
-}
-
-/// Evaluates `OUT/runs/` into `OUT/table/` as `report` does, prints `table1.md` and a summary
-/// line; returns the seconds it took.
-fn write_tables(plan: &Plan, args: &ReportArgs, merged: &Merged) -> Result<f64> {
-    let t = Instant::now();
-    let rows = report(args)?;
-    let seconds = t.elapsed().as_secs_f64();
-    let t1 = std::fs::read_to_string(args.out.join("table1.md")).unwrap_or_default();
-    println!("{t1}");
-    eprintln!(
-        "collect: {} run(s), {} without result; tables in {}",
-        rows.len(),
-        merged.without_result.len(),
-        plan.out.join("table").display()
-    );
-    Ok(seconds)
-}
-
-/// `table/` and `table1.json`.
-fn table1_results(plan: &Plan, a: &Table1Args, merged: &Merged, t0: Instant) -> Result<()> {
-    let args = a
-        .eval
-        .report_args(&plan.out.join("runs"), &plan.out.join("table"))?;
-    let report_seconds = write_tables(plan, &args, merged)?;
-    let (render_seconds, per_view) = plan_render_times(plan);
-    let doc = Table1Summary {
-        quick: a.quick,
-        presets: plan.datasets.iter().map(|d| d.preset.clone()).collect(),
-        pipelines: plan.pipelines.clone(),
+    let started_unix = read_records(plan)
+        .ok()
+        .and_then(|r| r.first().map(|r| r.submitted_unix))
+        .filter(|t| t.is_finite() && *t < now)
+        .unwrap_or(now);
+    let outcome = Outcome {
         executor: Executor::Slurm,
-        runs_executed: merged.executed.clone(),
+        datasets,
+        runs_executed: merged.executed,
         runs_reused: 0,
-        tasks_without_result: merged.without_result.clone(),
-        timing: Table1Timing {
-            datasets_seconds: render_seconds.values().sum(),
-            render_seconds,
-            render_seconds_per_view: per_view,
-            runs_seconds: merged.runs_seconds,
-            report_seconds,
-            total_seconds: batch_seconds(plan, t0),
-        },
+        tasks_without_result: merged.without_result,
+        datasets_seconds: render_seconds.values().sum(),
+        runs_seconds: merged.runs_seconds,
+        started_unix,
     };
-    write_summary(&plan.out.join("table1.json"), &doc)
-}
-
-/// `run`'s batch: `report`'s `table/` and `batch.json` (the datasets, pipelines, tasks without
-/// result and times).
-fn run_results(plan: &Plan, a: &RunArgs, merged: &Merged, t0: Instant) -> Result<()> {
-    let args = a
-        .eval
-        .report_args(&plan.out.join("runs"), &plan.out.join("table"))?;
-    let report_seconds = write_tables(plan, &args, merged)?;
-    let doc = BatchSummary {
-        executor: Executor::Slurm,
-        datasets: plan
-            .datasets
-            .iter()
-            .map(|d| plan.dataset_dir(&d.name))
-            .collect(),
-        pipelines: plan.pipelines.clone(),
-        runs_executed: merged.executed.clone(),
-        tasks_without_result: merged.without_result.clone(),
-        timing: BatchTiming {
-            runs_seconds: merged.runs_seconds,
-            report_seconds,
-            total_seconds: batch_seconds(plan, t0),
-        },
-    };
-    write_summary(&plan.out.join("batch.json"), &doc)
+    results(plan, &job, &outcome, None)
 }

@@ -1,5 +1,5 @@
-//! `sfmeval-runner table1|sweep|run --executor slurm`: the seed experiment, a sweep or a batch of
-//! runs as Slurm job arrays on a cluster whose nodes share the output folder, the runner binary,
+//! The Slurm executor of a batch plan ([`crate::batch`]), `sfmeval-runner table1|sweep|run
+//! --executor slurm`: the seed experiment, a sweep or a batch of runs as Slurm job arrays on a cluster whose nodes share the output folder, the runner binary,
 //! `blender_scripts` and the venv. Four stages, one sbatch script each under `OUT/slurm/` (a
 //! `run` batch, on datasets that exist, has only the last two):
 //!
@@ -8,92 +8,30 @@
 //! 3. `run` (`afterok` on finalize): one task per dataset × pipeline, each into its own folder;
 //! 4. `collect` (`afterany` on all): merge the runs into `OUT/runs/` (a task that left no
 //!    result becomes a failed or timed-out cell with Slurm's reason), evaluate and write the
-//!    tables, as a local `table1` (or `run` + `report`) does.
+//!    outputs with the same collect as the local executor.
 //!
-//! The modules: [`plan`] (what task k of a stage does, where it writes), [`resources`](mod@resources) (the
-//! per-stage `--cpus-per-task`, `--mem`, `--time`, partition, account, checked against `sinfo`), [`script`] (the sbatch
-//! scripts and `submit.sh`), [`submit`] (`sbatch` and `jobs.json`, each job recorded as soon as it is queued), [`state`] (which tasks left
-//! their result, why one did not), [`task`] (running one task) and [`collect`].
+//! The plan (what task k of a stage does, where it writes) and the tasks' work are the
+//! batch's, shared with the local executor. The modules here: [`resources`](mod@resources) (the
+//! per-stage `--cpus-per-task`, `--mem`, `--time`, partition, account, checked against
+//! `sinfo`), [`script`] (the sbatch scripts and `submit.sh`), [`submit`] (`sbatch` and
+//! `jobs.json`, each job recorded as soon as it is queued), [`state`] (why a task left no
+//! result), [`task`] (one task as a job runs it) and [`collect`] (the merge of the tasks'
+//! runs).
 
 pub mod collect;
-pub mod plan;
 pub mod resources;
 pub mod script;
 pub mod state;
 pub mod submit;
 pub mod task;
 
-use std::collections::BTreeSet;
-
 use anyhow::{Context, Result, bail};
 use sfmeval_fs::write_atomic;
 
-use std::path::{Path, PathBuf};
-
-use crate::args::{RunArgs, SlurmArgs, SweepArgs, Table1Args, ToolArgs};
-use crate::dataset::Dataset;
-use crate::env::find_python;
-use crate::generator::find_blender_scripts;
-use crate::pipelines::{parse_customs, parse_list};
-use crate::slurm::plan::{CellPlan, DatasetPlan, PLAN_SCHEMA, Plan, Stage};
+use crate::batch::plan::{Job, Plan, Stage};
+use crate::batch::state::missing_tasks;
 use crate::slurm::resources::resources;
 use crate::slurm::script::{Dependency, Submission, sbatch_script, submit_sh};
-use crate::slurm::state::missing_tasks;
-use crate::sweep::SweepPlan;
-use crate::table1::{dataset_name, generator_args, presets};
-
-/// The plan of a batch: its command line `argv`, output folder, tools, generator (absolute;
-/// none for `run`), pipelines and datasets (rendered in `render_shards` parts each, or, with
-/// `render_shards` 0, existing folders); the cells are the datasets by name × the pipelines
-/// (as `run`'s grid).
-fn make_plan(
-    argv: Vec<String>,
-    out: &Path,
-    tools: &ToolArgs,
-    blender_scripts: Option<PathBuf>,
-    pipelines: &[String],
-    datasets: Vec<DatasetPlan>,
-    render_shards: usize,
-) -> Result<Plan> {
-    if render_shards == 0 && datasets.iter().any(|d| d.dir.is_none()) {
-        bail!("--render-shards must be at least 1");
-    }
-    let out =
-        std::path::absolute(out).with_context(|| format!("resolving --out {}", out.display()))?;
-    // absolute when given as a path; a bare name is looked up on each node's PATH
-    let python = find_python(tools.python.as_deref())?;
-    let runner = std::env::current_exe().context("locating the sfmeval-runner binary")?;
-    let customs = parse_customs(&tools.customs)?;
-    let specs = parse_list(pipelines, &customs)?;
-    let mut names = BTreeSet::new();
-    for d in &datasets {
-        if !names.insert(d.name.clone()) {
-            bail!("two datasets are named {}", d.name);
-        }
-    }
-    let mut cells = Vec::new();
-    for name in &names {
-        for s in &specs {
-            cells.push(CellPlan {
-                dataset: name.clone(),
-                pipeline: s.name.clone(),
-            });
-        }
-    }
-    Ok(Plan {
-        schema: PLAN_SCHEMA.into(),
-        argv,
-        cwd: std::env::current_dir().context("the working directory")?,
-        runner,
-        python,
-        blender_scripts,
-        out,
-        render_shards,
-        datasets,
-        pipelines: specs.iter().map(|s| s.name.clone()).collect(),
-        cells,
-    })
-}
 
 /// What to submit: per dataset, its render tasks without result, then its finalize task, then
 /// its run tasks, each `afterok` on the one before it that is submitted (a `run` batch has
@@ -147,126 +85,31 @@ fn submissions(plan: &Plan) -> Vec<Submission> {
     subs
 }
 
-/// `table1 --executor slurm`: one dataset per preset.
-pub fn submit_table1(a: &Table1Args) -> Result<()> {
-    a.exec.check()?;
-    if !a.scenes.is_empty() {
-        bail!(
+/// The checks of the Slurm executor before a plan is made: options that go with the local
+/// executor only are refused.
+pub fn check(job: &Job) -> Result<()> {
+    job.eval().eval_options()?;
+    job.eval().align_request()?;
+    match job {
+        Job::Table1(a) if !a.scenes.is_empty() => bail!(
             "--scene (a Tanks and Temples scene) runs with the local executor only: run it with `table1 --scene DIR` or `run` + `report`"
-        );
-    }
-    let mut datasets: Vec<DatasetPlan> = Vec::new();
-    for p in presets(a) {
-        datasets.push(DatasetPlan {
-            generator_args: generator_args(&p, a.quick, &a.generator.sets),
-            name: dataset_name(&p, a.quick),
-            preset: p,
-            dir: None,
-        });
-    }
-    let scripts = std::path::absolute(find_blender_scripts(
-        a.generator.blender_scripts.as_deref(),
-    )?)?;
-    let plan = make_plan(
-        std::env::args().collect(),
-        &a.out,
-        &a.tools,
-        Some(scripts),
-        &a.pipelines,
-        datasets,
-        a.slurm.render_shards,
-    )?;
-    submit_plan(&plan, &a.slurm, a.resume, a.generator.fresh)
-}
-
-/// `run --executor slurm`: one task per dataset × pipeline on the existing datasets, then the
-/// collect, which merges the runs into `OUT/runs/` and writes `report`'s tables into
-/// `OUT/table/`.
-pub fn submit_run(a: &RunArgs) -> Result<()> {
-    a.batch.exec.check()?;
-    a.eval.eval_options()?;
-    a.eval.align_request()?;
-    if a.batch.shard.is_some() {
-        bail!("--shard goes with the local executor: a Slurm batch runs one task per cell");
-    }
-    if a.batch.retry_failed {
-        bail!(
+        ),
+        Job::Run(a) if a.batch.shard.is_some() => {
+            bail!("--shard goes with the local executor: a Slurm batch runs one task per cell")
+        }
+        Job::Run(a) if a.batch.retry_failed => bail!(
             "--retry-failed goes with the local executor: a Slurm batch's --resume redoes the \
              tasks without result"
-        );
+        ),
+        _ => Ok(()),
     }
-    let datasets = a
-        .datasets
-        .iter()
-        .map(|d| {
-            let ds = Dataset::open(d)?;
-            Ok(DatasetPlan {
-                preset: ds.name.clone(),
-                name: ds.name,
-                generator_args: Vec::new(),
-                dir: Some(ds.dir),
-            })
-        })
-        .collect::<Result<Vec<_>>>()?;
-    let plan = make_plan(
-        std::env::args().collect(),
-        &a.out,
-        &a.batch.tools,
-        None,
-        &a.batch.pipelines,
-        datasets,
-        0,
-    )?;
-    submit_plan(&plan, &a.slurm, a.batch.resume, false)
 }
 
-/// `sweep --executor slurm`: one dataset per factor value, made by the same generator
-/// arguments as a local sweep's variant.
-pub fn submit_sweep(a: &SweepArgs) -> Result<()> {
-    a.exec.check()?;
-    a.eval.eval_options()?;
-    let python = find_python(a.tools.python.as_deref())?;
-    let scripts = std::path::absolute(find_blender_scripts(
-        a.generator.blender_scripts.as_deref(),
-    )?)?;
-    let sweep_plan = SweepPlan::new(a, &python, &scripts)?;
-    let datasets = sweep_plan
-        .planned
-        .iter()
-        .map(|pl| {
-            let mut args = sweep_plan.base_args.clone();
-            for o in pl
-                .overrides
-                .iter()
-                .cloned()
-                .chain([format!("dataset.name=\"{}\"", pl.dataset)])
-            {
-                args.extend(["--set".to_string(), o]);
-            }
-            DatasetPlan {
-                preset: pl.text.clone(),
-                name: pl.dataset.clone(),
-                generator_args: args,
-                dir: None,
-            }
-        })
-        .collect();
-    let plan = make_plan(
-        std::env::args().collect(),
-        &a.out,
-        &a.tools,
-        Some(scripts),
-        &a.pipelines,
-        datasets,
-        a.slurm.render_shards,
-    )?;
-    submit_plan(&plan, &a.slurm, a.resume, a.generator.fresh)
-}
-
-/// Checks a resumed batch (`resume`) against its plan (or refuses to overwrite one), writes
-/// the plan and the scripts and, unless `--dry-run`, submits them.
-fn submit_plan(plan: &Plan, slurm: &SlurmArgs, resume: bool, fresh: bool) -> Result<()> {
-    if fresh {
+/// The Slurm executor: checks a resumed batch (`--resume`) against its plan (or refuses to
+/// overwrite one), writes the plan and the scripts and, unless `--dry-run`, submits them.
+pub fn submit_plan(plan: &Plan, job: &Job) -> Result<()> {
+    let (slurm, resume) = (job.slurm(), job.resume());
+    if job.fresh() {
         bail!("--fresh does not go with --executor slurm: choose a new --out");
     }
     let res = resources(slurm)?;
@@ -379,6 +222,8 @@ fn submit_plan(plan: &Plan, slurm: &SlurmArgs, resume: bool, fresh: bool) -> Res
 #[allow(clippy::unwrap_used, clippy::expect_used)]
 mod tests {
     use super::*;
+    use crate::batch::plan::{CellPlan, DatasetPlan, PLAN_SCHEMA};
+    use crate::batch::state;
 
     fn plan(out: &std::path::Path) -> Plan {
         let ds = |n: &str| DatasetPlan {

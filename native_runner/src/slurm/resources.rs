@@ -7,7 +7,7 @@ use std::path::{Path, PathBuf};
 use anyhow::{Context, Result, bail};
 
 use crate::args::SlurmArgs;
-use crate::slurm::plan::Stage;
+use crate::batch::plan::Stage;
 
 /// The request of one stage.
 #[derive(Debug, Clone, PartialEq)]

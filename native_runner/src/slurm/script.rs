@@ -5,8 +5,8 @@ use std::path::Path;
 
 use anyhow::{Result, bail};
 
+use crate::batch::plan::{Plan, Stage};
 use crate::exec::shell_quote;
-use crate::slurm::plan::{Plan, Stage};
 use crate::slurm::resources::Resources;
 
 /// How a submission waits for the ones before it (indices into the list of submissions).

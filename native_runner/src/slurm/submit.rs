@@ -10,7 +10,7 @@ use anyhow::{Context, Result, bail};
 use serde::{Deserialize, Serialize};
 use sfmeval_fs::write_atomic;
 
-use crate::slurm::plan::{Plan, Stage};
+use crate::batch::plan::{Plan, Stage};
 use crate::slurm::resources::slurm_program;
 use crate::slurm::script::{Submission, sbatch_args};
 

@@ -1,22 +1,19 @@
 //! One task of a batch, as an sbatch script runs it (`sfmeval-runner slurm-task --plan P
-//! --stage S --index K`). Every task is idempotent: one whose result is there (a rendered part,
+//! --stage S --index K`), through the batch's task code. Every task is idempotent: one whose result is there (a rendered part,
 //! a finalized dataset, a finished run) returns at once, so a resubmitted task only redoes what
 //! is missing.
 
-use std::process::Command;
-
-use anyhow::{Context, Result, bail};
+use anyhow::{Result, bail};
 use nix::sys::signal::{Signal, killpg};
 use nix::unistd::Pid;
 
-use crate::args::{SlurmTaskArgs, ToolArgs};
+use crate::args::SlurmTaskArgs;
+use crate::batch::plan::{Plan, Stage};
+use crate::batch::state::{dataset_done, task_done};
+use crate::batch::task::{generator, run_cells};
 use crate::dataset::Dataset;
-use crate::env::make_env;
-use crate::pipelines::{parse_customs, parse_list};
-use crate::run::{BatchOptions, run_batch};
 use crate::slurm::collect::collect;
-use crate::slurm::plan::{DatasetPlan, Plan, Stage};
-use crate::slurm::state::{dataset_done, task_done};
+use crate::summary::Executor;
 
 /// Runs the task named on the command line.
 pub fn slurm_task(a: &SlurmTaskArgs) -> Result<()> {
@@ -54,35 +51,6 @@ pub fn slurm_task(a: &SlurmTaskArgs) -> Result<()> {
     }
 }
 
-/// `generate.py ARGS EXTRA --out OUT/datasets/<name>`, its output into the task's log.
-fn generator(plan: &Plan, ds: &DatasetPlan, extra: &[&str]) -> Result<()> {
-    let dir = plan.dataset_dir(&ds.name);
-    let script = plan.blender_scripts()?.join("generate.py");
-    eprintln!(
-        "{}: {} {} {} {} --out {}",
-        ds.name,
-        plan.python.display(),
-        script.display(),
-        ds.generator_args.join(" "),
-        extra.join(" "),
-        dir.display()
-    );
-    // from the datasets folder, as a local table1 runs it (relative model paths in --set)
-    let status = Command::new(&plan.python)
-        .current_dir(plan.out.join("datasets"))
-        .arg(&script)
-        .args(&ds.generator_args)
-        .args(extra)
-        .arg("--out")
-        .arg(&dir)
-        .status()
-        .with_context(|| format!("starting {}", plan.python.display()))?;
-    if !status.success() {
-        bail!("the generator failed ({status}) on {}", dir.display());
-    }
-    Ok(())
-}
-
 /// Run task `k`: its pipeline on its dataset, into the task's own runs folder.
 fn run_cell(plan: &Plan, k: usize) -> Result<()> {
     let cell = plan.run_task(k)?;
@@ -91,23 +59,8 @@ fn run_cell(plan: &Plan, k: usize) -> Result<()> {
         bail!("dataset {} is not finalized", cell.dataset);
     }
     let dataset = Dataset::open(&plan.dataset_dir(&cell.dataset))?;
-    let customs = parse_customs(&job.tools().customs)?;
-    let specs = parse_list(job.pipelines(), &customs)?;
-    let spec = specs
-        .into_iter()
-        .find(|s| s.name == cell.pipeline)
-        .with_context(|| format!("pipeline {} is not in the plan's command", cell.pipeline))?;
-    let out = plan.task_runs(k);
-    let tools = ToolArgs {
-        python: Some(plan.python.clone()),
-        ..job.tools().clone()
-    };
-    let env = make_env(&tools, &out)?;
-    let opts = BatchOptions {
-        keep_scratch: job.keep_scratch(),
-        ..job.exec().batch_options(&out, true, false)?
-    };
-    let summary = run_batch(&[dataset], &[spec], &customs, &env, &opts)?;
+    let opts = job.batch_options(&plan.task_runs(k), Executor::Slurm)?;
+    let summary = run_cells(plan, &job, &[dataset], Some(&cell.pipeline), &opts)?;
     eprintln!(
         "run task {k}: {}/{}: {:?}",
         cell.dataset, cell.pipeline, summary.ran

@@ -3,7 +3,8 @@
 //! image noise or blur), renders one variant per value with the Blender generator, runs the
 //! pipelines on every variant (the `run` machinery: resumable, failures recorded), evaluates
 //! them (the `report` machinery) and plots each metric against the factor, one line per
-//! pipeline: `sweep.csv`, `sweep.html` and `charts/<metric>.svg`.
+//! pipeline: `sweep.csv`, `sweep.html` and `charts/<metric>.svg`. The batch is planned by
+//! [`crate::batch::plan::Plan::sweep`] and run by either executor.
 //!
 //! The steps, one module each: [`factor`] (`--factor` parsing), [`overrides`] (a value as
 //! generator overrides), [`variants`] (planning and rendering), [`cells`] (a cell per value
@@ -22,19 +23,16 @@ pub mod variants;
 use std::path::Path;
 use std::time::Instant;
 
-use anyhow::{Context, Result};
+use anyhow::Result;
 
 use sfmeval_fs::write_atomic;
 
 use crate::args::SweepArgs;
 use crate::chart::line;
-use crate::env::{find_python, make_env};
 use crate::exec::shell_quote;
-use crate::generator::{find_blender_scripts, resolved_config};
-use crate::pipelines::{parse_customs, parse_list};
+use crate::generator::resolved_config;
 use crate::report::{ReportArgs, report};
-use crate::run::run_batch;
-use crate::summary::{Executor, TaskWithoutResult};
+use crate::summary::{Executor, TaskWithoutResult, unix_now};
 use crate::sweep::factor::{Factor, parse_factor};
 use crate::sweep::metrics::metric_file;
 use sfmeval_table::Row;
@@ -76,66 +74,6 @@ impl SweepPlan {
     }
 }
 
-/// The whole sweep: plan and render the variants, run the pipelines, evaluate, write
-/// `sweep.csv`, `charts/`, `sweep.html` and `sweep.json`.
-pub fn sweep(a: &SweepArgs) -> Result<()> {
-    let t0 = Instant::now();
-    parse_factor(&a.factor)?;
-    a.exec.check()?;
-    a.slurm.check_local(a.resume)?;
-    // absolute paths: the generator runs in the datasets folder
-    let python = find_python(a.tools.python.as_deref())?;
-    let scripts = std::path::absolute(find_blender_scripts(
-        a.generator.blender_scripts.as_deref(),
-    )?)?;
-    let customs = parse_customs(&a.tools.customs)?;
-    let specs = parse_list(&a.pipelines, &customs)?;
-    a.eval.eval_options()?;
-    let plan = SweepPlan::new(a, &python, &scripts)?;
-    let out = std::path::absolute(&a.out)
-        .with_context(|| format!("output folder {}", a.out.display()))?;
-    let ds_root = out.join("datasets");
-    let (variants, datasets) = variants::render(
-        &plan.planned,
-        &plan.base_args,
-        &ds_root,
-        a.generator.fresh,
-        &python,
-        &scripts,
-    )?;
-    let render_seconds = t0.elapsed().as_secs_f64();
-    // runs
-    let runs = out.join("runs");
-    let t_runs = Instant::now();
-    if !datasets.is_empty() {
-        let env = make_env(&a.tools, &runs)?;
-        let opts = a
-            .exec
-            .batch_options(&runs, !a.generator.fresh, a.retry_failed)?;
-        let sum = run_batch(&datasets, &specs, &customs, &env, &opts)?;
-        eprintln!(
-            "sweep: runs: {} executed, {} reused",
-            sum.ran.values().sum::<usize>(),
-            sum.skipped
-        );
-    }
-    let runs_seconds = t_runs.elapsed().as_secs_f64();
-    let pipes: Vec<String> = specs.iter().map(|s| s.name.clone()).collect();
-    write_results(
-        a,
-        &plan,
-        &variants,
-        &pipes,
-        &out,
-        t0,
-        Execution {
-            executor: Executor::Local,
-            tasks_without_result: Vec::new(),
-            timing: serde_json::json!({"datasets_seconds": render_seconds, "runs_seconds": runs_seconds}),
-        },
-    )
-}
-
 /// How a sweep's runs were executed, for `sweep.json`.
 pub struct Execution {
     /// Where.
@@ -156,7 +94,7 @@ pub fn write_results(
     variants: &[variants::Variant],
     pipes: &[String],
     out: &Path,
-    t0: Instant,
+    started_unix: f64,
     execution: Execution,
 ) -> Result<()> {
     let Execution {
@@ -204,7 +142,7 @@ pub fn write_results(
         &out.join("sweep.html"),
         page::page(factor, &command, variants, pipes, &charts, &files).as_bytes(),
     )?;
-    let total = t0.elapsed().as_secs_f64();
+    let total = unix_now() - started_unix;
     let mut timing = timing;
     if let Some(t) = timing.as_object_mut() {
         t.insert("report_seconds".into(), report_seconds.into());

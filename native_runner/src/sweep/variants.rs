@@ -1,15 +1,11 @@
 //! The variants of a sweep: the generator arguments of the base dataset and of each factor
-//! value, and rendering them (a variant made by the same arguments is reused).
+//! value (rendered as the batch's datasets; a variant made by the same arguments is reused).
 
 use std::path::Path;
 
-use anyhow::{Context, Result};
+use anyhow::Result;
 use serde_json::Value as Json;
 
-use sfmeval_fs::write_atomic;
-
-use crate::dataset::Dataset;
-use crate::generator::render_dataset;
 use crate::sweep::factor::Factor;
 use crate::sweep::overrides::factor_overrides;
 
@@ -110,77 +106,6 @@ pub fn plan(factor: Factor, values: &[(String, f64)], base: &Json) -> Result<Vec
         });
     }
     Ok(planned)
-}
-
-/// Renders every planned variant into `ds_root/<dataset>/` with the generator (`python`,
-/// `scripts`), or reuses it when it is complete and was made by the same arguments (unless
-/// `fresh`). A variant that fails to render is recorded as `failed` and the others go on.
-/// Returns every variant's facts and the datasets to run the pipelines on.
-pub fn render(
-    planned: &[Planned],
-    base_args: &[String],
-    ds_root: &Path,
-    fresh: bool,
-    python: &Path,
-    scripts: &Path,
-) -> Result<(Vec<Variant>, Vec<Dataset>)> {
-    std::fs::create_dir_all(ds_root).with_context(|| format!("creating {}", ds_root.display()))?;
-    let mut variants: Vec<Variant> = Vec::new();
-    let mut datasets: Vec<Dataset> = Vec::new();
-    for pl in planned {
-        let (text, name, overrides) = (&pl.text, &pl.dataset, &pl.overrides);
-        let dest = ds_root.join(name);
-        let mut args = base_args.to_vec();
-        for o in overrides
-            .iter()
-            .cloned()
-            .chain([format!("dataset.name=\"{name}\"")])
-        {
-            args.extend(["--set".into(), o]);
-        }
-        // reuse only a complete variant made by the same generator arguments
-        let stamp = ds_root.join(format!("{name}.args.json"));
-        let stamp_json = serde_json::to_string_pretty(&args)? + "\n";
-        let complete = dest.join("dataset.json").is_file()
-            && dest.join("cameras.json").is_file()
-            && std::fs::read_to_string(&stamp).ok().as_deref() == Some(stamp_json.as_str());
-        let mut v = Variant {
-            value: text.clone(),
-            dataset: name.clone(),
-            overrides: overrides.clone(),
-            status: "reused".into(),
-            reason: None,
-            seconds: None,
-        };
-        if !complete || fresh {
-            match render_dataset("sweep", python, scripts, &args, &dest) {
-                Ok(secs) => {
-                    write_atomic(&stamp, stamp_json.as_bytes())?;
-                    v.status = "rendered".into();
-                    v.seconds = Some(secs);
-                }
-                Err(e) => {
-                    eprintln!("sweep: {name}: generation failed: {e:#}");
-                    let _ = std::fs::remove_file(&stamp);
-                    v.status = "failed".into();
-                    v.reason = Some(format!("{e:#}"));
-                }
-            }
-        } else {
-            eprintln!("sweep: reusing {}", dest.display());
-        }
-        if v.status != "failed" {
-            match Dataset::open(&dest) {
-                Ok(d) => datasets.push(d),
-                Err(e) => {
-                    v.status = "failed".into();
-                    v.reason = Some(format!("{e:#}"));
-                }
-            }
-        }
-        variants.push(v);
-    }
-    Ok((variants, datasets))
 }
 
 #[cfg(test)]

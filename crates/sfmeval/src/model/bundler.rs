@@ -181,17 +181,7 @@ pub fn read_bundler(out: &[u8], list: Option<&[u8]>) -> Result<Reconstruction> {
             .with("count", bad_refs),
         );
     }
-    if !rec.unregistered.is_empty() {
-        let note = Note::new(
-            Code::UnregisteredImages,
-            format!(
-                "{} camera(s) are unregistered (all zero)",
-                rec.unregistered.len()
-            ),
-        )
-        .with("count", rec.unregistered.len());
-        rec.notes.push(note);
-    }
+    rec.note_unregistered("camera(s) are unregistered (all zero)");
     if list.is_none() {
         rec.notes.push(Note::new(
             Code::NoImageList,

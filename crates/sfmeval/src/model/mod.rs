@@ -486,6 +486,18 @@ pub struct Reconstruction {
 }
 
 impl Reconstruction {
+    /// Notes the images the file lists without a pose ([`Reconstruction::unregistered`]),
+    /// when there are any: one `input.unregistered_images` note with their `count`, its
+    /// message the count and the format's words for them (`what`).
+    pub(crate) fn note_unregistered(&mut self, what: &str) {
+        let count = self.unregistered.len();
+        if count > 0 {
+            self.notes.push(
+                Note::new(Code::UnregisteredImages, format!("{count} {what}")).with("count", count),
+            );
+        }
+    }
+
     /// An empty reconstruction of the given format.
     pub fn new(format: &'static str) -> Reconstruction {
         Reconstruction {

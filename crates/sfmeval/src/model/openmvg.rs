@@ -292,17 +292,7 @@ pub fn read_openmvg_json(bytes: &[u8]) -> Result<Reconstruction> {
             .with("count", bad_refs),
         );
     }
-    if !rec.unregistered.is_empty() {
-        let note = Note::new(
-            Code::UnregisteredImages,
-            format!(
-                "{} view(s) have no pose (unregistered)",
-                rec.unregistered.len()
-            ),
-        )
-        .with("count", rec.unregistered.len());
-        rec.notes.push(note);
-    }
+    rec.note_unregistered("view(s) have no pose (unregistered)");
     Ok(rec)
 }
 
