@@ -5,7 +5,7 @@
 // thread, scalar). Both are the npm package's API; `init` picks one.
 let api = null;
 let version, loadGroundTruth, loadReconstruction, loadReconstructionFile, loadCameras, raw, cropFile, parseCrop,
-  parseTransform, parsePointPairs, errorColors, POSE_STRIDE, comparisonTables, runRow;
+  parseTransform, parsePointPairs, errorColors, POSE_STRIDE, comparisonTables, compareTable, runRow;
 
 // (module (func (result v128) i32.const 0 i8x16.splat i8x16.popcnt)): valid only with SIMD128
 const SIMD_PROBE = new Uint8Array([0, 97, 115, 109, 1, 0, 0, 0, 1, 5, 1, 96, 0, 1, 123, 3, 2, 1, 0,
@@ -113,7 +113,7 @@ const handlers = {
       api = { core, note };
       ({
         version, loadGroundTruth, loadReconstruction, loadReconstructionFile, loadCameras, raw, cropFile, parseCrop,
-        parseTransform, parsePointPairs, errorColors, POSE_STRIDE, comparisonTables, runRow,
+        parseTransform, parsePointPairs, errorColors, POSE_STRIDE, comparisonTables, compareTable, runRow,
       } = core);
     }
     // threads: the pool's size (1: the single-thread build); threadsOff: why threads are off;
@@ -275,9 +275,12 @@ const handlers = {
   runRowOnly({ runJson }) {
     return { row: runRow(runJson) };
   },
-  /** The comparison tables' texts (`sfmeval-runner report`'s files) of these rows. */
-  comparisonTables({ rows }) {
-    return { tables: comparisonTables(rows) };
+  /**
+   * The comparison tables' texts (`sfmeval-runner report`'s files) of the entries' rows, and the
+   * Compare table the page shows (columns, cell texts, best marks: the core's catalogue).
+   */
+  comparisonTables({ entries }) {
+    return { tables: comparisonTables(entries.map((e) => e.row)), table: compareTable(entries) };
   },
   colors({ clip }) {
     if (!last) throw new Error('no evaluation yet');

@@ -10,11 +10,17 @@ import { axeViolations } from './axe.mjs';
 import { execFileSync } from 'node:child_process';
 import { readFileSync, mkdirSync, readdirSync, writeFileSync } from 'node:fs';
 import { join, resolve } from 'node:path';
+import { pathToFileURL } from 'node:url';
 
 const args = Object.fromEntries(process.argv.slice(2).reduce((a, v, i, all) => (v.startsWith('--') ? [...a, [v.slice(2), all[i + 1]]] : a), []));
 const [runs, dataset, table, cli, out, cropFile, tableCrop] = ['runs', 'dataset', 'table', 'cli', 'out', 'crop', 'table-crop'].map((k) => resolve(args[k]));
 mkdirSync(out, { recursive: true });
 const origin = new URL(args.url).origin;
+
+// the npm package of the same build (scripts/build-web.sh), in Node: the core's catalogue and
+// colour map as the page must show them
+const npm = await import(pathToFileURL(resolve(new URL('../..', import.meta.url).pathname, 'target/web/npm/index.js')).href);
+await npm.init();
 
 let failed = 0;
 const check = (name, ok, why = '') => {
@@ -108,6 +114,23 @@ try {
   const headers = await page.$$eval('#cmp-table thead th', (ths) => ths.map((t) => t.dataset.k));
   const want = ['pipeline', 'registered', 'points', 'min', 'max', 'mean', 'median', 'std', 'completeness', 'f0', 'f1', 'f2', 'ate', 'status'];
   check('compare-columns', headers.join() === want.join(), headers.join());
+
+  // 4b. the table is the core's: headers, sort titles (best end), cell texts and best marks equal
+  //     the npm package's compareTable of the same rows and reports (the catalogue in Rust), and
+  //     the columns are the catalogue's COMPARE list with its best ends
+  const page4b = await page.evaluate(() => ({
+    entries: window.sfmeval.compare.entries.map((e) => ({ row: e.row, report: e.report })),
+    head: [...document.querySelectorAll('#cmp-table thead th')].map((th) => [th.dataset.k, th.querySelector('button').textContent, th.querySelector('button').title]),
+    cells: [...document.querySelectorAll('#cmp-table tbody tr')].map((tr) => [Number(tr.dataset.i), [...tr.querySelectorAll('td')].map((td) => td.textContent)]),
+  }));
+  const core = npm.compareTable(page4b.entries);
+  const wantHead = core.columns.map((c) => [c.id, c.header, `sort by ${c.header}${c.best ? ` (best: ${c.best === 'lower' ? 'lowest' : 'highest'})` : ''}`]);
+  check('compare-headers-from-the-catalogue', JSON.stringify(page4b.head) === JSON.stringify(wantHead), `${JSON.stringify(page4b.head)} vs ${JSON.stringify(wantHead)}`);
+  const wantCells = page4b.cells.map(([i]) => [i, core.rows[i].map((c) => `${c.text}${c.best ? ' ★' : ''}`)]);
+  check('compare-cells-from-the-core', JSON.stringify(page4b.cells) === JSON.stringify(wantCells), `${JSON.stringify(page4b.cells[0])} vs ${JSON.stringify(wantCells[0])}`);
+  const catalogue = Object.fromEntries(npm.metricCatalogue().map((m) => [m.key, m]));
+  check('compare-best-ends-are-the-catalogue-ones', core.columns.every((c) => (catalogue[c.key.replace(/\[\d+\]/, '[*]')] || {}).best === c.best)
+    && core.columns.find((c) => c.id === 'mean').best === 'lower' && core.columns.find((c) => c.id === 'f0').best === 'higher', JSON.stringify(core.columns));
 
   // 5. sorting: mean ascending, then descending
   await page.click('#cmp-table button.sort[data-k="mean"]');
