@@ -14,6 +14,7 @@ export const MSG = Object.freeze({
   compareRun: 'compareRun',
   runRowOnly: 'runRowOnly',
   comparisonTables: 'comparisonTables',
+  colormap: 'colormap',
   colors: 'colors',
   coloredPly: 'coloredPly',
   csv: 'csv',

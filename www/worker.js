@@ -282,6 +282,11 @@ const handlers = {
   comparisonTables({ entries }) {
     return { tables: comparisonTables(entries.map((e) => e.row)), table: compareTable(entries) };
   },
+  /** `n` colours (r,g,b) of the core's colour map from its low end to its top (the colour bar). */
+  colormap({ n }) {
+    const colors = errorColors(Array.from({ length: n }, (_, i) => i / (n - 1)), 1);
+    return { reply: { colors }, transfer: [colors.buffer] };
+  },
   colors({ clip }) {
     if (!last) throw new Error('no evaluation yet');
     const colors = last.colors(clip);

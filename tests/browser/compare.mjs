@@ -409,6 +409,17 @@ try {
     check(`results-tabs-switch-${w}x${h}`, back[0] && !back[1], JSON.stringify(back));
   }
 
+  // 14. the colour bar is the core's colour map, column by column (no copy of it in the page)
+  await page.click('#tab-evaluation');
+  await page.waitForFunction(() => Number(document.getElementById('colorbar-canvas').dataset.drawn || 0) > 0, null, { timeout: 20000 });
+  const bar = await page.evaluate(() => {
+    const cv = document.getElementById('colorbar-canvas');
+    const d = cv.getContext('2d').getImageData(0, 0, cv.width, 1).data;
+    return { w: cv.width, rgb: Array.from(d).filter((_, i) => i % 4 !== 3) };
+  });
+  const wantBar = Array.from(npm.errorColors(Array.from({ length: bar.w }, (_, i) => i / (bar.w - 1)), 1));
+  check('colorbar-is-the-core-colour-map', bar.rgb.length === wantBar.length && bar.rgb.every((v, i) => v === wantBar[i]),
+    `${bar.rgb.slice(0, 9)} vs ${wantBar.slice(0, 9)}`);
   check('compare-no-request-leaves-origin', requests.every((u) => u.startsWith(origin) || u.startsWith('blob:') || u.startsWith('data:')), requests.filter((u) => !u.startsWith(origin)).join(' '));
   check('compare-no-console-errors', consoleErrors.length === 0, consoleErrors.join(' | '));
 } catch (e) {
