@@ -9,6 +9,7 @@ import { Viewer } from './viewer.js';
 import { dropZone, entryFiles } from './files.js';
 import { $, esc } from './util.js';
 import { MSG } from './core.js';
+import { clearComparisonStale } from './ui.js';
 
 /** Files the runner evaluates in a run folder: `model/` (else `sparse.ply`). */
 const MODEL_EXT = /\.(bin|txt|nvm|out|json|ply)$/i;
@@ -205,6 +206,7 @@ export function setupCompare({ call, viewer, measureOptions, showError, download
       const { tables, table } = await call(MSG.comparisonTables, { entries: entries.map((e) => ({ row: e.row, report: e.report })) });
       state.tables = tables;
       state.table = table;
+      clearComparisonStale();
       render();
       // the results pane now shows the comparison, its table at the top (in view)
       showComparison();

@@ -8,7 +8,7 @@
 import { chromium } from 'playwright-core';
 import { axeViolations } from './axe.mjs';
 import { execFileSync } from 'node:child_process';
-import { readFileSync, mkdirSync, readdirSync, writeFileSync } from 'node:fs';
+import { copyFileSync, readFileSync, mkdirSync, readdirSync, writeFileSync } from 'node:fs';
 import { join, resolve } from 'node:path';
 import { pathToFileURL } from 'node:url';
 
@@ -420,6 +420,26 @@ try {
   const wantBar = Array.from(npm.errorColors(Array.from({ length: bar.w }, (_, i) => i / (bar.w - 1)), 1));
   check('colorbar-is-the-core-colour-map', bar.rgb.length === wantBar.length && bar.rgb.every((v, i) => v === wantBar[i]),
     `${bar.rgb.slice(0, 9)} vs ${wantBar.slice(0, 9)}`);
+  // 15. the comparison goes out of date when the ground truth changes (its note above the table,
+  //     in the flow: the header stays uncovered), and a new Compare clears it
+  await page.click('#tab-comparison');
+  // (another file of the same mesh: the input's change event needs a new file)
+  const gtCopy = join(out, 'compare-gt-copy.glb');
+  copyFileSync(join(dataset, 'ground_truth.glb'), gtCopy);
+  await page.setInputFiles('#file-gt', gtCopy);
+  await page.waitForFunction(() => document.body.dataset.compareStale === '1', null, { timeout: 20000 }).catch(() => {});
+  const stale = await page.evaluate(() => {
+    const note = document.getElementById('cmp-stale-note');
+    const th = document.querySelector('#cmp-table thead th');
+    const r = th.getBoundingClientRect();
+    const hit = document.elementFromPoint(r.left + Math.min(20, r.width / 2), r.top + r.height / 2);
+    return { shown: note.getClientRects().length > 0, text: note.textContent, headerUncovered: !!hit && th.contains(hit), flag: document.body.dataset.compareStale };
+  });
+  check('compare-out-of-date-when-the-ground-truth-changes', stale.shown && /ground truth/.test(stale.text) && stale.flag === '1' && stale.headerUncovered, JSON.stringify(stale));
+  await compareAgain();
+  const fresh = await page.evaluate(() => [document.getElementById('cmp-stale-note').hidden, document.body.dataset.compareStale]);
+  check('compare-again-is-current', fresh[0] === true && fresh[1] === undefined, JSON.stringify(fresh));
+
   check('compare-no-request-leaves-origin', requests.every((u) => u.startsWith(origin) || u.startsWith('blob:') || u.startsWith('data:')), requests.filter((u) => !u.startsWith(origin)).join(' '));
   check('compare-no-console-errors', consoleErrors.length === 0, consoleErrors.join(' | '));
 } catch (e) {
