@@ -11,7 +11,7 @@ import { $, esc } from './util.js';
 import { MSG } from './core.js';
 import { clearComparisonStale } from './ui.js';
 
-/** Files the runner evaluates in a run folder: `model/` (else `sparse.ply`). */
+/** Model files outside run folders (loose files, model folders), by extension. */
 const MODEL_EXT = /\.(bin|txt|nvm|out|json|ply)$/i;
 
 /** A COLMAP model's files: together they are one model (as the Reconstruction input reads them). */
@@ -21,13 +21,14 @@ const COLMAP_FILE = /^(cameras|images|points3D|rigs|frames)\.(txt|bin)$/i;
  * Groups picked or dropped files (with `webkitRelativePath`-like names) into the items to
  * compare: `{pipeline, runJson (File|null), files: {relName: File}, path}`. A folder holding
  * `run.json` files is a runs folder: each run folder is one item named by its pipeline, with
- * its `model/` files (or `sparse.ply`). Otherwise each folder's COLMAP files
+ * the files `runFiles(paths)` (the core's run-folder layout, as the runner reads it: `model/`,
+ * else `sparse.ply`) picks from the folder's paths. Otherwise each folder's COLMAP files
  * (cameras/images/points3D .txt or .bin) are one model named by that folder (`model` for loose
  * files, as the Reconstruction input names them), and every other model file (PLY, NVM, Bundler
  * .out, sfm_data.json) is one item named by the file; a name that repeats is prefixed by the
  * file's own folder.
  */
-export function groupItems(fileList) {
+export async function groupItems(fileList, runFiles) {
   const files = Array.from(fileList).map((f) => ({ f, path: (f.webkitRelativePath || f.name).replace(/^\/+/, '') }));
   const runs = files.filter((x) => x.path.split('/').pop() === 'run.json' && x.path.includes('/'));
   const items = [];
@@ -35,15 +36,8 @@ export function groupItems(fileList) {
     for (const r of runs) {
       const dir = r.path.slice(0, -'run.json'.length); // ends with '/'
       const inRun = files.filter((x) => x.path.startsWith(dir) && x.path !== r.path);
-      const model = {};
-      for (const x of inRun) {
-        const rel = x.path.slice(dir.length);
-        if (rel.startsWith('model/') && MODEL_EXT.test(rel)) model[rel.slice('model/'.length)] = x.f;
-      }
-      if (!Object.keys(model).length) {
-        const ply = inRun.find((x) => x.path.slice(dir.length) === 'sparse.ply');
-        if (ply) model['sparse.ply'] = ply.f;
-      }
+      const byRel = new Map(inRun.map((x) => [x.path.slice(dir.length), x.f]));
+      const model = Object.fromEntries((await runFiles([...byRel.keys()])).map(([p, name]) => [name, byRel.get(p)]));
       const parts = dir.split('/').filter(Boolean);
       items.push({ pipeline: parts[parts.length - 1], runJson: r.f, files: model, path: dir });
     }
@@ -143,8 +137,13 @@ export function setupCompare({ call, viewer, measureOptions, showError, download
     info.classList.add('error');
     showError(msg, 'file-runs');
   };
-  const take = (files) => {
-    const items = groupItems(files);
+  const runFiles = async (paths) => (await call(MSG.runFiles, { paths })).files;
+  let picks = 0; // the latest pick wins over an earlier one still being grouped
+  const take = async (files) => {
+    const pick = ++picks;
+    let items;
+    try { items = await groupItems(files, runFiles); } catch (err) { if (pick === picks) fail(`compare: ${err.message}`); return; }
+    if (pick !== picks) return;
     if (!items.length) fail('compare: no reconstruction found (a runs folder needs <pipeline>/run.json; a model folder its model files)');
     else setItems(items);
   };
@@ -154,7 +153,7 @@ export function setupCompare({ call, viewer, measureOptions, showError, download
     try {
       const files = [];
       for (const en of entries) files.push(...(await entryFiles(en)));
-      take(files.length ? files : dropped);
+      await take(files.length ? files : dropped);
     } catch (err) { fail(`compare: ${err.message}`); }
   });
 

@@ -13,6 +13,7 @@ export const MSG = Object.freeze({
   evaluate: 'evaluate',
   compareRun: 'compareRun',
   runRowOnly: 'runRowOnly',
+  runFiles: 'runFiles',
   comparisonTables: 'comparisonTables',
   colormap: 'colormap',
   colors: 'colors',

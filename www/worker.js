@@ -5,7 +5,7 @@
 // thread, scalar). Both are the npm package's API; `init` picks one.
 let api = null;
 let version, loadGroundTruth, loadReconstruction, loadReconstructionFile, loadCameras, raw, cropFile, parseCrop,
-  parseTransform, parsePointPairs, errorColors, POSE_STRIDE, comparisonTables, compareTable, runRow;
+  parseTransform, parsePointPairs, errorColors, POSE_STRIDE, comparisonTables, compareTable, runReconstructionFiles, runRow;
 
 // (module (func (result v128) i32.const 0 i8x16.splat i8x16.popcnt)): valid only with SIMD128
 const SIMD_PROBE = new Uint8Array([0, 97, 115, 109, 1, 0, 0, 0, 1, 5, 1, 96, 0, 1, 123, 3, 2, 1, 0,
@@ -113,7 +113,7 @@ const handlers = {
       api = { core, note };
       ({
         version, loadGroundTruth, loadReconstruction, loadReconstructionFile, loadCameras, raw, cropFile, parseCrop,
-        parseTransform, parsePointPairs, errorColors, POSE_STRIDE, comparisonTables, compareTable, runRow,
+        parseTransform, parsePointPairs, errorColors, POSE_STRIDE, comparisonTables, compareTable, runReconstructionFiles, runRow,
       } = core);
     }
     // threads: the pool's size (1: the single-thread build); threadsOff: why threads are off;
@@ -270,6 +270,10 @@ const handlers = {
         };
       } finally { e.free(); }
     } finally { r.free(); }
+  },
+  /** Which of a run folder's files (paths relative to it) form its reconstruction: `[[path, name]]`. */
+  runFiles({ paths }) {
+    return { files: runReconstructionFiles(paths) };
   },
   /** The row of a run that did not end ok, from its run.json text. */
   runRowOnly({ runJson }) {

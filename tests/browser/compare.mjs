@@ -66,6 +66,8 @@ try {
 
   // 1. the runs folder through the folder input: one row per run.json
   await page.setInputFiles('#dir-runs', runs);
+  // (which files form each run comes from the core, through the worker)
+  await page.waitForFunction(() => /runner run/.test(document.getElementById('info-runs').textContent), null, { timeout: 20000 }).catch(() => {});
   const info = await page.textContent('#info-runs');
   const pipelines = readdirSync(join(runs, 'statue')).sort();
   check('compare-recognises-runs', info.includes(`${pipelines.length} reconstructions (${pipelines.length} runner runs)`), info);

@@ -243,5 +243,9 @@ check('npm-crop-roundtrip', crop.volume.kind === 'sphere' && sfmeval.cropFile(cr
   }) && byKey['report.accuracy.mean'].best === 'lower' && byKey['report.thresholds[*].f_score'].best === 'higher',
   JSON.stringify(t.columns));
 }
+// a run folder's reconstruction as the runner reads it: model/'s model files, else sparse.ply
+check('npm-run-folder-layout', JSON.stringify(sfmeval.runReconstructionFiles(['run.json', 'log.txt', 'sparse.ply', 'model/sparse/0/points3D.bin', 'model/x.jpg']))
+  === JSON.stringify([['model/sparse/0/points3D.bin', 'sparse/0/points3D.bin']])
+  && JSON.stringify(sfmeval.runReconstructionFiles(['run.json', 'sparse.ply', 'model/notes.md'])) === JSON.stringify([['sparse.ply', 'sparse.ply']]));
 console.log(`npm: demo evaluated in ${ms.toFixed(0)} ms in Node`);
 process.exit(failed ? 1 : 0);

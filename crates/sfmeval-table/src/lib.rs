@@ -8,6 +8,7 @@ pub mod catalogue;
 pub mod cells;
 pub mod compare;
 pub mod csv;
+pub mod layout;
 pub mod number;
 pub mod order;
 pub mod row;

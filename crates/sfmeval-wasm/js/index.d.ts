@@ -254,6 +254,9 @@ export interface Metric {
   digits: number | null;
 }
 
+/** Which of a run folder's files (paths relative to it) form its reconstruction: `[path, name]`. */
+export function runReconstructionFiles(paths: string[]): [string, string][];
+
 /** The comparison's metrics. */
 export function metricCatalogue(): Metric[];
 

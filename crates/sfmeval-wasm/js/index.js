@@ -255,6 +255,15 @@ export function compareTable(entries) {
   return wasm.compareTable(JSON.stringify(entries.map((e) => ({ row: e.row, report: e.report ?? null }))));
 }
 
+/**
+ * Which of a run folder's files form its reconstruction, as the runner reads a run folder
+ * (`model/`'s model files, else `sparse.ply`): `paths` relative to the folder in, `[[path, name]]`
+ * out, `name` as `loadReconstruction` wants it keyed.
+ */
+export function runReconstructionFiles(paths) {
+  return wasm.runReconstructionFiles(JSON.stringify(paths));
+}
+
 /** The comparison's metrics: `[{key, id, header, unit, name, best, digits}]`. */
 export function metricCatalogue() {
   return wasm.metricCatalogue();

@@ -81,3 +81,16 @@ pub fn compare_table(entries_json: &str) -> Result<JsValue, JsError> {
 pub fn metric_catalogue() -> Result<JsValue, JsError> {
     to_js("catalogue", &sfmeval_table::CATALOGUE)
 }
+
+/// Which of a run folder's files form its reconstruction (`sfmeval_table::layout`), given the
+/// paths relative to the folder as a JSON array: `[[path, name]]`, `name` as the
+/// reconstruction's readers key it (the runner's `report` reads the same).
+#[wasm_bindgen(js_name = runReconstructionFiles)]
+pub fn run_reconstruction_files(paths_json: &str) -> Result<JsValue, JsError> {
+    let paths: Vec<String> =
+        serde_json::from_str(paths_json).map_err(|e| js_err("run folder paths", e))?;
+    to_js(
+        "run folder",
+        &sfmeval_table::layout::reconstruction_files(&paths),
+    )
+}
