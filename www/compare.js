@@ -9,8 +9,9 @@ import { Viewer } from './viewer.js';
 import { dropZone, entryFiles } from './files.js';
 import { $, esc } from './util.js';
 import { MSG } from './core.js';
+import { clearComparisonStale } from './ui.js';
 
-/** Files the runner evaluates in a run folder: `model/` (else `sparse.ply`). */
+/** Model files outside run folders (loose files, model folders), by extension. */
 const MODEL_EXT = /\.(bin|txt|nvm|out|json|ply)$/i;
 
 /** A COLMAP model's files: together they are one model (as the Reconstruction input reads them). */
@@ -20,13 +21,14 @@ const COLMAP_FILE = /^(cameras|images|points3D|rigs|frames)\.(txt|bin)$/i;
  * Groups picked or dropped files (with `webkitRelativePath`-like names) into the items to
  * compare: `{pipeline, runJson (File|null), files: {relName: File}, path}`. A folder holding
  * `run.json` files is a runs folder: each run folder is one item named by its pipeline, with
- * its `model/` files (or `sparse.ply`). Otherwise each folder's COLMAP files
+ * the files `runFiles(paths)` (the core's run-folder layout, as the runner reads it: `model/`,
+ * else `sparse.ply`) picks from the folder's paths. Otherwise each folder's COLMAP files
  * (cameras/images/points3D .txt or .bin) are one model named by that folder (`model` for loose
  * files, as the Reconstruction input names them), and every other model file (PLY, NVM, Bundler
  * .out, sfm_data.json) is one item named by the file; a name that repeats is prefixed by the
  * file's own folder.
  */
-export function groupItems(fileList) {
+export async function groupItems(fileList, runFiles) {
   const files = Array.from(fileList).map((f) => ({ f, path: (f.webkitRelativePath || f.name).replace(/^\/+/, '') }));
   const runs = files.filter((x) => x.path.split('/').pop() === 'run.json' && x.path.includes('/'));
   const items = [];
@@ -34,15 +36,8 @@ export function groupItems(fileList) {
     for (const r of runs) {
       const dir = r.path.slice(0, -'run.json'.length); // ends with '/'
       const inRun = files.filter((x) => x.path.startsWith(dir) && x.path !== r.path);
-      const model = {};
-      for (const x of inRun) {
-        const rel = x.path.slice(dir.length);
-        if (rel.startsWith('model/') && MODEL_EXT.test(rel)) model[rel.slice('model/'.length)] = x.f;
-      }
-      if (!Object.keys(model).length) {
-        const ply = inRun.find((x) => x.path.slice(dir.length) === 'sparse.ply');
-        if (ply) model['sparse.ply'] = ply.f;
-      }
+      const byRel = new Map(inRun.map((x) => [x.path.slice(dir.length), x.f]));
+      const model = Object.fromEntries((await runFiles([...byRel.keys()])).map(([p, name]) => [name, byRel.get(p)]));
       const parts = dir.split('/').filter(Boolean);
       items.push({ pipeline: parts[parts.length - 1], runJson: r.f, files: model, path: dir });
     }
@@ -83,38 +78,6 @@ export function groupItems(fileList) {
   items.sort((a, b) => (a.path < b.path ? -1 : a.path > b.path ? 1 : 0));
   return items;
 }
-
-/** The comparison table's columns: key, header, value of an entry, and which end is best. */
-function columns(entries) {
-  const nt = Math.max(0, ...entries.map((e) => (e.report ? e.report.thresholds.length : 0)));
-  const first = entries.find((e) => e.report);
-  const acc = (k) => (e) => (e.report ? e.report.accuracy[k] : null);
-  const cols = [
-    { key: 'pipeline', head: 'pipeline', val: (e) => e.row.pipeline, text: true },
-    { key: 'registered', head: 'registered / total', val: (e) => e.row.images_registered, show: (e) => `${e.row.images_registered}/${e.row.images_total}`, best: 'max' },
-    { key: 'points', head: 'points', val: (e) => (e.report ? e.row.points : null), best: 'max' },
-    { key: 'min', head: 'min', val: acc('min'), best: 'min' },
-    { key: 'max', head: 'max', val: acc('max'), best: 'min' },
-    { key: 'mean', head: 'mean', val: acc('mean'), best: 'min' },
-    { key: 'median', head: 'median', val: acc('median'), best: 'min' },
-    { key: 'std', head: 'std', val: acc('std'), best: 'min' },
-    { key: 'completeness', head: 'completeness (mean)', val: (e) => e.row.completeness_mean, best: 'min' },
-  ];
-  for (let k = 0; k < nt; k++) {
-    const pct = first ? Number(first.report.thresholds[k].tau_percent_of_diagonal.toFixed(6)) : k;
-    cols.push({ key: `f${k}`, head: `F@${pct}%`, val: (e) => (e.report && e.report.thresholds[k] ? e.report.thresholds[k].f_score : null), best: 'max' });
-  }
-  cols.push({ key: 'ate', head: 'pose ATE', val: (e) => (e.report && e.report.cameras ? e.report.cameras.ate_rmse : null), best: 'min' });
-  cols.push({ key: 'status', head: 'status', val: (e) => e.row.status, text: true });
-  return cols;
-}
-
-const fmt = (v) => {
-  if (v == null || Number.isNaN(v)) return '—';
-  if (Number.isInteger(v)) return String(v);
-  const a = Math.abs(v);
-  return a !== 0 && (a < 1e-3 || a >= 1e5) ? v.toExponential(3) : v.toPrecision(4);
-};
 
 /** Draws the P/R/F curves of every entry over one τ axis; returns the uPlot. */
 function curves(el, entries) {
@@ -158,7 +121,7 @@ function curves(el, entries) {
  * `showComparison()` turns the results pane to the comparison.
  */
 export function setupCompare({ call, viewer, measureOptions, showError, download, gtName, setRunning, showComparison }) {
-  const state = { items: [], entries: [], sort: null, tables: null, viewer2: null };
+  const state = { items: [], entries: [], sort: null, tables: null, table: null, viewer2: null };
   const info = $('info-runs');
   const setItems = (items) => {
     state.items = items;
@@ -174,8 +137,13 @@ export function setupCompare({ call, viewer, measureOptions, showError, download
     info.classList.add('error');
     showError(msg, 'file-runs');
   };
-  const take = (files) => {
-    const items = groupItems(files);
+  const runFiles = async (paths) => (await call(MSG.runFiles, { paths })).files;
+  let picks = 0; // the latest pick wins over an earlier one still being grouped
+  const take = async (files) => {
+    const pick = ++picks;
+    let items;
+    try { items = await groupItems(files, runFiles); } catch (err) { if (pick === picks) fail(`compare: ${err.message}`); return; }
+    if (pick !== picks) return;
     if (!items.length) fail('compare: no reconstruction found (a runs folder needs <pipeline>/run.json; a model folder its model files)');
     else setItems(items);
   };
@@ -185,7 +153,7 @@ export function setupCompare({ call, viewer, measureOptions, showError, download
     try {
       const files = [];
       for (const en of entries) files.push(...(await entryFiles(en)));
-      take(files.length ? files : dropped);
+      await take(files.length ? files : dropped);
     } catch (err) { fail(`compare: ${err.message}`); }
   });
 
@@ -234,8 +202,10 @@ export function setupCompare({ call, viewer, measureOptions, showError, download
         }
       }
       state.entries = entries;
-      const { tables } = await call(MSG.comparisonTables, { rows: entries.map((e) => e.row) });
+      const { tables, table } = await call(MSG.comparisonTables, { entries: entries.map((e) => ({ row: e.row, report: e.report })) });
       state.tables = tables;
+      state.table = table;
+      clearComparisonStale();
       render();
       // the results pane now shows the comparison, its table at the top (in view)
       showComparison();
@@ -260,43 +230,38 @@ export function setupCompare({ call, viewer, measureOptions, showError, download
 
   function render() {
     $('compare-results').hidden = false;
-    const cols = columns(state.entries);
+    // columns, cell texts and best marks come from the core (its catalogue of metrics); the
+    // page only sorts the rows
+    const { columns: cols, rows } = state.table;
     let order = state.entries.map((_, i) => i);
     if (state.sort) {
-      const c = cols.find((x) => x.key === state.sort.key);
-      if (c) {
-        const v = (i) => c.val(state.entries[i]);
+      const c = cols.findIndex((x) => x.id === state.sort.key);
+      if (c >= 0) {
+        const text = cols[c].text;
+        const v = (i) => (text ? rows[i][c].text : rows[i][c].value);
         order.sort((a, b) => {
           const x = v(a), y = v(b);
           if (x == null && y == null) return a - b;
           if (x == null) return 1;
           if (y == null) return -1;
-          const d = c.text ? String(x).localeCompare(String(y)) : x - y;
+          const d = text ? String(x).localeCompare(String(y)) : x - y;
           return (state.sort.dir === 'asc' ? d : -d) || a - b;
         });
       }
     }
-    const best = {};
-    for (const c of cols) {
-      if (!c.best) continue;
-      const vals = state.entries.map((e) => c.val(e)).filter((v) => v != null && Number.isFinite(v));
-      if (vals.length > 1) best[c.key] = c.best === 'min' ? Math.min(...vals) : Math.max(...vals);
-    }
     let h = '<table id="cmp-table"><thead><tr>';
     for (const c of cols) {
-      const s = state.sort && state.sort.key === c.key ? state.sort.dir : null;
-      h += `<th data-k="${c.key}" aria-sort="${s === 'asc' ? 'ascending' : s === 'desc' ? 'descending' : 'none'}"><button class="sort small" data-k="${c.key}" title="sort by ${esc(c.head)}${c.best ? ` (best: ${c.best === 'min' ? 'lowest' : 'highest'})` : ''}">${esc(c.head)}${s === 'asc' ? ' ▲' : s === 'desc' ? ' ▼' : ''}</button></th>`;
+      const s = state.sort && state.sort.key === c.id ? state.sort.dir : null;
+      h += `<th data-k="${c.id}" aria-sort="${s === 'asc' ? 'ascending' : s === 'desc' ? 'descending' : 'none'}"><button class="sort small" data-k="${c.id}" title="sort by ${esc(c.header)}${c.best ? ` (best: ${c.best === 'lower' ? 'lowest' : 'highest'})` : ''}">${esc(c.header)}${s === 'asc' ? ' ▲' : s === 'desc' ? ' ▼' : ''}</button></th>`;
     }
     h += '</tr></thead><tbody>';
     for (const i of order) {
       const e = state.entries[i];
       h += `<tr data-i="${i}" data-pipeline="${esc(e.row.pipeline)}">`;
-      for (const c of cols) {
-        const v = c.val(e);
-        const isBest = c.key in best && v === best[c.key];
-        const text = c.show ? c.show(e) : c.text ? v : fmt(v);
-        h += `<td data-k="${c.key}"${c.text ? ' class="text"' : ''}${isBest ? ' data-best="1" class="best" title="best of this column"' : ''}${v != null && !c.text ? ` data-v="${v}"` : ''}>${esc(text)}${isBest ? ' ★' : ''}</td>`;
-      }
+      cols.forEach((c, j) => {
+        const cell = rows[i][j];
+        h += `<td data-k="${c.id}"${c.text ? ' class="text"' : ''}${cell.best ? ' data-best="1" class="best" title="best of this column"' : ''}${cell.value != null ? ` data-v="${cell.value}"` : ''}>${esc(cell.text)}${cell.best ? ' ★' : ''}</td>`;
+      });
       h += '</tr>';
     }
     h += '</tbody></table>';

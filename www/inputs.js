@@ -125,7 +125,7 @@ async function loadGt(fileList, { demo = false } = {}) {
     setInputInfo('gt', `${gt.name} (${gt.format}): ${gt.vertexCount} vertices, ${gt.triangleCount} triangles`, { notes: gt.warnings });
     viewer.framedCameras = false;
     await resetEarlier('gt', { afterDemo, hadGt });
-    markStale(`the ground truth is now '${gt.name}'`);
+    markStale(`the ground truth is now '${gt.name}'`, { comparison: true });
     refreshPoints();
     return true;
   } catch (e) {
@@ -135,7 +135,7 @@ async function loadGt(fileList, { demo = false } = {}) {
     viewer.setCoverage(null);
     viewer.clearGroundTruth();
     inputFailed('gt', e);
-    markStale('the ground truth failed to load');
+    markStale('the ground truth failed to load', { comparison: true });
     refreshPoints();
     return false;
   } finally { setBusy(false); }
@@ -202,7 +202,7 @@ async function loadCams(fileList, { demo = false } = {}) {
     state.camerasName = Object.keys(files)[0];
     sources.cams = { files: Array.from(fileList), gtGen: loadedWith(), demo };
     setInputInfo('cams', `${state.camerasName}: ${c.images} images`);
-    markStale(`the ground-truth cameras are now '${state.camerasName}'`);
+    markStale(`the ground-truth cameras are now '${state.camerasName}'`, { comparison: true });
     return true;
   } catch (e) {
     // nothing half-loaded: the page and the worker both have no cameras now
@@ -210,7 +210,7 @@ async function loadCams(fileList, { demo = false } = {}) {
     sources.cams = null;
     await call(MSG.clearCameras).catch(() => {});
     inputFailed('cams', e);
-    markStale('the ground-truth cameras failed to load');
+    markStale('the ground-truth cameras failed to load', { comparison: true });
     return false;
   } finally { setBusy(false); }
 }
@@ -234,13 +234,13 @@ async function loadDepth(fileList) {
     state.depthCount = d.count;
     sources.depth = { files: npy, gtGen: loadedWith() };
     setInputInfo('depth', `${d.count} depth maps${d.checked ? '' : ' (checked against cameras.json when evaluating)'}`);
-    markStale(`${d.count} depth maps were loaded`);
+    markStale(`${d.count} depth maps were loaded`, { comparison: true });
   } catch (e) {
     state.depthCount = 0;
     sources.depth = null;
     await call(MSG.clearDepth).catch(() => {});
     inputFailed('depth', e);
-    markStale('the depth maps failed to load');
+    markStale('the depth maps failed to load', { comparison: true });
   } finally { setBusy(false); }
 }
 
@@ -288,7 +288,7 @@ $('clear-cams').onclick = async () => {
   state.camerasName = null;
   sources.cams = null;
   setInputInfo('cams', '—');
-  if (had) markStale('the ground-truth cameras were cleared');
+  if (had) markStale('the ground-truth cameras were cleared', { comparison: true });
 };
 $('clear-depth').onclick = async () => {
   await call(MSG.clearDepth);
@@ -296,7 +296,7 @@ $('clear-depth').onclick = async () => {
   state.depthCount = 0;
   sources.depth = null;
   setInputInfo('depth', '—');
-  if (had) markStale('the depth maps were cleared');
+  if (had) markStale('the depth maps were cleared', { comparison: true });
 };
 
 // ---- demo -------------------------------------------------------------------------------

@@ -1,12 +1,6 @@
 // Plots with uPlot: the accuracy histogram and precision/recall/F against τ.
 import uPlot from 'uplot';
 
-/** The core's viridis anchors (crates/sfmeval/src/colormap.rs), for the colour bar. */
-export const VIRIDIS = [
-  [68, 1, 84], [71, 44, 122], [59, 81, 139], [44, 113, 142], [33, 144, 141],
-  [39, 173, 129], [92, 200, 99], [170, 220, 50], [253, 231, 37],
-];
-
 const plots = new Map();
 function replace(el, plot) {
   const old = plots.get(el);

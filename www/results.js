@@ -6,7 +6,7 @@ import { state } from './state.js';
 import { clearStale, showView } from './ui.js';
 import { refreshPoints } from './points.js';
 import { reportNotes, notesHtml } from './notes.js';
-import { histogramPlot, curvesPlot, VIRIDIS } from './plots.js';
+import { histogramPlot, curvesPlot } from './plots.js';
 
 /** The alignment stages (`alignment.stages[].method`) in words. */
 const STAGE_LABEL = { cameras: 'camera centres', points: 'point pairs', global: 'global search', icp: 'ICP', given: 'given', none: 'none' };
@@ -126,16 +126,25 @@ $('tau-add').onclick = () => {
 };
 
 // colours
+let colormap = null; // the core's colours, one per column of the colour bar (low end to top)
 function drawColorbar(clip) {
-  const cv = $('colorbar-canvas');
-  const ctx = cv.getContext('2d');
-  const grad = ctx.createLinearGradient(0, 0, cv.width, 0);
-  VIRIDIS.forEach((c, i) => grad.addColorStop(i / (VIRIDIS.length - 1), `rgb(${c[0]},${c[1]},${c[2]})`));
-  ctx.fillStyle = grad;
-  ctx.fillRect(0, 0, cv.width, cv.height);
   $('cb-hi').textContent = `≥ ${Number(clip.toPrecision(3))}`;
   $('cb-hi').title = `clip ${g(clip)}: this distance and larger are yellow`;
   $('colorbar').style.display = 'flex';
+  const cv = $('colorbar-canvas');
+  // the core's own map (the points' colours), one column each: no copy of it here
+  const ready = colormap && colormap.length === 3 * cv.width ? Promise.resolve()
+    : call(MSG.colormap, { n: cv.width }).then((r) => { colormap = r.colors; });
+  ready.then(() => {
+    const ctx = cv.getContext('2d');
+    const img = ctx.createImageData(cv.width, cv.height);
+    for (let i = 0; i < cv.width * cv.height; i++) {
+      img.data.set(colormap.subarray(3 * (i % cv.width), 3 * (i % cv.width) + 3), 4 * i);
+      img.data[4 * i + 3] = 255;
+    }
+    ctx.putImageData(img, 0, 0);
+    cv.dataset.drawn = String(Number(cv.dataset.drawn || 0) + 1);
+  }).catch(() => {}); // a worker stopped by Cancel: the next evaluation draws it
 }
 $('clip').addEventListener('change', async () => {
   const clip = Number($('clip').value);

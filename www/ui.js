@@ -58,9 +58,12 @@ export function setBusy(b) {
 
 /**
  * Marks the results on screen as no longer current (dimmed under a note saying `why`),
- * disables their downloads and hides the colour bar. A new evaluation clears it.
+ * disables their downloads and hides the colour bar. A new evaluation clears it. With
+ * `comparison` (the ground truth, its cameras or depth maps changed: what Compare measured
+ * against) the comparison on screen goes out of date too, until the next Compare.
  */
-export function markStale(why) {
+export function markStale(why, { comparison = false } = {}) {
+  if (comparison) markComparisonStale(why);
   if (!state.shownResult) return;
   $('results').classList.add('stale');
   $('align-result').classList.add('stale');
@@ -72,6 +75,23 @@ export function markStale(why) {
   document.body.dataset.stale = '1';
   setRunNote('');
   if (state.result && state.recon) refreshPoints(); // without the error colours
+}
+/**
+ * The comparison on screen no longer matches the inputs: dimmed under its own note (above its
+ * table, in the flow: it never covers the table's header).
+ */
+export function markComparisonStale(why) {
+  if ($('compare-results').hidden) return;
+  $('compare-results').classList.add('stale');
+  $('cmp-stale-note').hidden = false;
+  $('cmp-stale-note').textContent = `Out of date: ${why}. This is the previous comparison; press Compare for a new one.`;
+  document.body.dataset.compareStale = '1';
+}
+export function clearComparisonStale() {
+  $('compare-results').classList.remove('stale');
+  $('cmp-stale-note').hidden = true;
+  $('cmp-stale-note').textContent = '';
+  delete document.body.dataset.compareStale;
 }
 export function clearStale() {
   $('results').classList.remove('stale');

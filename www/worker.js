@@ -5,7 +5,7 @@
 // thread, scalar). Both are the npm package's API; `init` picks one.
 let api = null;
 let version, loadGroundTruth, loadReconstruction, loadReconstructionFile, loadCameras, raw, cropFile, parseCrop,
-  parseTransform, parsePointPairs, errorColors, POSE_STRIDE, comparisonTables, runRow;
+  parseTransform, parsePointPairs, errorColors, POSE_STRIDE, comparisonTables, compareTable, runReconstructionFiles, runRow;
 
 // (module (func (result v128) i32.const 0 i8x16.splat i8x16.popcnt)): valid only with SIMD128
 const SIMD_PROBE = new Uint8Array([0, 97, 115, 109, 1, 0, 0, 0, 1, 5, 1, 96, 0, 1, 123, 3, 2, 1, 0,
@@ -113,7 +113,7 @@ const handlers = {
       api = { core, note };
       ({
         version, loadGroundTruth, loadReconstruction, loadReconstructionFile, loadCameras, raw, cropFile, parseCrop,
-        parseTransform, parsePointPairs, errorColors, POSE_STRIDE, comparisonTables, runRow,
+        parseTransform, parsePointPairs, errorColors, POSE_STRIDE, comparisonTables, compareTable, runReconstructionFiles, runRow,
       } = core);
     }
     // threads: the pool's size (1: the single-thread build); threadsOff: why threads are off;
@@ -271,13 +271,25 @@ const handlers = {
       } finally { e.free(); }
     } finally { r.free(); }
   },
+  /** Which of a run folder's files (paths relative to it) form its reconstruction: `[[path, name]]`. */
+  runFiles({ paths }) {
+    return { files: runReconstructionFiles(paths) };
+  },
   /** The row of a run that did not end ok, from its run.json text. */
   runRowOnly({ runJson }) {
     return { row: runRow(runJson) };
   },
-  /** The comparison tables' texts (`sfmeval-runner report`'s files) of these rows. */
-  comparisonTables({ rows }) {
-    return { tables: comparisonTables(rows) };
+  /**
+   * The comparison tables' texts (`sfmeval-runner report`'s files) of the entries' rows, and the
+   * Compare table the page shows (columns, cell texts, best marks: the core's catalogue).
+   */
+  comparisonTables({ entries }) {
+    return { tables: comparisonTables(entries.map((e) => e.row)), table: compareTable(entries) };
+  },
+  /** `n` colours (r,g,b) of the core's colour map from its low end to its top (the colour bar). */
+  colormap({ n }) {
+    const colors = errorColors(Array.from({ length: n }, (_, i) => i / (n - 1)), 1);
+    return { reply: { colors }, transfer: [colors.buffer] };
   },
   colors({ clip }) {
     if (!last) throw new Error('no evaluation yet');

@@ -5,14 +5,14 @@
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
 
-use anyhow::{Context, Result, bail};
+use anyhow::{Result, bail};
 use sfmeval::align::AlignRequest;
 use sfmeval::dataset::{Dataset, DatasetPaths};
 use sfmeval::evaluate::EvalOptions;
 use sfmeval::pipeline::{self, EvalRequest};
 use sfmeval::progress::NoProgress;
 use sfmeval::report::Report;
-use sfmeval_fs::{path_str, read_input_files, write_atomic};
+use sfmeval_fs::{path_str, write_atomic};
 
 use crate::run::{RunRecord, Status, list_runs, read_record};
 use crate::table::write_tables;
@@ -203,16 +203,8 @@ fn evaluate_run(
     rec: &RunRecord,
     args: &ReportArgs,
 ) -> Result<(Report, Vec<f64>)> {
-    let model = dir.join("model");
-    let mut files = if model.is_dir() {
-        read_input_files(&model)?
-    } else {
-        BTreeMap::new()
-    };
-    if files.is_empty() {
-        let ply = std::fs::read(dir.join("sparse.ply")).context("reading sparse.ply")?;
-        files.insert("sparse.ply".into(), ply);
-    }
+    // the run folder's layout (model/, else sparse.ply) is sfmeval-table's
+    let files = sfmeval_table::layout::read_run_reconstruction(&sfmeval_fs::Disk, path_str(dir)?)?;
     let name = format!("{}/{}", rec.dataset, rec.pipeline);
     let recon = pipeline::read_reconstruction(&name, &files)?;
     let request = EvalRequest {

@@ -44,7 +44,7 @@ pub fn evaluate_run(
     out: &Path,
     tau: Option<f64>,
 ) -> Result<Row> {
-    let model_dir = run_dir.join("model");
+    let model_dir = run_dir.join(sfmeval_table::layout::MODEL_DIR);
     let name = format!("{}/{}", rec.dataset, rec.pipeline);
     let recon = sfmeval::pipeline::read_reconstruction(&name, &read_input_files(&model_dir)?)
         .with_context(|| format!("model {}", model_dir.display()))?;

@@ -8,13 +8,19 @@
 import { chromium } from 'playwright-core';
 import { axeViolations } from './axe.mjs';
 import { execFileSync } from 'node:child_process';
-import { readFileSync, mkdirSync, readdirSync, writeFileSync } from 'node:fs';
+import { copyFileSync, readFileSync, mkdirSync, readdirSync, writeFileSync } from 'node:fs';
 import { join, resolve } from 'node:path';
+import { pathToFileURL } from 'node:url';
 
 const args = Object.fromEntries(process.argv.slice(2).reduce((a, v, i, all) => (v.startsWith('--') ? [...a, [v.slice(2), all[i + 1]]] : a), []));
 const [runs, dataset, table, cli, out, cropFile, tableCrop] = ['runs', 'dataset', 'table', 'cli', 'out', 'crop', 'table-crop'].map((k) => resolve(args[k]));
 mkdirSync(out, { recursive: true });
 const origin = new URL(args.url).origin;
+
+// the npm package of the same build (scripts/build-web.sh), in Node: the core's catalogue and
+// colour map as the page must show them
+const npm = await import(pathToFileURL(resolve(new URL('../..', import.meta.url).pathname, 'target/web/npm/index.js')).href);
+await npm.init();
 
 let failed = 0;
 const check = (name, ok, why = '') => {
@@ -60,6 +66,8 @@ try {
 
   // 1. the runs folder through the folder input: one row per run.json
   await page.setInputFiles('#dir-runs', runs);
+  // (which files form each run comes from the core, through the worker)
+  await page.waitForFunction(() => /runner run/.test(document.getElementById('info-runs').textContent), null, { timeout: 20000 }).catch(() => {});
   const info = await page.textContent('#info-runs');
   const pipelines = readdirSync(join(runs, 'statue')).sort();
   check('compare-recognises-runs', info.includes(`${pipelines.length} reconstructions (${pipelines.length} runner runs)`), info);
@@ -108,6 +116,23 @@ try {
   const headers = await page.$$eval('#cmp-table thead th', (ths) => ths.map((t) => t.dataset.k));
   const want = ['pipeline', 'registered', 'points', 'min', 'max', 'mean', 'median', 'std', 'completeness', 'f0', 'f1', 'f2', 'ate', 'status'];
   check('compare-columns', headers.join() === want.join(), headers.join());
+
+  // 4b. the table is the core's: headers, sort titles (best end), cell texts and best marks equal
+  //     the npm package's compareTable of the same rows and reports (the catalogue in Rust), and
+  //     the columns are the catalogue's COMPARE list with its best ends
+  const page4b = await page.evaluate(() => ({
+    entries: window.sfmeval.compare.entries.map((e) => ({ row: e.row, report: e.report })),
+    head: [...document.querySelectorAll('#cmp-table thead th')].map((th) => [th.dataset.k, th.querySelector('button').textContent, th.querySelector('button').title]),
+    cells: [...document.querySelectorAll('#cmp-table tbody tr')].map((tr) => [Number(tr.dataset.i), [...tr.querySelectorAll('td')].map((td) => td.textContent)]),
+  }));
+  const core = npm.compareTable(page4b.entries);
+  const wantHead = core.columns.map((c) => [c.id, c.header, `sort by ${c.header}${c.best ? ` (best: ${c.best === 'lower' ? 'lowest' : 'highest'})` : ''}`]);
+  check('compare-headers-from-the-catalogue', JSON.stringify(page4b.head) === JSON.stringify(wantHead), `${JSON.stringify(page4b.head)} vs ${JSON.stringify(wantHead)}`);
+  const wantCells = page4b.cells.map(([i]) => [i, core.rows[i].map((c) => `${c.text}${c.best ? ' ★' : ''}`)]);
+  check('compare-cells-from-the-core', JSON.stringify(page4b.cells) === JSON.stringify(wantCells), `${JSON.stringify(page4b.cells[0])} vs ${JSON.stringify(wantCells[0])}`);
+  const catalogue = Object.fromEntries(npm.metricCatalogue().map((m) => [m.key, m]));
+  check('compare-best-ends-are-the-catalogue-ones', core.columns.every((c) => (catalogue[c.key.replace(/\[\d+\]/, '[*]')] || {}).best === c.best)
+    && core.columns.find((c) => c.id === 'mean').best === 'lower' && core.columns.find((c) => c.id === 'f0').best === 'higher', JSON.stringify(core.columns));
 
   // 5. sorting: mean ascending, then descending
   await page.click('#cmp-table button.sort[data-k="mean"]');
@@ -385,6 +410,37 @@ try {
     await page.click('#tab-comparison');
     check(`results-tabs-switch-${w}x${h}`, back[0] && !back[1], JSON.stringify(back));
   }
+
+  // 14. the colour bar is the core's colour map, column by column (no copy of it in the page)
+  await page.click('#tab-evaluation');
+  await page.waitForFunction(() => Number(document.getElementById('colorbar-canvas').dataset.drawn || 0) > 0, null, { timeout: 20000 });
+  const bar = await page.evaluate(() => {
+    const cv = document.getElementById('colorbar-canvas');
+    const d = cv.getContext('2d').getImageData(0, 0, cv.width, 1).data;
+    return { w: cv.width, rgb: Array.from(d).filter((_, i) => i % 4 !== 3) };
+  });
+  const wantBar = Array.from(npm.errorColors(Array.from({ length: bar.w }, (_, i) => i / (bar.w - 1)), 1));
+  check('colorbar-is-the-core-colour-map', bar.rgb.length === wantBar.length && bar.rgb.every((v, i) => v === wantBar[i]),
+    `${bar.rgb.slice(0, 9)} vs ${wantBar.slice(0, 9)}`);
+  // 15. the comparison goes out of date when the ground truth changes (its note above the table,
+  //     in the flow: the header stays uncovered), and a new Compare clears it
+  await page.click('#tab-comparison');
+  // (another file of the same mesh: the input's change event needs a new file)
+  const gtCopy = join(out, 'compare-gt-copy.glb');
+  copyFileSync(join(dataset, 'ground_truth.glb'), gtCopy);
+  await page.setInputFiles('#file-gt', gtCopy);
+  await page.waitForFunction(() => document.body.dataset.compareStale === '1', null, { timeout: 20000 }).catch(() => {});
+  const stale = await page.evaluate(() => {
+    const note = document.getElementById('cmp-stale-note');
+    const th = document.querySelector('#cmp-table thead th');
+    const r = th.getBoundingClientRect();
+    const hit = document.elementFromPoint(r.left + Math.min(20, r.width / 2), r.top + r.height / 2);
+    return { shown: note.getClientRects().length > 0, text: note.textContent, headerUncovered: !!hit && th.contains(hit), flag: document.body.dataset.compareStale };
+  });
+  check('compare-out-of-date-when-the-ground-truth-changes', stale.shown && /ground truth/.test(stale.text) && stale.flag === '1' && stale.headerUncovered, JSON.stringify(stale));
+  await compareAgain();
+  const fresh = await page.evaluate(() => [document.getElementById('cmp-stale-note').hidden, document.body.dataset.compareStale]);
+  check('compare-again-is-current', fresh[0] === true && fresh[1] === undefined, JSON.stringify(fresh));
 
   check('compare-no-request-leaves-origin', requests.every((u) => u.startsWith(origin) || u.startsWith('blob:') || u.startsWith('data:')), requests.filter((u) => !u.startsWith(origin)).join(' '));
   check('compare-no-console-errors', consoleErrors.length === 0, consoleErrors.join(' | '));

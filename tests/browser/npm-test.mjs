@@ -206,5 +206,46 @@ if (nodeExample) {
 
 const crop = sfmeval.parseCrop('{"schema":"sfmeval.crop/1","volume":{"kind":"sphere","center":[0,0,0],"radius":1}}');
 check('npm-crop-roundtrip', crop.volume.kind === 'sphere' && sfmeval.cropFile(crop).includes('"sfmeval.crop/1"'));
+
+// The Compare table's cells come from the core's catalogue: its texts are the numbers as
+// JavaScript writes them (String, toPrecision(4), toExponential(3): the page's former format),
+// here against V8's own on numbers across every range and the rounding edges; the best marks
+// follow each column's best end.
+{
+  const jsText = (v) => {
+    if (v == null || Number.isNaN(v)) return '—';
+    if (Number.isInteger(v)) return String(v);
+    const a = Math.abs(v);
+    return a !== 0 && (a < 1e-3 || a >= 1e5) ? v.toExponential(3) : v.toPrecision(4);
+  };
+  let seed = 12345;
+  const rand = () => { seed = (seed * 1103515245 + 12345) % 2147483648; return seed / 2147483648; };
+  const values = [0.00125, 0.125, 99999.99, 0.00099995, 1.0005, 2.5, 1e21, 123456.5, 0.0009999, -0.33335, 12345.65];
+  for (let i = 0; i < 3000; i++) values.push((rand() - 0.3) * 10 ** Math.floor(rand() * 16 - 9));
+  for (let i = 0; i < 300; i++) values.push(Math.round(rand() * 1e6) / 1e4); // 4 decimals: many ties
+  const row = JSON.parse(JSON.stringify(sfmeval.runRow(JSON.stringify({
+    dataset: 'd', pipeline: 'p', tool: 't', version: null, status: 'ok', reason: null, wall_seconds: 0,
+    cpu_seconds: 0, peak_memory_bytes: 0, images_total: 36, images_registered: 30, points: 100,
+  }))));
+  const entries = values.map((v, i) => ({ row: { ...row, pipeline: `p${i}` }, report: { accuracy: { min: v }, thresholds: [] } }));
+  const t = sfmeval.compareTable(entries);
+  const minCol = t.columns.findIndex((c) => c.id === 'min');
+  const bad = values.map((v, i) => [v, t.rows[i][minCol].text, jsText(v)]).filter(([, a, b]) => a !== b);
+  check('npm-compare-table-numbers-as-javascript-writes-them', minCol >= 0 && bad.length === 0, JSON.stringify(bad.slice(0, 5)));
+  const lowest = Math.min(...values);
+  check('npm-compare-table-best-is-the-catalogue-end', t.columns[minCol].best === 'lower'
+    && t.rows.every((r, i) => r[minCol].best === (values[i] === lowest)), JSON.stringify(t.columns[minCol]));
+  const cat = sfmeval.metricCatalogue();
+  const byKey = Object.fromEntries(cat.map((m) => [m.key, m]));
+  check('npm-catalogue-drives-the-compare-columns', t.columns.every((c) => {
+    const m = byKey[c.key.replace(/\[\d+\]/, '[*]')];
+    return m && m.best === c.best && c.header.startsWith(m.header) && (m.unit ?? null) === c.unit;
+  }) && byKey['report.accuracy.mean'].best === 'lower' && byKey['report.thresholds[*].f_score'].best === 'higher',
+  JSON.stringify(t.columns));
+}
+// a run folder's reconstruction as the runner reads it: model/'s model files, else sparse.ply
+check('npm-run-folder-layout', JSON.stringify(sfmeval.runReconstructionFiles(['run.json', 'log.txt', 'sparse.ply', 'model/sparse/0/points3D.bin', 'model/x.jpg']))
+  === JSON.stringify([['model/sparse/0/points3D.bin', 'sparse/0/points3D.bin']])
+  && JSON.stringify(sfmeval.runReconstructionFiles(['run.json', 'sparse.ply', 'model/notes.md'])) === JSON.stringify([['sparse.ply', 'sparse.ply']]));
 console.log(`npm: demo evaluated in ${ms.toFixed(0)} ms in Node`);
 process.exit(failed ? 1 : 0);

@@ -1,9 +1,9 @@
 //! What the table cells say: Table I's `mean (points)` or the failure, and the wide table's
 //! columns and values (shared by Markdown, CSV and HTML).
 
+use crate::catalogue::{Metric, Source, WIDE, metrics_of, short};
 use crate::order::find;
 use crate::row::Row;
-use crate::text::one_line;
 
 /// Table I cell text: `mean m (points)` or the failure.
 pub fn table1_cell(r: Option<&Row>) -> String {
@@ -23,11 +23,6 @@ pub fn table1_cell(r: Option<&Row>) -> String {
     }
 }
 
-/// A reason on one line for a Markdown cell: no line breaks or `|`, at most 120 characters.
-fn short(s: &str) -> String {
-    one_line(&s.replace('|', " "), 120)
-}
-
 /// A number with `digits` decimals, empty for none.
 fn opt(v: Option<f64>, digits: usize) -> String {
     v.map(|x| format!("{x:.digits$}")).unwrap_or_default()
@@ -38,89 +33,87 @@ pub fn csv_num(v: Option<f64>) -> String {
     v.map(|x| format!("{x}")).unwrap_or_default()
 }
 
-/// Column headers of the wide table (shared by Markdown, CSV and HTML).
+/// The wide table's metrics ([`WIDE`] of the catalogue).
+fn wide_metrics() -> Vec<&'static Metric> {
+    metrics_of(WIDE)
+}
+
+/// The thresholds in percent of the diagonal that name per-threshold columns: the first row's
+/// with thresholds (rounded to 6 decimals).
+fn threshold_percents(rows: &[Row]) -> Vec<f64> {
+    rows.iter()
+        .find(|r| !r.thresholds.is_empty())
+        .map(|r| {
+            r.thresholds
+                .iter()
+                .map(|t| (t.tau_percent_of_diagonal * 1e6).round() / 1e6)
+                .collect()
+        })
+        .unwrap_or_default()
+}
+
+/// Column headers of the wide table (shared by Markdown, CSV and HTML): the catalogue's
+/// headers with their units, per-threshold metrics grouped by threshold.
 pub fn wide_columns(rows: &[Row]) -> Vec<String> {
-    let mut cols: Vec<String> = [
-        "dataset",
-        "pipeline",
-        "status",
-        "points",
-        "registered",
-        "mean (m)",
-        "median (m)",
-        "RMS (m)",
-    ]
-    .iter()
-    .map(|s| s.to_string())
-    .collect();
-    if let Some(r) = rows.iter().find(|r| !r.thresholds.is_empty()) {
-        for t in &r.thresholds {
-            let pct = (t.tau_percent_of_diagonal * 1e6).round() / 1e6;
-            cols.push(format!("P@{pct}%"));
-            cols.push(format!("R@{pct}%"));
-            cols.push(format!("F@{pct}%"));
-        }
-    }
-    cols.extend(
-        [
-            "rot. median (°)",
-            "centre median (m)",
-            "centre median (% radius)",
-            "centre max (% radius)",
-            "wall (s)",
-            "CPU (s)",
-            "peak mem (MB)",
-            "tool",
-            "reason",
-        ]
-        .iter()
-        .map(|s| s.to_string()),
-    );
+    let pcts = threshold_percents(rows);
+    let mut cols = Vec::new();
+    for_columns(&wide_metrics(), pcts.len(), |m, k| {
+        cols.push(m.header_with_unit(k.map(|k| pcts[k])));
+    });
     cols
 }
 
-/// One row's values in the wide table: numbers rounded for Markdown and HTML, in full for CSV
-/// (`csv`), with `n_tau` thresholds.
-pub fn wide_values(r: &Row, n_tau: usize, csv: bool) -> Vec<String> {
-    let num = |v: Option<f64>, d: usize| if csv { csv_num(v) } else { opt(v, d) };
-    let mut v = vec![
-        r.dataset.clone(),
-        r.pipeline.clone(),
-        r.status.clone(),
-        if r.status == "ok" {
-            r.points.to_string()
+/// Calls `f` with each column of `metrics`: a per-threshold run (consecutive per-threshold
+/// metrics) repeated for each of `n_tau` thresholds, with the threshold's index.
+pub(crate) fn for_columns(
+    metrics: &[&'static Metric],
+    n_tau: usize,
+    mut f: impl FnMut(&'static Metric, Option<usize>),
+) {
+    let mut i = 0;
+    while i < metrics.len() {
+        if metrics[i].per_threshold() {
+            let start = i;
+            while i < metrics.len() && metrics[i].per_threshold() {
+                i += 1;
+            }
+            for k in 0..n_tau {
+                for m in &metrics[start..i] {
+                    f(m, Some(k));
+                }
+            }
         } else {
-            String::new()
-        },
-        format!("{}/{}", r.images_registered, r.images_total),
-        num(r.mean, 6),
-        num(r.median, 6),
-        num(r.rms, 6),
-    ];
-    for k in 0..n_tau {
-        let t = r.thresholds.get(k);
-        v.push(num(t.map(|t| t.precision), 3));
-        v.push(num(t.map(|t| t.recall), 3));
-        v.push(num(t.map(|t| t.f_score), 3));
+            f(metrics[i], None);
+            i += 1;
+        }
     }
-    v.extend([
-        num(r.rotation_median_deg, 3),
-        num(r.center_median, 5),
-        num(r.center_median_percent, 3),
-        num(r.center_max_percent, 3),
-        num(Some(r.wall_seconds), 1),
-        num(Some(r.cpu_seconds), 1),
-        num(Some(r.peak_memory_mb), 0),
-        format!("{} {}", r.tool, r.version.as_deref().unwrap_or(""))
-            .trim()
-            .to_string(),
-        if csv {
-            r.reason.clone().unwrap_or_default()
-        } else {
-            short(r.reason.as_deref().unwrap_or(""))
-        },
-    ]);
+}
+
+/// One row's values in the wide table: numbers rounded for Markdown and HTML (the catalogue's
+/// decimals), in full for CSV (`csv`), with `n_tau` thresholds.
+pub fn wide_values(r: &Row, n_tau: usize, csv: bool) -> Vec<String> {
+    let mut v = Vec::new();
+    for_columns(&wide_metrics(), n_tau, |m, k| {
+        v.push(cell_text(m, r, k.unwrap_or(0), csv));
+    });
     v
+}
+
+/// A wide-table cell: the metric's text, or its number with the catalogue's decimals (in full
+/// for CSV), empty for none.
+fn cell_text(m: &Metric, r: &Row, k: usize, csv: bool) -> String {
+    if let Source::Text(f) = m.source {
+        return f(r, csv);
+    }
+    if let Some(shown) = m.shown {
+        return shown(r);
+    }
+    let v = m.number(r, k, None);
+    if csv {
+        csv_num(v)
+    } else {
+        opt(v, m.digits.unwrap_or(0))
+    }
 }
 
 /// The number of thresholds of the wide table (the most any row has).

@@ -4,14 +4,20 @@
 //! (through the wasm bindings) builds the same strings from the same runs, so both say the same
 //! thing byte for byte.
 
+pub mod catalogue;
 pub mod cells;
+pub mod compare;
 pub mod csv;
+pub mod layout;
+pub mod number;
 pub mod order;
 pub mod row;
 pub mod run;
 pub mod tables;
 pub mod text;
 
+pub use catalogue::{Best, CATALOGUE, Metric};
+pub use compare::{CompareTable, Entry, compare_table};
 pub use order::BUILTIN_PIPELINES;
 pub use row::{Prf, Row};
 pub use run::{RunFacts, Status, failed_row, report_row};

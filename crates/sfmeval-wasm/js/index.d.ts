@@ -237,6 +237,55 @@ export interface ComparisonTables {
 
 export function comparisonTables(rows: RunRow[]): ComparisonTables;
 
+/** A metric of the comparison (the core's catalogue). */
+export interface Metric {
+  /** JSON path into `{report, run}` (`report.accuracy.mean`); `[*]`: one per threshold. */
+  key: string;
+  /** Short id (`mean`; per threshold with its index: `f0`). */
+  id: string;
+  /** Header without the unit. */
+  header: string;
+  unit: string | null;
+  /** Long name (chart titles). */
+  name: string;
+  /** Which end is best; null for text. */
+  best: 'lower' | 'higher' | null;
+  /** Decimals in the Markdown tables; null for text. */
+  digits: number | null;
+}
+
+/** Which of a run folder's files (paths relative to it) form its reconstruction: `[path, name]`. */
+export function runReconstructionFiles(paths: string[]): [string, string][];
+
+/** The comparison's metrics. */
+export function metricCatalogue(): Metric[];
+
+/** A column of the Compare table. */
+export interface CompareColumn {
+  id: string;
+  key: string;
+  header: string;
+  unit: string | null;
+  best: 'lower' | 'higher' | null;
+  text: boolean;
+}
+
+/** A cell of the Compare table: its number (null for text or none), text, best of its column. */
+export interface CompareCell {
+  value: number | null;
+  text: string;
+  best: boolean;
+}
+
+/** The Compare table of some runs: columns and each entry's cells. */
+export interface CompareTable {
+  columns: CompareColumn[];
+  rows: CompareCell[][];
+}
+
+/** The Compare table of these runs (`report`: the evaluation's report, null when not evaluated). */
+export function compareTable(entries: { row: RunRow; report?: Report | null }[]): CompareTable;
+
 /** Viewer colours: r,g,b per value, viridis saturating at `clip` (the points' map), NaN grey. */
 export function errorColors(values: ArrayLike<number>, clip: number): Uint8Array;
 

@@ -245,6 +245,30 @@ export function comparisonTables(rows) {
   return wasm.comparisonTables(JSON.stringify(rows));
 }
 
+/**
+ * The Compare table of `entries` (`[{row, report}]`: a row of `runRow` / `evaluation.runRow` and
+ * its report object, or null when not evaluated): `{columns: [{id, key, header, unit, best, text}],
+ * rows: [[{value, text, best}]]}`, its columns, cell texts and best marks from the core's
+ * catalogue of metrics.
+ */
+export function compareTable(entries) {
+  return wasm.compareTable(JSON.stringify(entries.map((e) => ({ row: e.row, report: e.report ?? null }))));
+}
+
+/**
+ * Which of a run folder's files form its reconstruction, as the runner reads a run folder
+ * (`model/`'s model files, else `sparse.ply`): `paths` relative to the folder in, `[[path, name]]`
+ * out, `name` as `loadReconstruction` wants it keyed.
+ */
+export function runReconstructionFiles(paths) {
+  return wasm.runReconstructionFiles(JSON.stringify(paths));
+}
+
+/** The comparison's metrics: `[{key, id, header, unit, name, best, digits}]`. */
+export function metricCatalogue() {
+  return wasm.metricCatalogue();
+}
+
 /** Viewer colours (`Uint8Array` r,g,b per value: viridis saturating at `clip`, NaN grey). */
 export function errorColors(values, clip) {
   return wasm.errorColors(Float64Array.from(values), clip);

@@ -32,7 +32,9 @@ mod table;
 
 pub use poses::error_colors;
 pub use stream::ReconstructionStream;
-pub use table::{comparison_tables, run_row};
+pub use table::{
+    compare_table, comparison_tables, metric_catalogue, run_reconstruction_files, run_row,
+};
 /// `initThreadPool(n)`: starts the pool of `n` Web Workers the threaded build's maps run on.
 #[cfg(feature = "threads")]
 pub use wasm_bindgen_rayon::init_thread_pool;

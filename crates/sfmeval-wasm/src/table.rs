@@ -58,3 +58,39 @@ pub fn comparison_tables(rows_json: &str) -> Result<JsValue, JsError> {
     serde::Serialize::serialize(&out, &serde_wasm_bindgen::Serializer::json_compatible())
         .map_err(|e| js_err("tables", e.to_string()))
 }
+
+fn to_js<T: serde::Serialize>(what: &str, v: &T) -> Result<JsValue, JsError> {
+    v.serialize(&serde_wasm_bindgen::Serializer::json_compatible())
+        .map_err(|e| js_err(what, e.to_string()))
+}
+
+/// The page's Compare table of `entries_json` (a JSON array of `{row, report}`, `report` the
+/// evaluation's `sfmeval.report/3` or null): `{columns: [{id, key, header, unit, best, text}],
+/// rows: [[{value, text, best}]]}`, columns from `sfmeval_table`'s catalogue, texts and best
+/// marks decided there.
+#[wasm_bindgen(js_name = compareTable)]
+pub fn compare_table(entries_json: &str) -> Result<JsValue, JsError> {
+    let entries: Vec<sfmeval_table::Entry> =
+        serde_json::from_str(entries_json).map_err(|e| js_err("compare entries", e))?;
+    to_js("compare table", &sfmeval_table::compare_table(&entries))
+}
+
+/// The comparison's metrics (`sfmeval_table`'s catalogue): `[{key, id, header, unit, name, best,
+/// digits}]`.
+#[wasm_bindgen(js_name = metricCatalogue)]
+pub fn metric_catalogue() -> Result<JsValue, JsError> {
+    to_js("catalogue", &sfmeval_table::CATALOGUE)
+}
+
+/// Which of a run folder's files form its reconstruction (`sfmeval_table::layout`), given the
+/// paths relative to the folder as a JSON array: `[[path, name]]`, `name` as the
+/// reconstruction's readers key it (the runner's `report` reads the same).
+#[wasm_bindgen(js_name = runReconstructionFiles)]
+pub fn run_reconstruction_files(paths_json: &str) -> Result<JsValue, JsError> {
+    let paths: Vec<String> =
+        serde_json::from_str(paths_json).map_err(|e| js_err("run folder paths", e))?;
+    to_js(
+        "run folder",
+        &sfmeval_table::layout::reconstruction_files(&paths),
+    )
+}

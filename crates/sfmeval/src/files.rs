@@ -108,8 +108,9 @@ pub fn read_input_files(source: &dyn FileSource, path: &str) -> Result<BTreeMap<
     Ok(files)
 }
 
-/// Files worth reading from a model folder (skips images and logs).
-fn is_model_file(path: &str) -> bool {
+/// Whether a file can be part of an SfM model or a cloud, by its extension (a model folder's
+/// images and logs are not): the files [`read_input_files`] reads from a folder.
+pub fn is_model_file(path: &str) -> bool {
     let n = path.to_ascii_lowercase();
     [".bin", ".txt", ".nvm", ".out", ".json", ".ply"]
         .iter()

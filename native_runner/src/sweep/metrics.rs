@@ -1,54 +1,21 @@
 //! What a sweep plots: metrics as JSON paths into `{"report": <sfmeval.report/3>, "run": <the
-//! run's row>}`, the defaults, `[*]` expansion, lookup, and chart file names. A new report
-//! field is one more line in [`DEFAULT_METRICS`] (or `--metric PATH`).
+//! run's row>}`, the defaults (the catalogue's `SWEEP` lists, named there), `[*]` expansion,
+//! lookup, and chart file names. A new report field is one more line in the catalogue
+//! (`sfmeval_table::catalogue`) and its `SWEEP` list (or `--metric PATH`).
 
 use serde_json::Value as Json;
+pub use sfmeval_table::catalogue::lookup;
+use sfmeval_table::catalogue::{SWEEP, SWEEP_VISIBILITY, metrics_of};
 
 use crate::sweep::cells::Cell;
 
-/// Metrics plotted by default: `(path, label)`. `[*]` expands to one metric per element
-/// (the report's thresholds). Paths start at `report.` (the run's `sfmeval.report/3`) or `run.`
-/// (its row in `runs.csv`, plus `registered_fraction`).
-pub const DEFAULT_METRICS: &[(&str, &str)] = &[
-    ("report.thresholds[*].recall", "completeness (recall)"),
-    ("report.thresholds[*].precision", "precision"),
-    ("report.thresholds[*].f_score", "F-score"),
-    ("report.accuracy.mean", "accuracy: mean distance (m)"),
-    ("report.accuracy.median", "accuracy: median distance (m)"),
-    (
-        "report.completeness.median",
-        "completeness: median distance GT → reconstruction (m)",
-    ),
-    ("run.registered_fraction", "registered images (fraction)"),
-    (
-        "report.cameras.rotation_error_deg.median",
-        "median rotation error (°)",
-    ),
-    ("report.cameras.ate_rmse", "ATE RMSE (m)"),
-    ("run.points", "points"),
-    ("run.wall_seconds", "run time (s, wall)"),
-];
-
-/// Metrics plotted when some run's report has them: with `--visibility` (depth maps rendered)
-/// the core adds completeness over the visible surface and the track-based error.
-pub const VISIBILITY_METRICS: &[(&str, &str)] = &[
-    (
-        "report.completeness_visible.thresholds[*].recall_visible",
-        "completeness of the visible surface (recall)",
-    ),
-    (
-        "report.completeness_visible.visible_fraction",
-        "visible share of the surface (≥ k images)",
-    ),
-    (
-        "report.track_error.median",
-        "track-based true error: median (m)",
-    ),
-    (
-        "report.track_error.thresholds[*].sliding_fraction",
-        "sliding points (true error − surface distance > τ)",
-    ),
-];
+/// `(path, label)` of the catalogue's metrics of `keys`.
+fn catalogue_specs(keys: &[&str]) -> Vec<(String, String)> {
+    metrics_of(keys)
+        .iter()
+        .map(|m| (m.key.to_string(), m.name.to_string()))
+        .collect()
+}
 
 /// A metric to plot.
 #[derive(Debug, Clone, PartialEq)]
@@ -57,28 +24,6 @@ pub struct Metric {
     pub path: String,
     /// Chart title.
     pub label: String,
-}
-
-/// The value at `path` (`a.b[2].c`) of `doc`, if a finite-or-not number.
-pub fn lookup(doc: &Json, path: &str) -> Option<f64> {
-    let mut cur = doc;
-    for part in path.split('.') {
-        let (key, rest) = match part.find('[') {
-            Some(i) => (&part[..i], &part[i..]),
-            None => (part, ""),
-        };
-        if !key.is_empty() {
-            cur = cur.get(key)?;
-        }
-        let mut rest = rest;
-        while let Some(r) = rest.strip_prefix('[') {
-            let end = r.find(']')?;
-            let idx: usize = r[..end].parse().ok()?;
-            cur = cur.get(idx)?;
-            rest = &r[end + 1..];
-        }
-    }
-    cur.as_f64()
 }
 
 /// Expands `[*]` (first occurrence) against the documents: one metric per index seen, the
@@ -132,16 +77,17 @@ fn sig(x: f64) -> String {
 /// The metrics to plot: defaults then `--metric` ones, `[*]` expanded over the cells.
 pub fn metrics(extra: &[String], cells: &[Cell]) -> Vec<Metric> {
     let docs: Vec<&Json> = cells.iter().map(|c| &c.doc).collect();
-    let mut specs: Vec<(String, String)> = DEFAULT_METRICS
-        .iter()
-        .chain(VISIBILITY_METRICS.iter().filter(|(p, _)| {
-            // only when a report has the section (runs with depth maps)
-            let section = p.split('.').take(2).collect::<Vec<_>>().join("/");
-            docs.iter()
-                .any(|d| d.pointer(&format!("/{section}")).is_some())
-        }))
-        .map(|(p, l)| (p.to_string(), l.to_string()))
-        .collect();
+    let mut specs = catalogue_specs(SWEEP);
+    specs.extend(
+        catalogue_specs(SWEEP_VISIBILITY)
+            .into_iter()
+            .filter(|(p, _)| {
+                // only when a report has the section (runs with depth maps)
+                let section = p.split('.').take(2).collect::<Vec<_>>().join("/");
+                docs.iter()
+                    .any(|d| d.pointer(&format!("/{section}")).is_some())
+            }),
+    );
     for e in extra {
         let (p, l) = e.split_once('=').unwrap_or((e, e));
         specs.push((p.trim().to_string(), l.trim().to_string()));
@@ -201,6 +147,54 @@ mod tests {
             metric_file("report.thresholds[1].f_score"),
             "report_thresholds_1_f_score"
         );
+    }
+
+    #[test]
+    fn default_metrics_are_the_catalogue_ones_with_the_titles_sweeps_had() {
+        // the sweep's own list before the catalogue took it over: same paths (CSV columns,
+        // chart files) and titles
+        let before = [
+            ("report.thresholds[*].recall", "completeness (recall)"),
+            ("report.thresholds[*].precision", "precision"),
+            ("report.thresholds[*].f_score", "F-score"),
+            ("report.accuracy.mean", "accuracy: mean distance (m)"),
+            ("report.accuracy.median", "accuracy: median distance (m)"),
+            (
+                "report.completeness.median",
+                "completeness: median distance GT → reconstruction (m)",
+            ),
+            ("run.registered_fraction", "registered images (fraction)"),
+            (
+                "report.cameras.rotation_error_deg.median",
+                "median rotation error (°)",
+            ),
+            ("report.cameras.ate_rmse", "ATE RMSE (m)"),
+            ("run.points", "points"),
+            ("run.wall_seconds", "run time (s, wall)"),
+            (
+                "report.completeness_visible.thresholds[*].recall_visible",
+                "completeness of the visible surface (recall)",
+            ),
+            (
+                "report.completeness_visible.visible_fraction",
+                "visible share of the surface (≥ k images)",
+            ),
+            (
+                "report.track_error.median",
+                "track-based true error: median (m)",
+            ),
+            (
+                "report.track_error.thresholds[*].sliding_fraction",
+                "sliding points (true error − surface distance > τ)",
+            ),
+        ];
+        let mut now = catalogue_specs(SWEEP);
+        now.extend(catalogue_specs(SWEEP_VISIBILITY));
+        let before: Vec<(String, String)> = before
+            .iter()
+            .map(|(p, l)| (p.to_string(), l.to_string()))
+            .collect();
+        assert_eq!(now, before);
     }
 
     #[test]
