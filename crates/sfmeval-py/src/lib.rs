@@ -220,6 +220,11 @@ fn read_ground_truth(inputs: &mut Inputs, with_depth: bool) -> Result<Dataset, F
 fn read_recon(inputs: &mut Inputs) -> Result<ReconInput, Failure> {
     let source = std::mem::replace(&mut inputs.recon, ReconSource::Path(PathBuf::new()));
     match source {
+        ReconSource::Points(_) if inputs.recon_cameras.is_some() => {
+            Err(Failure::Input(anyhow::anyhow!(
+                "recon_cameras: the cameras go with a PLY file given as recon, not with an array"
+            )))
+        }
         ReconSource::Points(points) => {
             let name = inputs
                 .name

@@ -130,6 +130,12 @@ def test_arrays_on_both_sides_with_ground_truth_cameras(tmp_path):
     assert r.to_json().encode() == want
 
 
+def test_recon_cameras_need_a_recon_file():
+    with pytest.raises(sfmeval.InputError, match="recon_cameras"):
+        sfmeval.evaluate(DEMO / "ground_truth.glb", sfmeval.read(MODELS / "theia.ply").points,
+                         recon_cameras=MODELS / "theia_colmap")
+
+
 def test_bad_ground_truth_arrays_are_input_errors():
     v = np.zeros((4, 3))
     good = np.array([[0, 1, 2]])

@@ -509,8 +509,9 @@ def evaluate(
         Reconstruction: a PLY point cloud, a COLMAP model folder (sparse/ with sub-models is
         fine), an .nvm, a Bundler .out, an OpenMVG sfm_data.json or a cameras.json; or an
         ``(N, 3)`` float32/float64 array or ``PointCloud``, read as the float/double PLY of
-        those points (named ``name``, default ``points.ply``). Arrays that are C-contiguous
-        and aligned are read in place (copied once, into the core's own storage).
+        those points (named ``name``, default ``points.ply``; a ``Model``'s points alone: give
+        its path for its cameras). Arrays that are C-contiguous and aligned are read in place
+        (copied once, into the core's own storage).
     name
         The reconstruction's name in the report and its notes (default: the file or folder
         name).
