@@ -273,6 +273,8 @@ struct Outcome {
     distances: Vec<f64>,
     signed_distances: Option<Vec<f64>>,
     kept: Vec<u8>,
+    completeness_points: Vec<[f64; 3]>,
+    completeness_distances: Vec<f64>,
 }
 
 /// `values` as a Python `bytes` of float64 in native order, written in place (no second copy
@@ -318,6 +320,8 @@ fn evaluate_inputs(mut inputs: Inputs, progress: &dyn Progress) -> Result<Outcom
         distances: evaluation.distances,
         signed_distances: evaluation.signed_distances,
         kept,
+        completeness_points: evaluation.completeness_points,
+        completeness_distances: evaluation.completeness_distances,
     })
 }
 
@@ -349,18 +353,21 @@ fn sources(
     Ok((gt, recon))
 }
 
-/// What `_evaluate` returns to the wrapper: the report JSON, the distances, the signed ones and
-/// the kept flags.
+/// What `_evaluate` returns to the wrapper: the report JSON, the distances, the signed ones, the
+/// kept flags, and the completeness samples (x y z) with their distances.
 type Returned<'py> = (
     String,
     Bound<'py, PyBytes>,
     Option<Bound<'py, PyBytes>>,
     Bound<'py, PyBytes>,
+    Bound<'py, PyBytes>,
+    Bound<'py, PyBytes>,
 );
 
 /// `_evaluate(...)`: the report JSON (`sfmeval eval --report`'s bytes), the unsigned
-/// distances (float64, native order, one per input point), the signed ones (or `None`) and a
-/// kept flag per point (uint8). Arguments are the wrapper's normalised ones
+/// distances (float64, native order, one per input point), the signed ones (or `None`), a
+/// kept flag per point (uint8), and the completeness samples (x y z float64, ground-truth frame)
+/// and their distances to the reconstruction (float64), as `--samples-csv` writes them. Arguments are the wrapper's normalised ones
 /// (`python/sfmeval/__init__.py`): arrays C-contiguous, float32/float64 (uint32 triangles).
 #[pyfunction]
 #[pyo3(signature = (gt=None, recon=None, *, gt_vertices=None, gt_triangles=None, gt_name=None,
@@ -433,11 +440,19 @@ fn _evaluate<'py>(
         .as_deref()
         .map(|d| native_bytes(py, d))
         .transpose()?;
+    let sample_coordinates: Vec<f64> = outcome
+        .completeness_points
+        .iter()
+        .flatten()
+        .copied()
+        .collect();
     Ok((
         outcome.report_json,
         distances,
         signed,
         PyBytes::new(py, &outcome.kept),
+        native_bytes(py, &sample_coordinates)?,
+        native_bytes(py, &outcome.completeness_distances)?,
     ))
 }
 

@@ -126,16 +126,19 @@ class Report(Section):
     ``r.alignment.gt_from_recon`` as a 4×4 numpy array, ``r.notes`` as typed ``Note``s).
     """
 
-    __slots__ = ("_json", "_distances", "_signed", "_kept")
+    __slots__ = ("_json", "_distances", "_signed", "_kept", "_samples", "_sample_distances")
 
     def __init__(
-        self, report_json: str, distances: bytes, signed: Optional[bytes], kept: bytes
+        self, report_json: str, distances: bytes, signed: Optional[bytes], kept: bytes,
+        samples: bytes = b"", sample_distances: bytes = b"",
     ) -> None:
         super().__init__(json.loads(report_json))
         self._json = report_json
         self._distances = distances
         self._signed = signed
         self._kept = kept
+        self._samples = samples
+        self._sample_distances = sample_distances
 
     @property
     def alignment(self) -> _Alignment:
@@ -170,6 +173,18 @@ class Report(Section):
     def kept(self) -> np.ndarray:
         """Per point, whether it was kept (inside the crop, not farther than ``max_distance``)."""
         return np.frombuffer(self._kept, dtype=np.uint8).astype(bool)
+
+    @property
+    def completeness_points(self) -> np.ndarray:
+        """The completeness samples drawn on the ground truth, ``(M, 3)`` float64 in its frame
+        (the rows of ``sfmeval eval --samples-csv``)."""
+        return np.frombuffer(self._samples, dtype=np.float64).reshape(-1, 3)
+
+    @property
+    def completeness_distances(self) -> np.ndarray:
+        """Distance of each completeness sample to the aligned reconstruction (float64, the
+        samples' order)."""
+        return np.frombuffer(self._sample_distances, dtype=np.float64)
 
     def __repr__(self) -> str:
         acc = self._data.get("accuracy", {})
@@ -567,7 +582,7 @@ def evaluate(
         crop_path = os.fspath(crop)
     elif crop is not None:
         crop_json = json.dumps(dict(crop))
-    report_json, distances, signed_bytes, kept = _evaluate(
+    report_json, distances, signed_bytes, kept, samples_bytes, sample_distances = _evaluate(
         **_sources(gt, recon, gt_name, name),
         gt_cameras=_path(gt_cameras, "gt_cameras"),
         recon_cameras=_path(recon_cameras, "recon_cameras"),
@@ -586,7 +601,7 @@ def evaluate(
         threads=threads,
         progress=progress,
     )
-    return Report(report_json, distances, signed_bytes, kept)
+    return Report(report_json, distances, signed_bytes, kept, samples_bytes, sample_distances)
 
 
 def align(

@@ -31,7 +31,7 @@ def _evaluate(
     max_triangles: int = ...,
     threads: Optional[int] = ...,
     progress: Optional[Callable[[str, float], Any]] = ...,
-) -> Tuple[str, bytes, Optional[bytes], bytes]: ...
+) -> Tuple[str, bytes, Optional[bytes], bytes, bytes, bytes]: ...
 def _align(
     gt: Optional[str] = ...,
     recon: Optional[str] = ...,
