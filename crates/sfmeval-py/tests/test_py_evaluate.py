@@ -158,6 +158,25 @@ def test_report_is_the_clis_byte_for_byte(tmp_path, kwargs, flags):
         assert r.signed_distances is None
 
 
+def test_completeness_samples_are_the_clis_samples_csv(tmp_path):
+    csv = tmp_path / "samples.csv"
+    report = tmp_path / "cli.json"
+    p = subprocess.run([str(BIN), "eval", "--dataset", str(DEMO), "--recon", str(DEMO / "sparse"),
+                        "--samples", "30000", "--quiet", "--report", str(report),
+                        "--samples-csv", str(csv)], capture_output=True, text=True)
+    assert p.returncode == 0, p.stderr
+    rows = [line.split(",") for line in csv.read_text().splitlines()[1:]]
+    r = sfmeval.evaluate(DEMO, DEMO / "sparse", samples=30_000)
+    assert r.to_json().encode() == report.read_bytes()
+    pts, dist = r.completeness_points, r.completeness_distances
+    assert pts.shape == (len(rows), 3) and dist.shape == (len(rows),)
+    assert pts.tolist() == [[float(v) for v in row[1:4]] for row in rows]
+    assert dist.tolist() == [float(row[4]) for row in rows]
+    d = json.loads(report.read_text())
+    assert len(rows) == d["completeness"]["count"]
+    np.testing.assert_allclose(dist.mean(), d["completeness"]["mean"], rtol=1e-12)
+
+
 def test_keyword_arguments_take_path_objects_and_strings_alike():
     a = sfmeval.evaluate(str(CORE / "trimesh_mesh.glb"), str(CORE / "colmap_points.ply"),
                          align="none", samples=5000)

@@ -183,43 +183,56 @@ pub fn read_ground_truth_with_limits(
         }
         Format::Ply => {
             // No limit: the triangles are in the file (see `ReadLimits`).
-            let p = ply::read_ply(bytes)?;
-            if p.skipped_faces > 0 {
-                warnings.push(
-                    Note::new(
-                        Code::DegenerateFacesSkipped,
-                        format!(
-                            "{} faces with fewer than 3 vertices were skipped",
-                            p.skipped_faces
-                        ),
-                    )
-                    .with("count", p.skipped_faces),
-                );
-            }
-            if p.has_faces && !p.triangles.is_empty() {
-                let mesh = TriangleMesh {
-                    vertices: p.vertices.into_f64(),
-                    triangles: p.triangles,
-                };
-                mesh.validate("PLY")?;
-                GroundTruth::Mesh(mesh)
-            } else {
-                if p.vertices.is_empty() {
-                    return Err(Error::Empty {
-                        what: "ground-truth PLY (no vertices)".into(),
-                    });
-                }
-                GroundTruth::Cloud(PointCloud {
-                    points: p.vertices,
-                    colors: p.colors,
-                })
-            }
+            return ground_truth_from_ply(ply::read_ply(bytes)?);
         }
     };
     Ok(LoadedGroundTruth {
         ground_truth,
         format,
         notes: warnings,
+    })
+}
+
+/// The ground truth of a PLY file already decoded ([`ply::read_ply`], or
+/// [`ply::PlyData::from_memory`] for geometry a front end holds in memory), as
+/// [`read_ground_truth`] makes it from the file: a mesh when it has faces, else a cloud. No
+/// triangle limit: the triangles are present in the data (see [`ReadLimits`]).
+pub fn ground_truth_from_ply(p: ply::PlyData) -> Result<LoadedGroundTruth> {
+    let mut notes = Vec::new();
+    if p.skipped_faces > 0 {
+        notes.push(
+            Note::new(
+                Code::DegenerateFacesSkipped,
+                format!(
+                    "{} faces with fewer than 3 vertices were skipped",
+                    p.skipped_faces
+                ),
+            )
+            .with("count", p.skipped_faces),
+        );
+    }
+    let ground_truth = if p.has_faces && !p.triangles.is_empty() {
+        let mesh = TriangleMesh {
+            vertices: p.vertices.into_f64(),
+            triangles: p.triangles,
+        };
+        mesh.validate("PLY")?;
+        GroundTruth::Mesh(mesh)
+    } else {
+        if p.vertices.is_empty() {
+            return Err(Error::Empty {
+                what: "ground-truth PLY (no vertices)".into(),
+            });
+        }
+        GroundTruth::Cloud(PointCloud {
+            points: p.vertices,
+            colors: p.colors,
+        })
+    };
+    Ok(LoadedGroundTruth {
+        ground_truth,
+        format: Format::Ply,
+        notes,
     })
 }
 

@@ -354,6 +354,26 @@ pub fn read_ply(bytes: &[u8]) -> Result<PlyData> {
     check_data(out)
 }
 
+impl PlyData {
+    /// What reading a binary little-endian PLY of `vertices` (`float` x y z for
+    /// [`Positions::F32`], `double` for [`Positions::F64`]) and, with `triangles`, a face
+    /// element gives, with a read file's checks (finite vertices, face indices in range): for
+    /// front ends holding geometry in memory (the Python package's arrays), so that it is
+    /// evaluated exactly as that file is.
+    pub fn from_memory(vertices: Positions, triangles: Option<Vec<[u32; 3]>>) -> Result<PlyData> {
+        check_data(PlyData {
+            encoding: PlyEncoding::BinaryLittleEndian,
+            vertices,
+            colors: None,
+            has_faces: triangles.is_some(),
+            triangles: triangles.unwrap_or_default(),
+            skipped_faces: 0,
+            comments: Vec::new(),
+            vertex_properties: ["x", "y", "z"].map(String::from).to_vec(),
+        })
+    }
+}
+
 /// What `header` declares, with no vertex or face read yet, and where its vertex properties are.
 pub(super) fn empty_data(header: &Header) -> Result<(PlyData, VertexLayout)> {
     let vertex_idx = header

@@ -1,0 +1,431 @@
+//! The CLI's other verbs for Python: `read` (what a file holds, as arrays), `cameras`
+//! (`sfmeval cameras`), `tnt` (`sfmeval tnt`) and `table` (`sfmeval table`), each reading its
+//! inputs as the CLI does so that its JSON or text is the CLI's byte for byte.
+
+use std::path::{Path, PathBuf};
+
+use anyhow::{Context as _, anyhow, bail};
+use pyo3::prelude::*;
+use pyo3::types::{PyBytes, PyDict};
+use sfmeval::dataset::DatasetPaths;
+use sfmeval::geometry::{GroundTruth, Positions};
+use sfmeval::io::{LoadedCloud, ReadLimits};
+use sfmeval::model;
+use sfmeval::pipeline::{self, ReconInput};
+use sfmeval::pose::PoseOptions;
+use sfmeval::report::Report;
+use sfmeval::transform::Similarity;
+use sfmeval_fs::{Disk, name_of, path_str, read, read_input_files, read_transform, write_atomic};
+use sfmeval_table::{Row, failed_row, report_row, summary_json, tables};
+use sfmeval_tnt::{self as tnt, IcpCriteria, Registration, Scene, TntRequest};
+
+use crate::{Failure, existing, hooks};
+
+/// A file's contents for `sfmeval.read`.
+enum Content {
+    Mesh {
+        vertices: Vec<[f64; 3]>,
+        triangles: Vec<[u32; 3]>,
+    },
+    /// A cloud (`cameras` empty) or an SfM model's points with its cameras.json.
+    Points {
+        recon: Box<ReconInput>,
+        cameras_json: Option<String>,
+    },
+}
+
+/// What `read` found, with its name, format and notes.
+struct Read {
+    name: String,
+    format: String,
+    notes: String,
+    content: Content,
+}
+
+/// Whether `path` is a geometry file (`.ply`, `.glb`, `.gltf`, `.obj`) rather than a model.
+fn is_geometry(path: &Path) -> bool {
+    path.is_file()
+        && path.extension().is_some_and(|e| {
+            ["ply", "glb", "gltf", "obj"]
+                .iter()
+                .any(|g| e.eq_ignore_ascii_case(g))
+        })
+}
+
+/// Reads `path`: a geometry file as the ground-truth reader reads it (a mesh, or a cloud whose
+/// camera-centre markers are removed as for `--recon`), anything else as `--recon` reads it.
+fn read_path(path: &Path, limits: &ReadLimits) -> Result<Read, Failure> {
+    let path = existing(path)?;
+    let name = name_of(path);
+    let recon = if is_geometry(path) {
+        let dataset =
+            sfmeval_fs::read_dataset(&DatasetPaths::ground_truth(path_str(path)?), limits)?;
+        let loaded = dataset.loaded;
+        match loaded.ground_truth {
+            GroundTruth::Mesh(mesh) => {
+                return Ok(Read {
+                    name,
+                    format: loaded.format.name().to_string(),
+                    notes: serde_json::to_string(&loaded.notes)?,
+                    content: Content::Mesh {
+                        vertices: mesh.vertices,
+                        triangles: mesh.triangles,
+                    },
+                });
+            }
+            GroundTruth::Cloud(cloud) => pipeline::reconstruction_from_cloud(
+                &name,
+                LoadedCloud {
+                    cloud,
+                    format: loaded.format,
+                    notes: loaded.notes,
+                },
+            ),
+        }
+    } else {
+        sfmeval_fs::read_reconstruction(path, &name)?
+    };
+    let cameras_json = recon
+        .model
+        .as_ref()
+        .map(|m| model::cameras_json::write_cameras_json(m, "reconstruction"));
+    Ok(Read {
+        name,
+        format: recon.format.clone(),
+        notes: serde_json::to_string(&recon.notes)?,
+        content: Content::Points {
+            recon: Box::new(recon),
+            cameras_json,
+        },
+    })
+}
+
+fn bytes_of<T: Copy, const N: usize>(rows: &[[T; N]], to: impl Fn(T) -> Vec<u8>) -> Vec<u8> {
+    rows.iter().flatten().flat_map(|v| to(*v)).collect()
+}
+
+/// `_read(path, max_triangles)`: a dict with `kind` (`mesh`, `cloud`, `model`), `name`,
+/// `format`, `notes` (JSON), `points` (bytes, `dtype` `float32`/`float64`, as stored),
+/// `triangles` (uint32 bytes, meshes), `colors` (uint8 bytes or `None`) and `cameras`
+/// (cameras.json text, models).
+#[pyfunction]
+#[pyo3(signature = (path, max_triangles=ReadLimits::DEFAULT_MAX_TRIANGLES))]
+pub(crate) fn _read<'py>(
+    py: Python<'py>,
+    path: PathBuf,
+    max_triangles: u64,
+) -> PyResult<Bound<'py, PyDict>> {
+    let limits = ReadLimits::triangles(max_triangles);
+    let read = hooks::run(py, None, None, |_| read_path(&path, &limits))?;
+    let out = PyDict::new(py);
+    out.set_item("name", &read.name)?;
+    out.set_item("format", &read.format)?;
+    out.set_item("notes", &read.notes)?;
+    match read.content {
+        Content::Mesh {
+            vertices,
+            triangles,
+        } => {
+            out.set_item("kind", "mesh")?;
+            out.set_item("dtype", "float64")?;
+            out.set_item(
+                "points",
+                PyBytes::new(py, &bytes_of(&vertices, |v| v.to_ne_bytes().to_vec())),
+            )?;
+            out.set_item(
+                "triangles",
+                PyBytes::new(py, &bytes_of(&triangles, |v| v.to_ne_bytes().to_vec())),
+            )?;
+            out.set_item("colors", py.None())?;
+            out.set_item("cameras", py.None())?;
+        }
+        Content::Points {
+            recon,
+            cameras_json,
+        } => {
+            out.set_item(
+                "kind",
+                if recon.model.is_some() {
+                    "model"
+                } else {
+                    "cloud"
+                },
+            )?;
+            let (dtype, bytes) = match &recon.cloud.points {
+                Positions::F64(p) => ("float64", bytes_of(p, |v| v.to_ne_bytes().to_vec())),
+                Positions::F32(p) => ("float32", bytes_of(p, |v| v.to_ne_bytes().to_vec())),
+            };
+            out.set_item("dtype", dtype)?;
+            out.set_item("points", PyBytes::new(py, &bytes))?;
+            out.set_item("triangles", py.None())?;
+            match &recon.cloud.colors {
+                Some(c) => out.set_item("colors", PyBytes::new(py, &bytes_of(c, |v| vec![v])))?,
+                None => out.set_item("colors", py.None())?,
+            }
+            out.set_item("cameras", cameras_json)?;
+        }
+    }
+    Ok(out)
+}
+
+/// `sfmeval cameras --gt-cameras G --recon R [--transform T] --report OUT`: the file's text.
+fn cameras_of(
+    gt_cameras: &Path,
+    recon: &Path,
+    transform_path: Option<&Path>,
+    transform_json: Option<&str>,
+) -> Result<String, Failure> {
+    let gt = model::read_model_files(&read_input_files(existing(gt_cameras)?)?)
+        .with_context(|| format!("ground-truth cameras '{}'", gt_cameras.display()))?;
+    let est = pipeline::read_reconstruction(&name_of(recon), &read_input_files(existing(recon)?)?)
+        .with_context(|| format!("reconstruction '{}'", recon.display()))?;
+    let est = est.model.ok_or_else(|| {
+        anyhow!(
+            "reconstruction '{}' has no cameras (a bare point cloud)",
+            recon.display()
+        )
+    })?;
+    let given = match (transform_path, transform_json) {
+        (Some(p), _) => Some(read_transform(existing(p)?)?),
+        (None, Some(text)) => Some(Similarity::parse(text.as_bytes()).context("transform")?),
+        (None, None) => None,
+    };
+    let (_, alignment, cams) = pipeline::cameras_only(&gt, &est, given, 0, &PoseOptions::default())
+        .with_context(|| format!("cameras of '{}'", recon.display()))?;
+    let value = serde_json::json!({"alignment": alignment, "cameras": cams});
+    let mut s = serde_json::to_string_pretty(&value)?;
+    s.push('\n');
+    Ok(s)
+}
+
+/// `_cameras(gt_cameras, recon, transform_path=None, transform_json=None)`: the JSON
+/// `sfmeval cameras --report` writes.
+#[pyfunction]
+#[pyo3(signature = (gt_cameras, recon, transform_path=None, transform_json=None))]
+pub(crate) fn _cameras(
+    py: Python<'_>,
+    gt_cameras: PathBuf,
+    recon: PathBuf,
+    transform_path: Option<PathBuf>,
+    transform_json: Option<String>,
+) -> PyResult<String> {
+    hooks::run(py, None, None, |_| {
+        cameras_of(
+            &gt_cameras,
+            &recon,
+            transform_path.as_deref(),
+            transform_json.as_deref(),
+        )
+    })
+}
+
+/// `sfmeval tnt`'s inputs.
+struct TntInputs {
+    scene: PathBuf,
+    scene_name: Option<String>,
+    recon: PathBuf,
+    trajectory: Option<PathBuf>,
+    transform_path: Option<PathBuf>,
+    transform_text: Option<String>,
+    tau: Option<f64>,
+    seed: u64,
+    out: Option<PathBuf>,
+}
+
+/// `sfmeval tnt` on the same inputs: its `report.json`, and its output files in `out` when
+/// given.
+fn tnt_of(t: &TntInputs, progress: &dyn sfmeval::progress::Progress) -> Result<String, Failure> {
+    let scene_dir = existing(&t.scene)?;
+    let recon_path = existing(&t.recon)?;
+    let scene = Scene::read(&Disk, path_str(scene_dir)?, t.scene_name.as_deref())?;
+    let recon = sfmeval_fs::read_reconstruction(recon_path, &name_of(recon_path))?;
+    let registration = match (&t.transform_path, &t.transform_text, &t.trajectory) {
+        (Some(p), _, _) => Registration::Given(
+            tnt::matrix::parse(&read(existing(p)?)?, "transform")
+                .with_context(|| format!("transform '{}'", p.display()))?,
+        ),
+        (None, Some(text), _) => Registration::Given(
+            tnt::matrix::parse(text.as_bytes(), "transform").context("transform")?,
+        ),
+        (None, None, Some(log)) => Registration::Protocol {
+            trajectory: tnt::read_log(&read(existing(log)?)?)
+                .with_context(|| format!("trajectory '{}'", log.display()))?,
+            trajectory_name: name_of(log),
+            options: tnt::TrajectoryAlignmentOptions {
+                seed: t.seed,
+                ..Default::default()
+            },
+        },
+        (None, None, None) => Err(anyhow!(
+            "give trajectory= (a .log), or transform= to skip the registration"
+        ))?,
+    };
+    let request = TntRequest {
+        tau: t.tau,
+        registration,
+        icp: IcpCriteria::TOOLBOX,
+    };
+    let mut evaluation = tnt::evaluate(
+        &scene,
+        &name_of(recon_path),
+        &recon.cloud.points.as_f64(),
+        &request,
+        progress,
+    )?;
+    evaluation.report.notes.splice(0..0, recon.notes);
+    let json = evaluation.report_json();
+    if let Some(out) = &t.out {
+        std::fs::create_dir_all(out)
+            .with_context(|| format!("cannot create '{}'", out.display()))?;
+        write_atomic(&out.join("report.json"), json.as_bytes())?;
+        for (name, bytes) in evaluation.output_files() {
+            write_atomic(&out.join(name), &bytes)?;
+        }
+    }
+    Ok(json)
+}
+
+/// `_tnt(scene, recon, ...)`: the `report.json` of `sfmeval tnt` on the same inputs (written
+/// with the other output files into `out` when given).
+#[pyfunction]
+#[pyo3(signature = (scene, recon, *, scene_name=None, trajectory=None, transform_path=None,
+    transform_text=None, tau=None, seed=0, out=None, threads=None, progress=None))]
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn _tnt(
+    py: Python<'_>,
+    scene: PathBuf,
+    recon: PathBuf,
+    scene_name: Option<String>,
+    trajectory: Option<PathBuf>,
+    transform_path: Option<PathBuf>,
+    transform_text: Option<String>,
+    tau: Option<f64>,
+    seed: u64,
+    out: Option<PathBuf>,
+    threads: Option<usize>,
+    progress: Option<Py<PyAny>>,
+) -> PyResult<String> {
+    let inputs = TntInputs {
+        scene,
+        scene_name,
+        recon,
+        trajectory,
+        transform_path,
+        transform_text,
+        tau,
+        seed,
+        out,
+    };
+    hooks::run(py, threads, progress, |p| tnt_of(&inputs, p))
+}
+
+/// `NAME=VALUE` split at the first `=`, or `None` when there is no `=` (as `sfmeval table`).
+fn named(s: &str) -> Option<(&str, &str)> {
+    s.split_once('=').filter(|(n, _)| !n.is_empty())
+}
+
+/// The pipeline a report argument names and the report's path, as `sfmeval table` reads its
+/// `[PIPELINE=]REPORT` arguments.
+fn pipeline_and_path(arg: &str) -> anyhow::Result<(String, PathBuf)> {
+    if let Some((name, path)) = named(arg)
+        && !Path::new(arg).exists()
+    {
+        return Ok((name.to_string(), PathBuf::from(path)));
+    }
+    let path = PathBuf::from(arg);
+    let parent = path
+        .parent()
+        .and_then(|p| p.file_name())
+        .map(|n| n.to_string_lossy().into_owned())
+        .filter(|n| !n.is_empty());
+    match parent {
+        Some(name) => Ok((name, path)),
+        None => bail!(
+            "cannot tell the pipeline of '{arg}': give it as PIPELINE={arg} (or put the report in a folder named after it)"
+        ),
+    }
+}
+
+fn read_report(path: &Path) -> Result<Report, Failure> {
+    let text = read(existing(path)?)?;
+    let text = std::str::from_utf8(&text)
+        .with_context(|| format!("report '{}' is not UTF-8 text", path.display()))?;
+    Ok(serde_json::from_str(text).with_context(|| {
+        format!(
+            "'{}' is not an sfmeval.report/3 (sfmeval eval --report) file",
+            path.display()
+        )
+    })?)
+}
+
+/// The rows of `sfmeval table REPORT... [--dataset D] [--failed P=R...]`.
+fn table_rows(
+    reports: &[String],
+    dataset: Option<&str>,
+    failed: &[String],
+) -> Result<Vec<Row>, Failure> {
+    let mut read = Vec::new();
+    for arg in reports {
+        let (pipeline, path) = pipeline_and_path(arg)?;
+        let report = read_report(&path)?;
+        read.push((pipeline, path, report));
+    }
+    let dataset = match (dataset, read.first()) {
+        (Some(d), _) => d.to_string(),
+        (None, Some((_, _, r))) => {
+            let name = &r.inputs.ground_truth.name;
+            Path::new(name)
+                .file_stem()
+                .map_or_else(|| name.clone(), |s| s.to_string_lossy().into_owned())
+        }
+        (None, None) => Err(anyhow!("no report given"))?,
+    };
+    let mut rows = Vec::new();
+    for (pipeline, path, report) in &read {
+        rows.push(report_row(&dataset, pipeline, report, path_str(path)?));
+    }
+    for f in failed {
+        let Some((pipeline, reason)) = named(f) else {
+            Err(anyhow!("failed '{f}': expected PIPELINE=REASON"))?
+        };
+        rows.push(failed_row(&dataset, pipeline, "failed", reason));
+    }
+    let mut seen = std::collections::BTreeSet::new();
+    for r in &rows {
+        if !seen.insert(r.pipeline.as_str()) {
+            Err(anyhow!(
+                "pipeline '{}' is given twice: name each report PIPELINE=REPORT",
+                r.pipeline
+            ))?;
+        }
+    }
+    Ok(rows)
+}
+
+/// `_table(reports, dataset=None, failed=[])`: the texts `sfmeval table` prints and writes
+/// (`table1.md`, `table1.csv`, `table.md`, `runs.csv`, `summary.json`) as a dict by file name.
+#[pyfunction]
+#[pyo3(signature = (reports, dataset=None, failed=Vec::new()))]
+pub(crate) fn _table<'py>(
+    py: Python<'py>,
+    reports: Vec<String>,
+    dataset: Option<String>,
+    failed: Vec<String>,
+) -> PyResult<Bound<'py, PyDict>> {
+    let texts = hooks::run(py, None, None, |_| {
+        let rows = table_rows(&reports, dataset.as_deref(), &failed)?;
+        let t = tables(&rows);
+        Ok([
+            ("table1.md", t.table1_md),
+            ("table1.csv", t.table1_csv),
+            ("table.md", t.table_md),
+            ("runs.csv", t.runs_csv),
+            ("summary.json", summary_json(&rows)?),
+        ])
+    })?;
+    let out = PyDict::new(py);
+    for (name, text) in texts {
+        out.set_item(name, text)?;
+    }
+    Ok(out)
+}
