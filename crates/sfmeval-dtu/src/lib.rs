@@ -1,0 +1,8 @@
+//! The DTU MVS evaluation (Aanæs et al., "Large-Scale Data for Multiple-View Stereopsis",
+//! IJCV 2016) as its widely used Python port (jzhangbs/DTUeval-python, `eval.py`) runs it, on
+//! the sfmeval core: the benchmark's files ([`scan`]: the STL points, the observation mask, the
+//! ground plane, read from the `.mat` files by [`mat`]), the reconstruction sampled when it is a
+//! mesh, the down-sampling, the bounding box and observation-mask filtering, accuracy and
+//! completeness capped at 20 mm, and the coloured error clouds.
+
+pub mod mat;
