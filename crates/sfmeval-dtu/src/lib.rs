@@ -6,3 +6,14 @@
 //! completeness capped at 20 mm, and the coloured error clouds.
 
 pub mod mat;
+mod protocol;
+mod report;
+pub mod scan;
+pub mod vis;
+
+pub use protocol::{
+    DOWNSAMPLE_DENSITY, DtuEvaluation, DtuInput, DtuOptions, MAX_DIST, PATCH_SIZE, Shuffle,
+    VISUALIZE_THRESHOLD, evaluate, pairwise_sum, radius_filter, sample_mesh, shuffle,
+};
+pub use report::{DTU_SCHEMA, DtuCounts, DtuReport, DtuReportOptions};
+pub use scan::{DtuScan, NamedBytes, ObsMask};
