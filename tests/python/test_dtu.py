@@ -13,6 +13,7 @@ import subprocess
 import sys
 from pathlib import Path
 
+import jsonschema
 import numpy as np
 import pytest
 
@@ -21,6 +22,7 @@ import dtu_scene
 HERE = Path(__file__).resolve().parent
 PORT = HERE / "dtu_port.py"
 PYTHON = os.environ.get("SFMEVAL_PYTHON", sys.executable)
+SCHEMA = json.loads((HERE.parents[1] / "schemas" / "dtu.schema.json").read_text())
 
 
 @pytest.fixture(scope="module")
@@ -43,7 +45,9 @@ def run_sfmeval(sfmeval_bin, scene, recon, mode, vis_dir, *extra):
                         "--vis-out", str(vis_dir), "--json", *extra],
                        capture_output=True, text=True)
     assert p.returncode == 0, p.stderr
-    return json.loads(p.stdout)
+    rep = json.loads(p.stdout)
+    jsonschema.validate(rep, SCHEMA)
+    return rep
 
 
 def body(path):

@@ -616,6 +616,7 @@ def test_dtu_valid_layout_is_measured(sfmeval_bin, dtu_dataset):
     code, out, err = _run_dtu(sfmeval_bin, dtu_dataset)
     assert code == 0, err
     rep = json.loads(out)
+    jsonschema.validate(rep, json.loads((ROOT / "schemas" / "dtu.schema.json").read_text()))
     assert rep["schema"] == "sfmeval.dtu/1" and rep["mean_accuracy"] == 0.0
 
 
