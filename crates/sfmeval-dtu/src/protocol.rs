@@ -576,6 +576,19 @@ mod tests {
                 ]
             })
             .collect();
+        // Copies 2²¹ cells away share cell keys with the originals: only more candidates.
+        let mut pts = pts;
+        let far: Vec<Point3> = pts[..500]
+            .iter()
+            .map(|p| {
+                [
+                    p[0] + 0.4 * f64::from(1u32 << 21),
+                    p[1],
+                    p[2] - 0.4 * f64::from(1u32 << 21),
+                ]
+            })
+            .collect();
+        pts.extend(far);
         let kept = radius_filter(&pts, 0.2);
         let mut brute = vec![false; pts.len()];
         for i in 0..pts.len() {
