@@ -102,6 +102,9 @@ while read -r line; do skip "bench-compare-quick" "$line"; done < <(
 # The Tanks and Temples protocol against the benchmark's own toolbox, quick mode.
 check bench-tnt-quick .venv/bin/python bench/tanksandtemples.py --quick
 
+# The DTU evaluation against its Python port, quick mode (about 10 s).
+check bench-dtu-quick .venv/bin/python bench/dtu.py --quick
+
 # The Python package (crates/sfmeval-py): its wheel built, installed in a fresh venv and tested
 # against the CLI's reports byte for byte.
 check python-package scripts/check-python-package.sh

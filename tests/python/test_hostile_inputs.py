@@ -550,3 +550,145 @@ def test_ground_truth_camera_warnings_reach_the_report(evaluate, tmp_path):
     assert kind == "ok", rep
     hits = [w for w in [n["message"] for n in rep["notes"]] if w.startswith("ground-truth cameras: ")]
     assert hits and "principal point" in hits[0] and "outside" in hits[0], [n["message"] for n in rep["notes"]]
+
+
+# ---------------------------------------------------------------- DTU .mat files
+
+def _mat_header():
+    text = b"MATLAB 5.0 MAT-file, hostile test".ljust(116, b" ")
+    return text + b"\0" * 8 + struct.pack("<H", 0x0100) + b"IM"
+
+
+def _element(ty, data):
+    pad = (-len(data)) % 8
+    return struct.pack("<II", ty, len(data)) + data + b"\0" * pad
+
+
+def _matrix(name, dims, class_code=9, data_ty=2, data=b"", flags=0x0200):
+    body = (_element(6, struct.pack("<II", class_code | flags, 0))
+            + _element(5, struct.pack(f"<{len(dims)}i", *dims))
+            + _element(1, name.encode())
+            + _element(data_ty, data))
+    return struct.pack("<II", 14, len(body)) + body
+
+
+def _compressed(raw):
+    import zlib
+    z = zlib.compress(raw)
+    return struct.pack("<II", 15, len(z)) + z
+
+
+@pytest.fixture(scope="module")
+def dtu_dataset(tmp_path_factory):
+    """A tiny valid DTU layout (STL points, observation mask, plane) and a reconstruction."""
+    import numpy as np
+    from scipy.io import savemat
+    root = tmp_path_factory.mktemp("dtu_hostile")
+    (root / "Points" / "stl").mkdir(parents=True)
+    (root / "ObsMask").mkdir()
+    pts = surface_points(500, scale=10.0)
+    cloud_ply(root / "Points" / "stl" / "stl001_total.ply", pts)
+    savemat(root / "ObsMask" / "ObsMask1_10.mat",
+            {"ObsMask": np.ones((8, 8, 8), dtype=bool), "BB": np.array([[-20.0] * 3, [20.0] * 3]),
+             "Res": np.array([[5.0]])}, do_compression=True)
+    savemat(root / "ObsMask" / "Plane1.mat", {"P": np.array([0.0, 0.0, 1.0, 100.0])})
+    cloud_ply(root / "recon.ply", pts)
+    return root
+
+
+def _dtu_with_mask(dtu_dataset, tmp_path, mask_bytes):
+    import shutil
+    root = tmp_path / "dtu"
+    shutil.copytree(dtu_dataset, root)
+    (root / "ObsMask" / "ObsMask1_10.mat").write_bytes(mask_bytes)
+    return root
+
+
+def _run_dtu(sfmeval_bin, root):
+    code, out, err, rss, secs = run_measured(sfmeval_bin, "dtu", "--dataset", root, "--scan", "1",
+                                             "--recon", root / "recon.ply", "--json")
+    assert rss is not None and rss < MAX_RSS_KB, f"peak RSS {rss} KB"
+    assert "panicked" not in err, err
+    return code, out, err
+
+
+def test_dtu_valid_layout_is_measured(sfmeval_bin, dtu_dataset):
+    code, out, err = _run_dtu(sfmeval_bin, dtu_dataset)
+    assert code == 0, err
+    rep = json.loads(out)
+    jsonschema.validate(rep, json.loads((ROOT / "schemas" / "dtu.schema.json").read_text()))
+    assert rep["schema"] == "sfmeval.dtu/1" and rep["mean_accuracy"] == 0.0
+
+
+@pytest.mark.parametrize("cut", [0, 100, 128, 140, 200, -1])
+def test_dtu_truncated_mat_is_refused_naming_the_file(sfmeval_bin, dtu_dataset, tmp_path, cut):
+    whole = (dtu_dataset / "ObsMask" / "ObsMask1_10.mat").read_bytes()
+    root = _dtu_with_mask(dtu_dataset, tmp_path, whole[:cut] if cut >= 0 else whole[:-5])
+    code, _, err = _run_dtu(sfmeval_bin, root)
+    assert code == 1 and "ObsMask1_10.mat" in err, err
+    assert "truncated" in err or "no variable" in err or "ends" in err, err
+
+
+@pytest.mark.parametrize("value, kind", [
+    ("a string", "char array"),
+    ({"a": 1.0}, "struct array"),
+    ([[1.0, "x"]], "cell array"),
+    (1j, "complex"),
+])
+def test_dtu_mat_of_the_wrong_class_is_refused(sfmeval_bin, dtu_dataset, tmp_path, value, kind):
+    import io
+    import numpy as np
+    from scipy.io import savemat
+    buf = io.BytesIO()
+    v = np.array(value, dtype=object) if isinstance(value, list) else value
+    savemat(buf, {"ObsMask": v, "BB": np.zeros((2, 3)), "Res": 1.0}, do_compression=True)
+    root = _dtu_with_mask(dtu_dataset, tmp_path, buf.getvalue())
+    code, _, err = _run_dtu(sfmeval_bin, root)
+    assert code == 1 and "ObsMask1_10.mat" in err and kind in err, err
+
+
+def test_dtu_mat_without_its_variables_names_them(sfmeval_bin, dtu_dataset, tmp_path):
+    import io
+    import numpy as np
+    from scipy.io import savemat
+    buf = io.BytesIO()
+    savemat(buf, {"Mask": np.ones((2, 2, 2), dtype=bool)})
+    root = _dtu_with_mask(dtu_dataset, tmp_path, buf.getvalue())
+    code, _, err = _run_dtu(sfmeval_bin, root)
+    assert code == 1 and "no variable 'ObsMask'" in err and "Mask" in err, err
+
+
+@pytest.mark.parametrize("dims", [[100000, 100000, 100000], [2**31 - 1] * 3, [-1, 4, 4]])
+@pytest.mark.parametrize("compressed", [False, True])
+def test_dtu_mat_with_huge_dimensions_is_refused_before_allocating(
+        sfmeval_bin, dtu_dataset, tmp_path, dims, compressed):
+    m = _matrix("ObsMask", dims, data=b"\1" * 64)
+    root = _dtu_with_mask(dtu_dataset, tmp_path, _mat_header() + (_compressed(m) if compressed else m))
+    code, _, err = _run_dtu(sfmeval_bin, root)
+    assert code == 1 and "ObsMask1_10.mat" in err, err
+    assert "above the limit" in err or "negative dimension" in err, err
+
+
+def test_dtu_mat_declaring_more_than_its_stream_holds_is_refused(sfmeval_bin, dtu_dataset, tmp_path):
+    """A compressed mask that declares 3.4 GB (within the limit) but whose stream ends after
+    1 MB: inflated no further than the stream, refused as truncated, under the memory bound."""
+    import zlib
+    dims = [1500, 1500, 1500]
+    n = 1500 ** 3
+    head = (_element(6, struct.pack("<II", 9 | 0x0200, 0)) + _element(5, struct.pack("<3i", *dims))
+            + _element(1, b"ObsMask") + struct.pack("<II", 2, n))
+    raw = struct.pack("<II", 14, len(head) + n) + head + b"\0" * (1 << 20)
+    z = zlib.compressobj()
+    stream = z.compress(raw) + z.flush(zlib.Z_SYNC_FLUSH)
+    mat = _mat_header() + struct.pack("<II", 15, len(stream)) + stream
+    root = _dtu_with_mask(dtu_dataset, tmp_path, mat)
+    code, _, err = _run_dtu(sfmeval_bin, root)
+    assert code == 1 and "ObsMask1_10.mat" in err and "ends after" in err, err
+
+
+def test_dtu_mat_dimensions_that_disagree_with_the_data_are_refused(sfmeval_bin, dtu_dataset,
+                                                                     tmp_path):
+    m = _matrix("ObsMask", [4, 4, 4], data=b"\1" * 10)
+    root = _dtu_with_mask(dtu_dataset, tmp_path, _mat_header() + m)
+    code, _, err = _run_dtu(sfmeval_bin, root)
+    assert code == 1 and "ObsMask1_10.mat" in err and "64" in err, err

@@ -88,6 +88,10 @@ enum Command {
     /// benchmark's own evaluation toolbox computes them.
     #[command(alias = "tanksandtemples")]
     Tnt(Box<TntArgs>),
+    /// The DTU MVS evaluation on a scan (STL points, observation mask, ground plane):
+    /// mean accuracy, mean completeness and overall in mm, as the benchmark's Python port
+    /// computes them.
+    Dtu(Box<crate::dtu::DtuArgs>),
     /// Write a model's cameras as a Tanks and Temples .log trajectory (one frame per image).
     Log(LogArgs),
     /// Table I and the comparison table of evaluation reports, as `sfmeval-runner report`
@@ -292,6 +296,7 @@ pub fn run(cli: Cli) -> Result<()> {
             max_triangles,
         } => info(&file, &ReadLimits::triangles(max_triangles)),
         Command::Tnt(args) => tnt_cmd(&args),
+        Command::Dtu(args) => crate::dtu::dtu_cmd(&args),
         Command::Log(args) => log_cmd(&args),
         Command::Table(args) => table_cmd(&args),
         Command::Export(args) => export_cmd(&args),

@@ -2,6 +2,7 @@
 
 mod commands;
 mod concurrent;
+mod dtu;
 mod progress;
 mod summary;
 mod table;

@@ -1,0 +1,622 @@
+//! The evaluation, step for step as `eval.py` of DTUeval-python runs it:
+//!
+//! 1. a mesh is sampled ([`sample_mesh`]): its vertices, then a grid of points in each
+//!    triangle of non-zero area whose spacing follows the down-sampling density;
+//! 2. the points are shuffled (the port shuffles unseeded; here a seeded Fisher–Yates, or the
+//!    file's order with [`Shuffle::None`]) and down-sampled by [`radius_filter`]: in that
+//!    order, a point is kept when no point kept before it lies within the density (0.2 mm);
+//! 3. points outside the bounding box `BB` widened by the patch size (60 mm below, 120 mm
+//!    above: the port's `BB[1:]+patch*2`, in `float32` as it casts `BB`) are dropped, and of
+//!    the rest those whose observation-mask cell (rounded half to even) is observed are
+//!    measured;
+//! 4. accuracy: each observed point's distance to its nearest STL point, the mean over those
+//!    below `max_dist` (20 mm); completeness: each STL point above the ground plane, its
+//!    distance to the nearest reconstruction point inside the widened box, the mean over those
+//!    below `max_dist`; overall: the mean of the two.
+//!
+//! Nearest distances are exact (`KdCloud`, the squared sum summed x, y, z as scikit-learn's
+//! k-d tree does), the radius test is scikit-learn's leaf test `d² ≤ r²`, and the means are
+//! pairwise sums as numpy's. Where a result can differ from the port at all: points within
+//! rounding of the radius, of a mask cell's half-way point or of the ground plane, and the
+//! shuffle (the port's is unseeded, so two of its runs differ too).
+
+use rand::{Rng as _, SeedableRng as _};
+use rand_chacha::ChaCha8Rng;
+use sfmeval::distance::KdCloud;
+use sfmeval::geometry::Point3;
+use sfmeval::progress::NoProgress;
+use sfmeval::{Error, Result, parallel};
+
+use crate::scan::DtuScan;
+
+/// The evaluator's defaults.
+pub const DOWNSAMPLE_DENSITY: f64 = 0.2;
+/// The patch size the bounding box is widened by (mm).
+pub const PATCH_SIZE: f64 = 60.0;
+/// The distance cap (mm).
+pub const MAX_DIST: f64 = 20.0;
+/// The distance at which the error clouds turn fully red (mm).
+pub const VISUALIZE_THRESHOLD: f64 = 10.0;
+
+/// The order points are down-sampled in.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Shuffle {
+    /// A Fisher–Yates shuffle drawn from ChaCha8 seeded with this seed (the evaluator shuffles
+    /// at random).
+    Seeded(u64),
+    /// The input's order: the file's points, or a mesh's vertices then its samples.
+    None,
+}
+
+/// The evaluator's options.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct DtuOptions {
+    /// `downsample_density` (mm).
+    pub downsample_density: f64,
+    /// `patch_size` (mm).
+    pub patch_size: f64,
+    /// `max_dist` (mm).
+    pub max_dist: f64,
+    /// `visualize_threshold` (mm).
+    pub visualize_threshold: f64,
+    /// The down-sampling order.
+    pub shuffle: Shuffle,
+}
+
+impl Default for DtuOptions {
+    fn default() -> Self {
+        DtuOptions {
+            downsample_density: DOWNSAMPLE_DENSITY,
+            patch_size: PATCH_SIZE,
+            max_dist: MAX_DIST,
+            visualize_threshold: VISUALIZE_THRESHOLD,
+            shuffle: Shuffle::Seeded(0),
+        }
+    }
+}
+
+impl DtuOptions {
+    fn validate(&self) -> Result<()> {
+        for (name, v) in [
+            ("downsample density", self.downsample_density),
+            ("patch size", self.patch_size),
+            ("max_dist", self.max_dist),
+            ("visualize threshold", self.visualize_threshold),
+        ] {
+            if !(v.is_finite() && v > 0.0) {
+                return Err(Error::InvalidOption(format!(
+                    "the {name} must be a positive number, got {v}"
+                )));
+            }
+        }
+        Ok(())
+    }
+}
+
+/// The reconstruction: a point cloud, or a mesh the evaluator samples.
+#[derive(Debug, Clone, PartialEq)]
+pub enum DtuInput {
+    /// Points (the port's `--mode pcd`).
+    Cloud(Vec<Point3>),
+    /// A triangle mesh (`--mode mesh`).
+    Mesh {
+        /// Vertices.
+        vertices: Vec<Point3>,
+        /// Triangles.
+        triangles: Vec<[u32; 3]>,
+    },
+}
+
+/// The samples of a mesh as the port takes them: every vertex, then for each triangle of
+/// non-zero area (in order) the points `v0 + e1 (i + ½)/n1 + e2 (j + ½)/n2` with
+/// `(i + ½)/n1 + (j + ½)/n2 < 1`, `i` outer, where `n = ⌊|e| / t⌋` and
+/// `t = density √(|e1| |e2| / |e1 × e2|)`, in the port's floating-point operations.
+pub fn sample_mesh(
+    vertices: &[Point3],
+    triangles: &[[u32; 3]],
+    density: f64,
+) -> Result<Vec<Point3>> {
+    let n_vertices = vertices.len();
+    for (k, t) in triangles.iter().enumerate() {
+        if t.iter().any(|&v| v as usize >= n_vertices) {
+            return Err(Error::InvalidContent(format!(
+                "triangle {k} names vertex {} of {n_vertices}",
+                t.iter().max().copied().unwrap_or(0)
+            )));
+        }
+    }
+    // Per triangle: the edge vectors, the counts and the corner, or None for zero area.
+    let plans: Vec<Option<Plan>> = parallel::map(triangles, &NoProgress, |t| {
+        let p0 = vertices[t[0] as usize];
+        let p1 = vertices[t[1] as usize];
+        let p2 = vertices[t[2] as usize];
+        let v1 = [p1[0] - p0[0], p1[1] - p0[1], p1[2] - p0[2]];
+        let v2 = [p2[0] - p0[0], p2[1] - p0[1], p2[2] - p0[2]];
+        let l1 = norm(v1);
+        let l2 = norm(v2);
+        // numpy's cross: each component a product minus a product, rounded in turn.
+        let c = [
+            v1[1] * v2[2] - v1[2] * v2[1],
+            v1[2] * v2[0] - v1[0] * v2[2],
+            v1[0] * v2[1] - v1[1] * v2[0],
+        ];
+        let area2 = norm(c);
+        if !(area2 > 0.0) {
+            return None;
+        }
+        let thr = density * (l1 * l2 / area2).sqrt();
+        let n1 = (l1 / thr).floor();
+        let n2 = (l2 / thr).floor();
+        Some((v1, v2, p0, n1, n2))
+    });
+    // The samples must be numbered in u32: bound their count before allocating.
+    let mut bound: f64 = n_vertices as f64;
+    for (_, _, _, n1, n2) in plans.iter().flatten() {
+        bound += (n1 + 1.0) * (n2 + 1.0);
+    }
+    let limit = u32::MAX as f64;
+    if !(bound <= limit) {
+        // The exact count is about half the bound; count before refusing.
+        let exact: f64 = plans
+            .iter()
+            .flatten()
+            .map(|&(_, _, _, n1, n2)| triangle_count(n1, n2) as f64)
+            .sum::<f64>()
+            + n_vertices as f64;
+        if !(exact <= limit) {
+            return Err(Error::LimitExceeded {
+                format: "mesh",
+                what: format!("points sampled at a density of {density}"),
+                count: exact as u64,
+                limit: u32::MAX as u64,
+                hint: "",
+            });
+        }
+    }
+    let chunks: Vec<&[Option<Plan>]> = plans.chunks(4096).collect();
+    let pieces: Vec<Vec<Point3>> = parallel::map(&chunks, &NoProgress, |chunk| {
+        let mut out = Vec::new();
+        for (v1, v2, p0, n1, n2) in chunk.iter().flatten() {
+            sample_triangle(*v1, *v2, *p0, *n1, *n2, &mut out);
+        }
+        out
+    });
+    let total: usize = n_vertices + pieces.iter().map(Vec::len).sum::<usize>();
+    let mut points = Vec::with_capacity(total);
+    points.extend_from_slice(vertices);
+    for p in pieces {
+        points.extend_from_slice(&p);
+    }
+    Ok(points)
+}
+
+/// A triangle's edge vectors, corner and sample counts.
+type Plan = (Point3, Point3, Point3, f64, f64);
+
+fn norm(v: Point3) -> f64 {
+    (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt()
+}
+
+/// `sample_single_tri`: `c = mgrid[:n1+1, :n2+1] + 0.5`, divided by `max(n, 1e-7)`, the cells
+/// with `c0 + c1 < 1` in C order, `q = v1 c0 + v2 c1 + v0`.
+fn sample_triangle(v1: Point3, v2: Point3, p0: Point3, n1: f64, n2: f64, out: &mut Vec<Point3>) {
+    let d1 = n1.max(1e-7);
+    let d2 = n2.max(1e-7);
+    let mut i = 0.0;
+    while i <= n1 {
+        let k0 = (i + 0.5) / d1;
+        if !(k0 + 0.5 / d2 < 1.0) {
+            break;
+        }
+        let mut j = 0.0;
+        while j <= n2 {
+            let k1 = (j + 0.5) / d2;
+            if !(k0 + k1 < 1.0) {
+                break;
+            }
+            out.push([
+                v1[0] * k0 + v2[0] * k1 + p0[0],
+                v1[1] * k0 + v2[1] * k1 + p0[1],
+                v1[2] * k0 + v2[2] * k1 + p0[2],
+            ]);
+            j += 1.0;
+        }
+        i += 1.0;
+    }
+}
+
+fn triangle_count(n1: f64, n2: f64) -> u64 {
+    let mut out = 0u64;
+    let d1 = n1.max(1e-7);
+    let d2 = n2.max(1e-7);
+    let mut i = 0.0;
+    while i <= n1 {
+        let k0 = (i + 0.5) / d1;
+        // The largest j with k0 + (j + ½)/d2 < 1, found by stepping back from the estimate.
+        let mut j = ((1.0 - k0) * d2 - 0.5).floor().min(n2);
+        while j >= 0.0 && !(k0 + (j + 0.5) / d2 < 1.0) {
+            j -= 1.0;
+        }
+        while j + 1.0 <= n2 && k0 + (j + 1.5) / d2 < 1.0 {
+            j += 1.0;
+        }
+        if j < 0.0 {
+            break;
+        }
+        out += j as u64 + 1;
+        i += 1.0;
+    }
+    out
+}
+
+/// Shuffles `points` in place as [`Shuffle`] says.
+pub fn shuffle(points: &mut [Point3], order: Shuffle) {
+    if let Shuffle::Seeded(seed) = order {
+        let mut rng = ChaCha8Rng::seed_from_u64(seed);
+        for i in (1..points.len()).rev() {
+            let j = rng.random_range(0..=i);
+            points.swap(i, j);
+        }
+    }
+}
+
+/// The port's down-sampling: visiting `points` in order, a point is kept when no point kept
+/// before it lies within `radius` (`d² ≤ r²`, scikit-learn's radius test); returns the mask of
+/// kept points. Kept points are hashed into cells of twice the radius, so a query reads at most
+/// eight cells' kept points.
+pub fn radius_filter(points: &[Point3], radius: f64) -> Vec<bool> {
+    let r2 = radius * radius;
+    let cell = 2.0 * radius;
+    let mut heads: std::collections::HashMap<u64, u32, CellHash> =
+        std::collections::HashMap::with_hasher(CellHash);
+    // next[i]: the kept point before i in i's cell (u32::MAX ends the list).
+    let mut next = vec![u32::MAX; points.len()];
+    let mut kept = vec![false; points.len()];
+    let coord = |v: f64| (v / cell).floor() as i64;
+    for (i, &p) in points.iter().enumerate() {
+        let lo = [
+            coord(p[0] - radius),
+            coord(p[1] - radius),
+            coord(p[2] - radius),
+        ];
+        let hi = [
+            coord(p[0] + radius),
+            coord(p[1] + radius),
+            coord(p[2] + radius),
+        ];
+        let mut near = false;
+        'cells: for x in lo[0]..=hi[0].min(lo[0] + 2) {
+            for y in lo[1]..=hi[1].min(lo[1] + 2) {
+                for z in lo[2]..=hi[2].min(lo[2] + 2) {
+                    let Some(&head) = heads.get(&cell_key(x, y, z)) else {
+                        continue;
+                    };
+                    let mut k = head;
+                    while k != u32::MAX {
+                        if sfmeval::distance::distance2(p, points[k as usize]) <= r2 {
+                            near = true;
+                            break 'cells;
+                        }
+                        k = next[k as usize];
+                    }
+                }
+            }
+        }
+        if !near {
+            kept[i] = true;
+            let own = cell_key(coord(p[0]), coord(p[1]), coord(p[2]));
+            let slot = heads.entry(own).or_insert(u32::MAX);
+            next[i] = *slot;
+            *slot = i as u32;
+        }
+    }
+    kept
+}
+
+/// A cell's key: 21 bits of each coordinate. Far cells can share a key; they only add
+/// candidates, each tested by its distance.
+fn cell_key(x: i64, y: i64, z: i64) -> u64 {
+    let m = (1u64 << 21) - 1;
+    (x as u64 & m) | ((y as u64 & m) << 21) | ((z as u64 & m) << 42)
+}
+
+#[derive(Clone, Copy, Default)]
+struct CellHash;
+
+impl std::hash::BuildHasher for CellHash {
+    type Hasher = CellHasher;
+    fn build_hasher(&self) -> CellHasher {
+        CellHasher(0)
+    }
+}
+
+struct CellHasher(u64);
+
+impl std::hash::Hasher for CellHasher {
+    fn finish(&self) -> u64 {
+        self.0
+    }
+    fn write(&mut self, bytes: &[u8]) {
+        for &b in bytes {
+            self.0 = (self.0.rotate_left(8) ^ u64::from(b)).wrapping_mul(0x9E37_79B9_7F4A_7C15);
+        }
+    }
+    fn write_u64(&mut self, k: u64) {
+        // A multiplicative hash with the high bits folded down (hashbrown reads both ends).
+        let h = (k ^ (k >> 29)).wrapping_mul(0x9E37_79B9_7F4A_7C15);
+        self.0 = h ^ (h >> 32);
+    }
+}
+
+/// numpy's pairwise sum (blocks of 8 partial sums up to 128 values, halves above), so means
+/// agree with `ndarray.mean` to the last bits in most cases.
+pub fn pairwise_sum(a: &[f64]) -> f64 {
+    let n = a.len();
+    if n < 8 {
+        let mut res = 0.0;
+        for &x in a {
+            res += x;
+        }
+        res
+    } else if n <= 128 {
+        let mut r = [0.0; 8];
+        r.copy_from_slice(&a[..8]);
+        let mut i = 8;
+        while i < n - n % 8 {
+            for (j, rj) in r.iter_mut().enumerate() {
+                *rj += a[i + j];
+            }
+            i += 8;
+        }
+        let mut res = ((r[0] + r[1]) + (r[2] + r[3])) + ((r[4] + r[5]) + (r[6] + r[7]));
+        while i < n {
+            res += a[i];
+            i += 1;
+        }
+        res
+    } else {
+        let mut n2 = n / 2;
+        n2 -= n2 % 8;
+        pairwise_sum(&a[..n2]) + pairwise_sum(&a[n2..])
+    }
+}
+
+/// The mean of the values below `cap`, or `None` when there is none.
+fn capped_mean(d: &[f64], cap: f64) -> (Option<f64>, usize) {
+    let below: Vec<f64> = d.iter().copied().filter(|&x| x < cap).collect();
+    if below.is_empty() {
+        (None, 0)
+    } else {
+        (Some(pairwise_sum(&below) / below.len() as f64), below.len())
+    }
+}
+
+/// Everything an evaluation measured, with what the error clouds need.
+#[derive(Debug, Clone, PartialEq)]
+pub struct DtuEvaluation {
+    /// The options used.
+    pub options: DtuOptions,
+    /// Points before down-sampling (a mesh's vertices and samples).
+    pub sampled_points: usize,
+    /// The down-sampled points, in the shuffled order (the d2s cloud's points).
+    pub downsampled: Vec<Point3>,
+    /// How many of them lie in the widened bounding box.
+    pub in_box: usize,
+    /// Indices into `downsampled` of the observed points, in order.
+    pub observed: Vec<u32>,
+    /// Their distances to the STL points (mm).
+    pub d2s: Vec<f64>,
+    /// Indices of the STL points above the ground plane, in order.
+    pub above: Vec<u32>,
+    /// Their distances to the reconstruction points in the widened box (mm).
+    pub s2d: Vec<f64>,
+    /// How many STL points there are.
+    pub stl_points: usize,
+    /// Mean accuracy (mm): the mean of `d2s` below `max_dist`.
+    pub mean_d2s: Option<f64>,
+    /// How many `d2s` values are below `max_dist`.
+    pub d2s_counted: usize,
+    /// Mean completeness (mm): the mean of `s2d` below `max_dist`.
+    pub mean_s2d: Option<f64>,
+    /// How many `s2d` values are below `max_dist`.
+    pub s2d_counted: usize,
+    /// The mean of the two.
+    pub overall: Option<f64>,
+}
+
+/// Runs the evaluation of `input` against `scan`.
+pub fn evaluate(scan: &DtuScan, input: DtuInput, options: &DtuOptions) -> Result<DtuEvaluation> {
+    options.validate()?;
+    let mut points = match input {
+        DtuInput::Cloud(p) => p,
+        DtuInput::Mesh {
+            vertices,
+            triangles,
+        } => sample_mesh(&vertices, &triangles, options.downsample_density)?,
+    };
+    if points.is_empty() {
+        return Err(Error::Empty {
+            what: "the reconstruction".into(),
+        });
+    }
+    if points.len() > u32::MAX as usize {
+        return Err(Error::LimitExceeded {
+            format: "DTU",
+            what: "reconstruction points".into(),
+            count: points.len() as u64,
+            limit: u32::MAX as u64,
+            hint: "",
+        });
+    }
+    let sampled_points = points.len();
+    shuffle(&mut points, options.shuffle);
+    let kept = radius_filter(&points, options.downsample_density);
+    let mut downsampled = Vec::with_capacity(kept.iter().filter(|&&k| k).count());
+    for (p, k) in points.iter().zip(&kept) {
+        if *k {
+            downsampled.push(*p);
+        }
+    }
+    drop(points);
+    drop(kept);
+
+    // The box in float32, as the port casts BB before widening it.
+    let om = &scan.obs_mask;
+    let bb_lo32 = om.bb[0].map(|v| v as f32);
+    let bb_hi32 = om.bb[1].map(|v| v as f32);
+    let patch32 = options.patch_size as f32;
+    let patch2_32 = (options.patch_size * 2.0) as f32;
+    let lo = bb_lo32.map(|v| f64::from(v - patch32));
+    let hi = bb_hi32.map(|v| f64::from(v + patch2_32));
+    let origin = bb_lo32.map(f64::from);
+    let mut data_in = Vec::new();
+    let mut observed = Vec::new();
+    for (i, p) in downsampled.iter().enumerate() {
+        if !(0..3).all(|a| p[a] >= lo[a] && p[a] < hi[a]) {
+            continue;
+        }
+        data_in.push(*p);
+        let mut cell = [0usize; 3];
+        let mut inside = true;
+        for a in 0..3 {
+            let g = ((p[a] - origin[a]) / om.res).round_ties_even();
+            if g >= 0.0 && g < om.dims[a] as f64 {
+                cell[a] = g as usize;
+            } else {
+                inside = false;
+            }
+        }
+        if inside && om.cells[cell[0] + om.dims[0] * (cell[1] + om.dims[1] * cell[2])] != 0 {
+            observed.push(i as u32);
+        }
+    }
+    if data_in.is_empty() {
+        return Err(Error::InvalidContent(format!(
+            "no reconstruction point lies in the scan's bounding box widened by the patch size ({lo:?} to {hi:?}); is the reconstruction in the scan's frame, in mm?"
+        )));
+    }
+    let in_box = data_in.len();
+
+    let stl_index = KdCloud::new(&scan.stl)?;
+    let obs_points: Vec<Point3> = observed.iter().map(|&i| downsampled[i as usize]).collect();
+    let d2s: Vec<f64> =
+        parallel::map_points_with_state(&obs_points, &NoProgress, |start: &mut NearStart, p| {
+            let (d, k) = stl_index.nearest_from(*p, start.0);
+            start.0 = k;
+            d
+        });
+    drop(stl_index);
+    drop(obs_points);
+
+    let pl = scan.plane;
+    let above: Vec<u32> = (0..scan.stl.len())
+        .filter(|&i| {
+            let s = scan.stl[i];
+            pl[0] * s[0] + pl[1] * s[1] + pl[2] * s[2] + pl[3] > 0.0
+        })
+        .map(|i| i as u32)
+        .collect();
+    let above_points: Vec<Point3> = above.iter().map(|&i| scan.stl[i as usize]).collect();
+    let data_index = KdCloud::new(&data_in)?;
+    let s2d: Vec<f64> =
+        parallel::map_points_with_state(&above_points, &NoProgress, |start: &mut NearStart, p| {
+            let (d, k) = data_index.nearest_from(*p, start.0);
+            start.0 = k;
+            d
+        });
+
+    let (mean_d2s, d2s_counted) = capped_mean(&d2s, options.max_dist);
+    let (mean_s2d, s2d_counted) = capped_mean(&s2d, options.max_dist);
+    let overall = match (mean_d2s, mean_s2d) {
+        (Some(a), Some(b)) => Some((a + b) / 2.0),
+        _ => None,
+    };
+    Ok(DtuEvaluation {
+        options: *options,
+        sampled_points,
+        downsampled,
+        in_box,
+        observed,
+        d2s,
+        above,
+        s2d,
+        stl_points: scan.stl.len(),
+        mean_d2s,
+        d2s_counted,
+        mean_s2d,
+        s2d_counted,
+        overall,
+    })
+}
+
+/// The previous query's answer, where the next query starts.
+struct NearStart(usize);
+
+impl Default for NearStart {
+    fn default() -> Self {
+        NearStart(sfmeval::distance::NO_POINT)
+    }
+}
+
+#[cfg(test)]
+#[allow(clippy::unwrap_used)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn radius_filter_is_the_greedy_rule() {
+        // Brute force on a random cloud: kept iff no earlier kept point within r.
+        let mut rng = ChaCha8Rng::seed_from_u64(7);
+        let pts: Vec<Point3> = (0..3000)
+            .map(|_| {
+                [
+                    rng.random_range(-2.0..2.0),
+                    rng.random_range(-2.0..2.0),
+                    rng.random_range(-0.5..0.5),
+                ]
+            })
+            .collect();
+        // Copies 2²¹ cells away share cell keys with the originals: only more candidates.
+        let mut pts = pts;
+        let far: Vec<Point3> = pts[..500]
+            .iter()
+            .map(|p| {
+                [
+                    p[0] + 0.4 * f64::from(1u32 << 21),
+                    p[1],
+                    p[2] - 0.4 * f64::from(1u32 << 21),
+                ]
+            })
+            .collect();
+        pts.extend(far);
+        let kept = radius_filter(&pts, 0.2);
+        let mut brute = vec![false; pts.len()];
+        for i in 0..pts.len() {
+            brute[i] =
+                (0..i).all(|j| !brute[j] || sfmeval::distance::distance2(pts[i], pts[j]) > 0.04);
+        }
+        assert_eq!(kept, brute);
+        assert!(kept.iter().filter(|&&k| k).count() > 100);
+    }
+
+    #[test]
+    fn triangle_count_matches_the_samples() {
+        for (n1, n2) in [
+            (0.0, 0.0),
+            (1.0, 0.0),
+            (3.0, 5.0),
+            (17.0, 4.0),
+            (40.0, 41.0),
+        ] {
+            let mut out = Vec::new();
+            sample_triangle([1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0; 3], n1, n2, &mut out);
+            assert_eq!(out.len() as u64, triangle_count(n1, n2), "{n1} {n2}");
+        }
+    }
+
+    #[test]
+    fn pairwise_sum_adds_up() {
+        let v: Vec<f64> = (0..1000).map(|i| f64::from(i) * 0.5).collect();
+        assert_eq!(pairwise_sum(&v), 0.5 * 999.0 * 1000.0 / 2.0);
+    }
+}
