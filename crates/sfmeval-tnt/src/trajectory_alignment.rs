@@ -80,7 +80,7 @@ pub fn align_trajectories(
         )));
     }
     if n < options.ransac_n || options.ransac_n < 3 || options.max_iterations == 0 {
-        return Err(Error::InvalidOption(format!(
+        return Err(Error::InvalidContent(format!(
             "trajectory alignment needs at least {} frames, the reference has {n}",
             options.ransac_n.max(3)
         )));

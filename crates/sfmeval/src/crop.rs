@@ -170,7 +170,7 @@ impl Volume {
         if ok {
             Ok(())
         } else {
-            Err(Error::InvalidOption(format!(
+            Err(Error::InvalidContent(format!(
                 "crop {} is invalid (non-finite values, min > max, negative size, a rotation that is not orthonormal, or a polygon of fewer than 3 vertices)",
                 self.kind()
             )))
@@ -228,7 +228,7 @@ impl Open3dPolygonVolume {
             || self.version_major != 1
             || self.version_minor != 0
         {
-            return Err(Error::InvalidOption(format!(
+            return Err(Error::InvalidContent(format!(
                 "crop file: class '{}' version {}.{} is not Open3D's SelectionPolygonVolume 1.0",
                 self.class_name, self.version_major, self.version_minor
             )));
@@ -238,7 +238,7 @@ impl Open3dPolygonVolume {
             "y" | "Y" => Axis::Y,
             "z" | "Z" => Axis::Z,
             other => {
-                return Err(Error::InvalidOption(format!(
+                return Err(Error::InvalidContent(format!(
                     "crop file: orthogonal_axis is '{other}', expected x, y or z"
                 )));
             }

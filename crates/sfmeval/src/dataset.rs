@@ -135,7 +135,7 @@ impl Dataset {
         }
         if let Some(dir) = paths.depth.resolve(source, true)? {
             let Some(cameras) = dataset.cameras.as_ref() else {
-                return Err(Error::InvalidOption(format!(
+                return Err(Error::InvalidContent(format!(
                     "the depth maps '{dir}' need the ground-truth cameras (cameras.json)"
                 )));
             };

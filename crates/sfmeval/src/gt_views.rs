@@ -158,7 +158,7 @@ pub(crate) fn build_views(
         let stem = depth_stem(&im.name);
         let cam = gt_cameras
             .camera_of(im)
-            .ok_or_else(|| Error::InvalidOption(format!("image '{}' has no camera", im.name)))?;
+            .ok_or_else(|| Error::InvalidContent(format!("image '{}' has no camera", im.name)))?;
         let extra = match cam.model.as_str() {
             "SIMPLE_PINHOLE" | "PINHOLE" => 0.0,
             _ => {
@@ -171,25 +171,25 @@ pub(crate) fn build_views(
             }
         };
         if extra != 0.0 {
-            return Err(Error::InvalidOption(format!(
+            return Err(Error::InvalidContent(format!(
                 "image '{}': camera model {} has distortion; depth maps need pinhole cameras",
                 im.name, cam.model
             )));
         }
         if !(cam.fx > 0.0 && cam.fy > 0.0) {
-            return Err(Error::InvalidOption(format!(
+            return Err(Error::InvalidContent(format!(
                 "image '{}': camera {} has no positive focal length",
                 im.name, cam.id
             )));
         }
         let depth = depth_by_stem.get(&stem).ok_or_else(|| {
-            Error::InvalidOption(format!(
+            Error::InvalidContent(format!(
                 "missing depth map for image '{}' (expected depth/{stem}.npy)",
                 im.name
             ))
         })?;
         if (depth.width as u64, depth.height as u64) != (cam.width, cam.height) {
-            return Err(Error::InvalidOption(format!(
+            return Err(Error::InvalidContent(format!(
                 "depth/{stem}.npy is {}×{} but camera {} of image '{}' is {}×{}",
                 depth.width, depth.height, cam.id, im.name, cam.width, cam.height
             )));

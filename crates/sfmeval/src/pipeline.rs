@@ -72,7 +72,7 @@ pub fn read_reconstruction(name: &str, files: &BTreeMap<String, Vec<u8>>) -> Res
             }
             more => {
                 let names: Vec<&str> = more.iter().take(5).map(|(n, _)| n.as_str()).collect();
-                return Err(Error::InvalidOption(format!(
+                return Err(Error::InvalidContent(format!(
                     "reconstruction '{name}' holds an SfM model and {} PLY files ({}): give the one PLY to evaluate and the model as its cameras",
                     more.len(),
                     names.join(", ")
@@ -162,7 +162,7 @@ pub fn read_reconstruction_with_cameras(
     cameras_name: &str,
 ) -> Result<ReconInput> {
     if let Some(n) = model_file(files) {
-        return Err(Error::InvalidOption(format!(
+        return Err(Error::InvalidContent(format!(
             "reconstruction '{name}' is an SfM model ('{n}'), not a point cloud: separate cameras are only for a PLY"
         )));
     }

@@ -223,7 +223,7 @@ fn relative(ri: &Mat3, ti: Point3, rj: &Mat3, tj: Point3) -> (Mat3, Point3) {
 /// Camera-pose metrics of `est` against `gt` after `gt_from_recon` (see the module docs).
 ///
 /// Errors: [`Error::Empty`] when the ground truth has no images or no estimated image matches a
-/// ground-truth name; [`Error::InvalidOption`] for a non-finite or degenerate similarity. Fewer
+/// ground-truth name; [`Error::InvalidContent`] for a non-finite or degenerate similarity. Fewer
 /// than 3 matches, non-finite estimated poses (treated as unregistered) and unmatched names are
 /// warnings.
 pub fn evaluate_cameras(
@@ -256,13 +256,13 @@ pub(crate) fn evaluate_cameras_matched(
         .flatten()
         .any(|v| !v.is_finite())
     {
-        return Err(Error::InvalidOption(
+        return Err(Error::InvalidContent(
             "gt_from_recon has non-finite entries".into(),
         ));
     }
     let scale = gt_from_recon.scale();
     if !(scale.is_finite() && scale > 0.0) {
-        return Err(Error::InvalidOption(format!(
+        return Err(Error::InvalidContent(format!(
             "gt_from_recon has scale {scale}, not a similarity"
         )));
     }

@@ -207,12 +207,12 @@ fn bad_inputs_are_errors_or_warnings() {
     m.matrix[0][0] = f64::NAN;
     assert!(matches!(
         evaluate_cameras(&gt, &est, &m, &o),
-        Err(Error::InvalidOption(_))
+        Err(Error::InvalidContent(_))
     ));
     let zero = Similarity::from_parts(0.0, Similarity::IDENTITY.rotation(), [0.0; 3]);
     assert!(matches!(
         evaluate_cameras(&gt, &est, &zero, &o),
-        Err(Error::InvalidOption(_))
+        Err(Error::InvalidContent(_))
     ));
     // A single GT camera: radius 0, a warning, no panic.
     let mut g1 = gt.clone();
