@@ -127,7 +127,10 @@ def test_an_exception_in_the_progress_callback_stops_the_evaluation():
 
 
 CHILD = """
-import sys, time, sfmeval
+import signal, sys, time, sfmeval
+# Python's own Ctrl-C handler even where the parent left SIGINT ignored (a shell's background
+# job inherits SIG_IGN, and Python then installs no handler)
+signal.signal(signal.SIGINT, signal.default_int_handler)
 args = dict(gt=sys.argv[1], recon=sys.argv[2], gt_cameras=sys.argv[3], samples=3_000_000,
             threads=1)
 stages = []
