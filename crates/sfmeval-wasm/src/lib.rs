@@ -114,8 +114,9 @@ pub struct GroundTruth {
 #[wasm_bindgen]
 impl GroundTruth {
     /// Reads `bytes` named `name`; `external` is an optional object `{uri: Uint8Array}` with the
-    /// external buffers of a `.gltf`; `max_triangles` (default 10 M) refuses a mesh with more
-    /// triangles once every glTF node instance is expanded, before anything is allocated.
+    /// external buffers of a `.gltf`; `max_triangles` (default 10 M) refuses a glTF mesh with
+    /// more triangles once every node instance is expanded, before anything is allocated (a
+    /// PLY's or OBJ's triangles are in the file and are not held to it).
     #[wasm_bindgen(constructor)]
     pub fn new(
         name: &str,

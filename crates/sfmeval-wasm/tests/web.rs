@@ -98,9 +98,10 @@ fn errors_carry_the_core_message() {
     assert!(evaluate(&mut gt, &recon, options(r#"{"samples": 0}"#), None).is_err());
     assert!(evaluate(&mut gt, &recon, options(r#"{"bogus": 1}"#), None).is_err());
     assert!(evaluate(&mut gt, &recon, options(r#"{"align": "given"}"#), None).is_err());
-    // The triangle limit: the tetrahedron's 4 triangles pass 4 and fail 3.
-    assert!(GroundTruth::new("tetra.ply", &Uint8Array::from(GT), None, Some(4.0)).is_ok());
-    assert!(GroundTruth::new("tetra.ply", &Uint8Array::from(GT), None, Some(3.0)).is_err());
+    // The triangle limit guards glTF instancing only: a PLY's triangles are in the file, so the
+    // tetrahedron's 4 pass a limit of 3; a limit below 1 is refused.
+    assert!(GroundTruth::new("tetra.ply", &Uint8Array::from(GT), None, Some(3.0)).is_ok());
+    assert!(GroundTruth::new("tetra.ply", &Uint8Array::from(GT), None, Some(0.0)).is_err());
 }
 
 const RUN_JSON: &str = r#"{"schema":"sfmeval.run/1","dataset":"tetra","dataset_dir":"/d","pipeline":"colmap","kind":"colmap","tool":"colmap","version":"3.9","status":"ok","reason":null,"command":[],"options":{},"wall_seconds":1.5,"cpu_seconds":2.0,"peak_memory_bytes":2500000,"exit_status":0,"images_total":36,"images_registered":30,"points":5,"models":1,"started_unix":0,"finished_unix":1,"log":"log.txt","steps":[],"warnings":[]}"#;
