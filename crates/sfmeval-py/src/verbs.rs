@@ -4,7 +4,7 @@
 
 use std::path::{Path, PathBuf};
 
-use anyhow::{Context as _, anyhow, bail};
+use anyhow::{Context as _, anyhow};
 use pyo3::prelude::*;
 use pyo3::types::{PyBytes, PyDict};
 use sfmeval::dataset::DatasetPaths;
@@ -15,7 +15,10 @@ use sfmeval::pipeline::{self, ReconInput};
 use sfmeval::pose::PoseOptions;
 use sfmeval::report::Report;
 use sfmeval::transform::Similarity;
-use sfmeval_fs::{Disk, name_of, path_str, read, read_input_files, read_transform, write_atomic};
+use sfmeval_fs::{
+    Disk, name_of, named, path_str, pipeline_and_path, read, read_input_files, read_transform,
+    write_atomic,
+};
 use sfmeval_table::{Row, failed_row, report_row, summary_json, tables};
 use sfmeval_tnt::{self as tnt, IcpCriteria, Registration, Scene, TntRequest};
 
@@ -317,33 +320,6 @@ pub(crate) fn _tnt(
         out,
     };
     hooks::run(py, threads, progress, |p| tnt_of(&inputs, p))
-}
-
-/// `NAME=VALUE` split at the first `=`, or `None` when there is no `=` (as `sfmeval table`).
-fn named(s: &str) -> Option<(&str, &str)> {
-    s.split_once('=').filter(|(n, _)| !n.is_empty())
-}
-
-/// The pipeline a report argument names and the report's path, as `sfmeval table` reads its
-/// `[PIPELINE=]REPORT` arguments.
-fn pipeline_and_path(arg: &str) -> anyhow::Result<(String, PathBuf)> {
-    if let Some((name, path)) = named(arg)
-        && !Path::new(arg).exists()
-    {
-        return Ok((name.to_string(), PathBuf::from(path)));
-    }
-    let path = PathBuf::from(arg);
-    let parent = path
-        .parent()
-        .and_then(|p| p.file_name())
-        .map(|n| n.to_string_lossy().into_owned())
-        .filter(|n| !n.is_empty());
-    match parent {
-        Some(name) => Ok((name, path)),
-        None => bail!(
-            "cannot tell the pipeline of '{arg}': give it as PIPELINE={arg} (or put the report in a folder named after it)"
-        ),
-    }
 }
 
 fn read_report(path: &Path) -> Result<Report, Failure> {
