@@ -211,7 +211,7 @@ impl Evaluation {
 
     /// Calls `f(index, point in the ground-truth frame)` for every reconstructed point in input
     /// order (4 bytes a point of extra memory).
-    pub fn for_each_point_in_gt(&self, mut f: impl FnMut(usize, Point3)) {
+    pub(crate) fn for_each_point_in_gt(&self, mut f: impl FnMut(usize, Point3)) {
         let t = self.gt_from_recon;
         let slot_of = self.slot_of_input();
         for (i, &k) in slot_of.iter().enumerate() {

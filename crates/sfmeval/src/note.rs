@@ -235,7 +235,7 @@ impl Note {
     }
 
     /// The same note with `prefix` before its message (e.g. `ground-truth cameras: `).
-    pub fn prefixed(mut self, prefix: &str) -> Note {
+    pub(crate) fn prefixed(mut self, prefix: &str) -> Note {
         self.message = format!("{prefix}{}", self.message);
         self
     }

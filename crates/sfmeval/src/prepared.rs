@@ -85,7 +85,7 @@ impl PreparedGroundTruth {
 
     /// [`Self::distance`] for a query near the previous one with the same `hint` (a mesh
     /// query starts from the previous answer: the same result, faster).
-    pub fn distance_from(
+    pub(crate) fn distance_from(
         &self,
         p: Point3,
         signed: bool,

@@ -103,7 +103,7 @@ impl Statistics {
     }
 
     /// [`Statistics::of`] on values it may reorder (the sums run in the given order).
-    pub fn of_owned(values: Vec<f64>, bins: usize) -> Statistics {
+    pub(crate) fn of_owned(values: Vec<f64>, bins: usize) -> Statistics {
         Statistics::of_kept(&values, |_| true, bins)
     }
 
@@ -112,7 +112,11 @@ impl Statistics {
     /// are selected exactly by `select_ranks` (a few counting passes), so the results are the
     /// same bits as sorting a copy would give. The count, extremes, counting passes and
     /// histogram run on one range of the values per thread (exact, so thread-independent).
-    pub fn of_kept(values: &[f64], keep: impl Fn(usize) -> bool + Sync, bins: usize) -> Statistics {
+    pub(crate) fn of_kept(
+        values: &[f64],
+        keep: impl Fn(usize) -> bool + Sync,
+        bins: usize,
+    ) -> Statistics {
         let kept = || {
             values
                 .iter()

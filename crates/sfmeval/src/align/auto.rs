@@ -14,7 +14,7 @@ use crate::prepared::PreparedGroundTruth;
 use crate::transform::Similarity;
 
 /// Most runs of `icp` alone while it looks for its fixed point (`IcpOptions::max_restarts`).
-pub const ICP_ALONE_RUNS: usize = 8;
+pub(crate) const ICP_ALONE_RUNS: usize = 8;
 
 /// Which alignment to run.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

@@ -6,9 +6,9 @@ use super::{Alignment, StageKind};
 use crate::note::{Code, Note};
 
 /// Below this share of the points inside the final stage's distance gate, the fit is doubtful.
-pub const MIN_INLIER_RATIO: f64 = 0.5;
+pub(crate) const MIN_INLIER_RATIO: f64 = 0.5;
 /// An rmse of at most this percentage of the ground-truth diagonal is a tight fit.
-pub const TIGHT_RMSE_PERCENT_OF_DIAGONAL: f64 = 0.5;
+pub(crate) const TIGHT_RMSE_PERCENT_OF_DIAGONAL: f64 = 0.5;
 
 /// The notes on the fit of the last stage of `alignment` when it is a search against the
 /// surface (`icp` or `global`) and was not rejected; `diagonal` is the ground truth's

@@ -31,7 +31,6 @@ mod tests;
 pub(crate) use auto::fell_back;
 pub use auto::{AlignInput, AlignMethod, AlignOptions, align};
 pub(crate) use fit::fit_verdict;
-pub use fit::{MIN_INLIER_RATIO, TIGHT_RMSE_PERCENT_OF_DIAGONAL};
 pub use global::GlobalOptions;
 pub use icp::{IcpOptions, refine_icp};
 pub use points::{PointPair, align_points, parse_point_pairs};

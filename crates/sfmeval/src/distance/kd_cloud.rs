@@ -88,7 +88,7 @@ impl KdCloud {
     /// as `(d², slot)` into `out`; returns how many, and the squared radius below which every
     /// point is among them (`radius2`, or the `K`-th distance when `K` were found). `p` must be
     /// finite.
-    pub fn nearest_k_below<const K: usize>(
+    pub(crate) fn nearest_k_below<const K: usize>(
         &self,
         p: Point3,
         radius2: f64,
@@ -100,7 +100,7 @@ impl KdCloud {
 
     /// Whether [`KdCloud::nearest_below`] for `p` reaches slot `a` before slot `b`: of two
     /// points at the same distance it answers the first.
-    pub fn visits_before(&self, p: &Point3, a: usize, b: usize) -> bool {
+    pub(crate) fn visits_before(&self, p: &Point3, a: usize, b: usize) -> bool {
         self.tree.visits_before(p, a, b)
     }
 }

@@ -17,7 +17,7 @@ use super::kd_cloud::{KdCloud, distance2};
 use crate::geometry::Point3;
 
 /// Points a list holds.
-pub const LIST_LEN: usize = 8;
+pub(crate) const LIST_LEN: usize = 8;
 
 /// Relative margin on the coverage, far above the rounding of the distances.
 const MARGIN: f64 = 1e-9;
