@@ -10,8 +10,14 @@ Writes into OUT (default bench/data):
   gt_from_recon.txt             that similarity's inverse mapping moved clouds back (row-major 4x4)
   cloud_{10m,100m}.ply          with --dense 10m[,100m]: dense clouds of the same kind on mesh_1m
                                 (not moved), written in chunks of 5M points (1.2 GB for 100m)
-Usage: bench/generate.py [--out DIR] [--quick] [--dense 10m,100m]
-       (--quick: 50k mesh and 10k/100k clouds only; --dense: only the dense clouds)
+  mesh_tube_1m.ply, cloud_tube_1m.ply
+                                with --smooth: the smooth, low-outlier workload: a closed tube
+                                (a torus with a wavy cross-section, 1M triangles) and 1M points
+                                sampled on it, each moved along a random direction by Gaussian
+                                noise of 0.15 % of the bbox diagonal clipped at 0.5 %: no point
+                                farther than 0.5 % of the diagonal from the surface, no outliers
+Usage: bench/generate.py [--out DIR] [--quick] [--dense 10m,100m] [--smooth]
+       (--quick: 50k mesh and 10k/100k clouds only; --dense, --smooth: only those files)
 """
 import argparse
 import json
@@ -120,14 +126,53 @@ def write_dense(out, name, n):
     print(f"cloud_{name}: {n} points")
 
 
+def tube(n_around, n_across):
+    """A closed tube: a torus (radii 1 and 0.3) whose cross-section's radius waves along it;
+    2 · n_around · n_across triangles, every vertex shared (no seam)."""
+    u = np.linspace(0, 2 * np.pi, n_around, endpoint=False)
+    w = np.linspace(0, 2 * np.pi, n_across, endpoint=False)
+    uu, ww = np.meshgrid(u, w, indexing="ij")
+    r = 0.3 * (1 + 0.15 * np.sin(5 * uu) + 0.05 * np.cos(3 * ww + uu))
+    v = np.stack([(1 + r * np.cos(ww)) * np.cos(uu), (1 + r * np.cos(ww)) * np.sin(uu), r * np.sin(ww)],
+                 -1).reshape(-1, 3)
+    i, j = np.meshgrid(np.arange(n_around), np.arange(n_across), indexing="ij")
+    a = i * n_across + j
+    b = ((i + 1) % n_around) * n_across + j
+    c = ((i + 1) % n_around) * n_across + (j + 1) % n_across
+    d = i * n_across + (j + 1) % n_across
+    f = np.concatenate([np.stack([a, b, c], -1).reshape(-1, 3), np.stack([a, c, d], -1).reshape(-1, 3)])
+    return v, f.astype(np.uint32)
+
+
+def write_smooth(out):
+    """mesh_tube_1m.ply and cloud_tube_1m.ply (see the module's docs)."""
+    v, f = tube(1000, 500)
+    write_ply(out / "mesh_tube_1m.ply", v, f)
+    v = np.asarray(v, "<f4").astype(np.float64)
+    diag = np.linalg.norm(v.max(0) - v.min(0))
+    rng = np.random.default_rng([20261205, 1])
+    n = 1_000_000
+    pts = sample(v, f, n, rng)
+    direction = rng.normal(size=(n, 3))
+    direction /= np.linalg.norm(direction, axis=1)[:, None]
+    offset = np.clip(rng.normal(scale=0.0015 * diag, size=n), -0.005 * diag, 0.005 * diag)
+    write_ply(out / "cloud_tube_1m.ply", pts + direction * offset[:, None])
+    print(f"mesh_tube_1m: {len(v)} vertices, {len(f)} triangles; cloud_tube_1m: {n} points within "
+          f"{0.005 * diag:.4g} (0.5 % of the diagonal {diag:.4g})")
+
+
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--out", default=str(Path(__file__).resolve().parent / "data"))
     ap.add_argument("--quick", action="store_true")
     ap.add_argument("--dense", default="", help="only write these dense clouds: 10m, 100m (comma-separated)")
+    ap.add_argument("--smooth", action="store_true", help="only write the smooth tube workload")
     args = ap.parse_args()
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
+    if args.smooth:
+        write_smooth(out)
+        return
     if args.dense:
         for name in args.dense.split(","):
             write_dense(out, name, DENSE[name])

@@ -99,6 +99,10 @@ check bench-compare-quick .venv/bin/python bench/compare.py --quick
 while read -r line; do skip "bench-compare-quick" "$line"; done < <(
   sed -nE 's/^skipped: (.*)$/\1/p' "$log/bench-compare-quick.log")
 
+# The per-stage wall and CPU table at 1 and 2 threads, quick mode (bench_op's CPU clock and the
+# thread counts' reports compared).
+check bench-stages-quick .venv/bin/python bench/stages.py --quick
+
 # The Tanks and Temples protocol against the benchmark's own toolbox, quick mode.
 check bench-tnt-quick .venv/bin/python bench/tanksandtemples.py --quick
 

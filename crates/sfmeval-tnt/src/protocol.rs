@@ -203,17 +203,23 @@ pub fn evaluate(
 
     progress.start(Stage::Alignment, 5);
     let gt_cropped = nonempty(crop(&scene.ground_truth), "ground-truth")?;
-    let gt_half = voxel_down_sample(&gt_cropped, tau / 2.0)?;
-    let gt_half_index = KdCloud::new(&gt_half)?;
-    progress.advance(1);
+    // The τ/2 grid, which the τ/2 refinement and the evaluation search.
+    let half_grid = || -> Result<(Vec<Point3>, KdCloud)> {
+        let gt_half = voxel_down_sample(&gt_cropped, tau / 2.0)?;
+        let index = KdCloud::new(&gt_half)?;
+        Ok((gt_half, index))
+    };
 
     let mut stage_params = Vec::new();
     let mut stage_results = Vec::new();
-    let (mode, alignment, trajectory_input, gt_from_recon) = match &request.registration {
+    let (mode, alignment, trajectory_input, gt_from_recon, gt_half, gt_half_index) = match &request
+        .registration
+    {
         Registration::Given(t) => {
             matrix::validate(t, "the given transform")?;
-            progress.advance(3);
-            ("given", None, None, *t)
+            let (gt_half, gt_half_index) = half_grid()?;
+            progress.advance(4);
+            ("given", None, None, *t, gt_half, gt_half_index)
         }
         Registration::Protocol {
             trajectory,
@@ -227,12 +233,35 @@ pub fn evaluate(
                 .iter()
                 .map(|f| matrix::apply(&scene.gt_from_reference, f.center()))
                 .collect();
-            let aligned = align_trajectories(&centers, &reference, options)
-                .map_err(|e| e.in_file("trajectory", trajectory_name.as_str()))?;
-            progress.advance(1);
+            // The trajectory RANSAC, the τ/2 and τ grids with their indexes and the uniform
+            // refinement's index over the whole cropped ground truth run side by side: none
+            // depends on another (each is the same whichever thread makes it), and each has
+            // serial steps (the first median splits, the RANSAC's chunk ends) that the others
+            // fill.
+            let ((aligned, half), (gt_full_index, uniform_index)) = parallel::join(
+                || {
+                    parallel::join(
+                        || {
+                            align_trajectories(&centers, &reference, options)
+                                .map_err(|e| e.in_file("trajectory", trajectory_name.as_str()))
+                        },
+                        half_grid,
+                    )
+                },
+                || {
+                    parallel::join(
+                        || voxel_down_sample(&gt_cropped, tau).and_then(|v| KdCloud::new(&v)),
+                        // Indexed in place: no copy of the cropped ground truth within the
+                        // budget.
+                        || KdCloud::new(&uniform_down_sample(&gt_cropped)),
+                    )
+                },
+            );
+            let (aligned, (gt_half, gt_half_index)) = (aligned?, half?);
+            let (gt_full_index, index) = (gt_full_index?, uniform_index?);
+            progress.advance(2);
             let mut t = aligned.gt_from_recon;
             // Two voxel refinements, then the uniform one.
-            let gt_full_index = KdCloud::new(&voxel_down_sample(&gt_cropped, tau)?)?;
             for (voxel, distance, index) in [
                 (tau, 80.0 * tau, &gt_full_index),
                 (tau / 2.0, 20.0 * tau, &gt_half_index),
@@ -252,8 +281,6 @@ pub fn evaluate(
             }
             let source = nonempty(crop_moved(&t), "reconstructed")?;
             let source = uniform_down_sample(&source);
-            // Indexed in place: no copy of the cropped ground truth within the budget.
-            let index = KdCloud::new(&uniform_down_sample(&gt_cropped))?;
             let r = registration_icp(&source, &index, 2.0 * tau, request.icp);
             t = matrix::mul(&r.transformation, &t);
             stage_params.push(StageParams::new(
@@ -296,6 +323,8 @@ pub fn evaluate(
                     mapped,
                 }),
                 t,
+                gt_half,
+                gt_half_index,
             )
         }
     };

@@ -6,8 +6,10 @@
 //!     [--seed N] [--queries CLOUD2] [--start 4x4.txt] [--gate F] [--iterations N]
 //! ```
 //!
-//! Prints one JSON line `{"op", "seconds", "threads", "result": {...}}`. `seconds` covers the
-//! operation only: every op except `load` reads its files first, untimed. Ops:
+//! Prints one JSON line `{"op", "seconds", "cpu_seconds", "threads", "result": {...}}`.
+//! `seconds` covers the operation only: every op except `load` reads its files first, untimed;
+//! `cpu_seconds` is the CPU time all the process's threads spent over the same span (Linux's
+//! per-thread `schedstat`; `null` elsewhere). Ops:
 //!
 //! - `load`: read and parse the mesh and the cloud;
 //! - `bvh`: build the mesh's BVH (parry);
@@ -25,7 +27,8 @@
 //! them). `--threads N` sizes rayon's pool (default: all cores).
 
 use std::error::Error;
-use std::time::Instant;
+use std::sync::Mutex;
+use std::time::Duration;
 
 use serde_json::{Value, json};
 use sfmeval::align::{IcpOptions, refine_icp};
@@ -36,6 +39,46 @@ use sfmeval::progress::NoProgress;
 use sfmeval::transform::Similarity;
 
 type Res<T> = Result<T, Box<dyn Error>>;
+
+/// The CPU seconds of the last span a [`Clock`] measured ([`Clock::elapsed`]).
+static CPU_SECONDS: Mutex<Option<f64>> = Mutex::new(None);
+
+/// CPU time of every live thread of this process, in seconds (the first field of each
+/// `/proc/self/task/*/schedstat`, nanoseconds on the CPU); `None` where it cannot be read.
+/// rayon's pool threads live as long as the process, so none of the op's time is lost.
+fn process_cpu_seconds() -> Option<f64> {
+    let mut ns = 0u64;
+    for task in std::fs::read_dir("/proc/self/task").ok()? {
+        let stat = std::fs::read_to_string(task.ok()?.path().join("schedstat")).ok()?;
+        ns += stat.split_whitespace().next()?.parse::<u64>().ok()?;
+    }
+    Some(ns as f64 * 1e-9)
+}
+
+/// A wall clock that also reads the process's CPU time: `elapsed` records the CPU seconds
+/// since `now` for the output's `cpu_seconds`.
+struct Clock {
+    wall: std::time::Instant,
+    cpu: Option<f64>,
+}
+
+impl Clock {
+    fn now() -> Clock {
+        Clock {
+            cpu: process_cpu_seconds(),
+            wall: std::time::Instant::now(),
+        }
+    }
+
+    fn elapsed(&self) -> Duration {
+        let wall = self.wall.elapsed();
+        let cpu = process_cpu_seconds().zip(self.cpu).map(|(b, a)| b - a);
+        if let Ok(mut last) = CPU_SECONDS.lock() {
+            *last = cpu;
+        }
+        wall
+    }
+}
 
 struct Args {
     op: String,
@@ -114,7 +157,7 @@ fn main() -> Res<()> {
     let cloud_path = || a.cloud.as_deref().ok_or("--cloud is required");
     let (seconds, result) = match a.op.as_str() {
         "load" => {
-            let t = Instant::now();
+            let t = Clock::now();
             let m = read_mesh(mesh_path()?)?;
             let c = read_cloud(cloud_path()?)?;
             let s = t.elapsed().as_secs_f64();
@@ -123,7 +166,7 @@ fn main() -> Res<()> {
         }
         "bvh" => {
             let m = read_mesh(mesh_path()?)?;
-            let t = Instant::now();
+            let t = Clock::now();
             let idx = MeshIndex::new(&m)?;
             let s = t.elapsed().as_secs_f64();
             drop(idx);
@@ -131,7 +174,7 @@ fn main() -> Res<()> {
         }
         "kdtree" => {
             let c = read_cloud(cloud_path()?)?;
-            let t = Instant::now();
+            let t = Clock::now();
             let idx = CloudIndex::new(&c)?;
             let s = t.elapsed().as_secs_f64();
             drop(idx);
@@ -140,7 +183,7 @@ fn main() -> Res<()> {
         "accuracy" => {
             let m = read_mesh(mesh_path()?)?;
             let c = read_cloud(cloud_path()?)?;
-            let t = Instant::now();
+            let t = Clock::now();
             let idx = MeshIndex::new(&m)?;
             let d = sfmeval::parallel::map_points_with_state(&c, &NoProgress, |hint, p| {
                 idx.closest_from(*p, hint).distance
@@ -150,7 +193,7 @@ fn main() -> Res<()> {
         "completeness" => {
             let m = read_mesh(mesh_path()?)?;
             let c = read_cloud(cloud_path()?)?;
-            let t = Instant::now();
+            let t = Clock::now();
             let samples = sfmeval::sampling::sample_surface(&m, a.samples, a.seed)?;
             let idx = CloudIndex::new(&c)?;
             let d = sfmeval::parallel::map_points(&samples, &NoProgress, |p| idx.nearest(*p).0);
@@ -159,7 +202,7 @@ fn main() -> Res<()> {
         "c2c" => {
             let c = read_cloud(cloud_path()?)?;
             let q = read_cloud(a.queries.as_deref().ok_or("--queries is required")?)?;
-            let t = Instant::now();
+            let t = Clock::now();
             let idx = CloudIndex::new(&c)?;
             let d = sfmeval::parallel::map_points(&q, &NoProgress, |p| idx.nearest(*p).0);
             (t.elapsed().as_secs_f64(), summary(&d))
@@ -170,7 +213,7 @@ fn main() -> Res<()> {
             let start = Similarity::parse(&std::fs::read(
                 a.start.as_deref().ok_or("--start is required")?,
             )?)?;
-            let t = Instant::now();
+            let t = Clock::now();
             let gt = PreparedGroundTruth::new(&GroundTruth::Mesh(m), 1, 0, &NoProgress)?;
             let index_s = t.elapsed().as_secs_f64();
             let (sim, stage) = refine_icp(&gt, &c, &start, &IcpOptions::default())?;
@@ -182,7 +225,9 @@ fn main() -> Res<()> {
         "cost" => cost(&read_mesh(mesh_path()?)?, &read_cloud(cloud_path()?)?)?,
         other => return Err(format!("unknown op {other}").into()),
     };
-    let out = json!({"op": a.op, "seconds": seconds, "threads": threads, "result": result});
+    let cpu_seconds = CPU_SECONDS.lock().ok().and_then(|c| *c);
+    let out = json!({"op": a.op, "seconds": seconds, "cpu_seconds": cpu_seconds,
+                     "threads": threads, "result": result});
     println!("{out}");
     Ok(())
 }
@@ -242,7 +287,7 @@ fn cost(mesh: &TriangleMesh, cloud: &[Point3]) -> Res<(f64, Value)> {
     let tris: Vec<[Point3; 3]> = mesh.triangles.iter().map(|t| mesh.corners(t)).collect();
     // point-triangle tests: every query against a sliding window of triangles (cache-resident)
     let reps = 2_000_000usize;
-    let t = Instant::now();
+    let t = Clock::now();
     let mut acc = 0.0;
     for i in 0..reps {
         acc += point_triangle_sq(cloud[i % n], tris[(i * 7) % 4096 % tris.len()]);
@@ -250,7 +295,7 @@ fn cost(mesh: &TriangleMesh, cloud: &[Point3]) -> Res<(f64, Value)> {
     let per_test = t.elapsed().as_secs_f64() / reps as f64;
     std::hint::black_box(acc);
     // streaming: a pass reading the cloud and writing one f64 per point
-    let t = Instant::now();
+    let t = Clock::now();
     let out: Vec<f64> = cloud.iter().map(|p| p[0] + p[1] + p[2]).collect();
     let per_point = t.elapsed().as_secs_f64() / cloud.len() as f64;
     std::hint::black_box(out);
