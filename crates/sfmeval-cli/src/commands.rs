@@ -90,6 +90,9 @@ enum Command {
         /// baselines get translation error 0, and it is the AUC's min_error (0: off).
         #[arg(long, value_name = "D", default_value_t = 0.0)]
         position_accuracy: f64,
+        /// Write every scored ground-truth pair's errors here (CSV).
+        #[arg(long, value_name = "OUT.csv")]
+        pairs: Option<PathBuf>,
         /// Write the report (sfmeval.poses/1 JSON) here.
         #[arg(long, value_name = "OUT.json")]
         report: Option<PathBuf>,
@@ -306,6 +309,7 @@ pub fn run(cli: Cli) -> Result<()> {
             recon,
             protocol,
             position_accuracy,
+            pairs,
             report,
             json,
         } => poses_cmd(
@@ -313,6 +317,7 @@ pub fn run(cli: Cli) -> Result<()> {
             &recon,
             &protocol,
             position_accuracy,
+            pairs.as_deref(),
             report.as_deref(),
             json,
         ),
@@ -668,6 +673,7 @@ fn poses_cmd(
     recon: &Path,
     protocol: &str,
     position_accuracy: f64,
+    pairs: Option<&Path>,
     report: Option<&Path>,
     json: bool,
 ) -> Result<()> {
@@ -697,6 +703,9 @@ fn poses_cmd(
     s.push('\n');
     if let Some(p) = report {
         write_atomic(p, s.as_bytes())?;
+    }
+    if let Some(p) = pairs {
+        write_atomic(p, poses.pairs_csv(&gt).as_bytes())?;
     }
     if json {
         print!("{s}");

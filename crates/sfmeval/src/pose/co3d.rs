@@ -5,7 +5,8 @@
 //!
 //! - every unordered pair `i < j` of ground-truth images (`batched_all_pairs`), the relative
 //!   pose `cam_j_from_cam_i` of the estimate and of the ground truth;
-//! - rotation error `acos(1 − 2·max(eps, 1 − (q·q_gt)²))` in degrees, translation error the
+//! - rotation error `acos(1 − 2·max(eps, 1 − (q·q_gt)²))` in degrees, the quaternions PyTorch3D's
+//!   `matrix_to_quaternion` (not normalized), translation error the
 //!   sign-folded angle `acos(sqrt(1 − max(eps, 1 − (t̂·t̂_gt)²)))`, then `min(θ, |180 − θ|)`,
 //!   `eps = 1e-15`;
 //! - RRA@θ / RTA@θ: share of pairs with the rotation / translation error `< θ`, in percent,
@@ -17,8 +18,8 @@
 use serde::{Deserialize, Serialize};
 
 use super::protocol::{
-    Convention, PairError, PairSet, PairedPoses, ProtocolOptions, ThresholdTest, TranslationSign,
-    folded_translation_error_rad, quaternion_error_rad, relative,
+    Convention, PairError, PairRow, PairSet, PairedPoses, ProtocolOptions, ThresholdTest,
+    TranslationSign, folded_translation_error_rad, quaternion_error_pytorch3d_rad, relative,
 };
 
 /// The CO3D numbers.
@@ -44,6 +45,7 @@ pub struct Co3dResult {
 pub(crate) fn evaluate(
     paired: &PairedPoses,
     options: &ProtocolOptions,
+    rows: &mut Vec<PairRow>,
 ) -> (Convention, Co3dResult) {
     let n = paired.gt.len();
     let mut r_err = Vec::with_capacity(n * n.saturating_sub(1) / 2);
@@ -62,14 +64,32 @@ pub(crate) fn evaluate(
                 (Some((ei_r, ei_t)), Some((ej_r, ej_t))) => {
                     let (r_gt, t_gt) = relative(&ri, ti, &rj, tj);
                     let (r_est, t_est) = relative(&ei_r, ei_t, &ej_r, ej_t);
-                    r_err.push(to_deg(quaternion_error_rad(&r_gt, &r_est)));
+                    let r = to_deg(quaternion_error_pytorch3d_rad(&r_gt, &r_est));
                     let t = to_deg(folded_translation_error_rad(t_gt, t_est));
-                    t_err.push(t.min((180.0 - t).abs()));
+                    let t = t.min((180.0 - t).abs());
+                    r_err.push(r);
+                    t_err.push(t);
+                    rows.push(PairRow {
+                        i,
+                        j,
+                        registered: true,
+                        rotation_deg: r,
+                        translation_deg: t,
+                        error_deg: r.max(t),
+                    });
                 }
                 _ => {
                     unregistered += 1;
                     r_err.push(180.0);
                     t_err.push(180.0);
+                    rows.push(PairRow {
+                        i,
+                        j,
+                        registered: false,
+                        rotation_deg: 180.0,
+                        translation_deg: 180.0,
+                        error_deg: 180.0,
+                    });
                 }
             }
         }

@@ -22,8 +22,8 @@
 use serde::{Deserialize, Serialize};
 
 use super::protocol::{
-    Convention, PairError, PairSet, PairedPoses, ProtocolOptions, ThresholdTest, TranslationSign,
-    relative,
+    Convention, PairError, PairRow, PairSet, PairedPoses, ProtocolOptions, ThresholdTest,
+    TranslationSign, relative,
 };
 use crate::geometry::Point3;
 use crate::model::{mat_mul, rotation_angle_deg, transpose};
@@ -105,6 +105,7 @@ pub(crate) fn compute_auc(errors: &[f64], thresholds: &[f64], min_error: f64) ->
 pub(crate) fn evaluate(
     paired: &PairedPoses,
     options: &ProtocolOptions,
+    rows: &mut Vec<PairRow>,
 ) -> (Convention, ColmapResult) {
     let n = paired.gt.len();
     let min_dist = options.colmap_position_accuracy;
@@ -135,10 +136,26 @@ pub(crate) fn evaluate(
                     };
                     let dr = rotation_angle_deg(&mat_mul(&transpose(&r_est), &r_gt));
                     errors.push(dt.max(dr));
+                    rows.push(PairRow {
+                        i: src,
+                        j: tgt,
+                        registered: true,
+                        rotation_deg: dr,
+                        translation_deg: dt,
+                        error_deg: dt.max(dr),
+                    });
                 }
                 _ => {
                     unregistered += 1;
                     errors.push(180.0);
+                    rows.push(PairRow {
+                        i: src,
+                        j: tgt,
+                        registered: false,
+                        rotation_deg: 180.0,
+                        translation_deg: 180.0,
+                        error_deg: 180.0,
+                    });
                 }
             }
         }

@@ -17,7 +17,7 @@
 use serde::{Deserialize, Serialize};
 
 use super::protocol::{
-    Convention, PairError, PairSet, PairedPoses, ThresholdTest, TranslationSign,
+    Convention, PairError, PairRow, PairSet, PairedPoses, ThresholdTest, TranslationSign,
     folded_translation_error_rad, quaternion_error_rad, relative,
 };
 
@@ -41,7 +41,7 @@ pub struct ImcResult {
 }
 
 /// The protocol on paired poses.
-pub(crate) fn evaluate(paired: &PairedPoses) -> (Convention, ImcResult) {
+pub(crate) fn evaluate(paired: &PairedPoses, rows: &mut Vec<PairRow>) -> (Convention, ImcResult) {
     let n = paired.gt.len();
     let valid = paired.non_finite == 0;
     let mut errors = Vec::with_capacity(n * n.saturating_sub(1) / 2);
@@ -61,11 +61,28 @@ pub(crate) fn evaluate(paired: &PairedPoses) -> (Convention, ImcResult) {
                     let (r_est, t_est) = relative(&ei_r, ei_t, &ej_r, ej_t);
                     let err_q = quaternion_error_rad(&r_gt, &r_est);
                     let err_t = folded_translation_error_rad(t_gt, t_est);
-                    errors.push(err_q.max(err_t) * 180.0 / std::f64::consts::PI);
+                    let deg = |rad: f64| rad * 180.0 / std::f64::consts::PI;
+                    errors.push(deg(err_q.max(err_t)));
+                    rows.push(PairRow {
+                        i,
+                        j,
+                        registered: true,
+                        rotation_deg: deg(err_q),
+                        translation_deg: deg(err_t),
+                        error_deg: deg(err_q.max(err_t)),
+                    });
                 }
                 _ => {
                     unregistered += 1;
                     errors.push(1e6);
+                    rows.push(PairRow {
+                        i,
+                        j,
+                        registered: false,
+                        rotation_deg: f64::INFINITY,
+                        translation_deg: f64::INFINITY,
+                        error_deg: 1e6,
+                    });
                 }
             }
         }

@@ -26,7 +26,7 @@ pub use co3d::Co3dResult;
 pub use colmap_benchmark::ColmapResult;
 pub use imc::ImcResult;
 pub use protocol::{
-    Convention, POSES_SCHEMA, PairError, PairSet, PosesReport, Protocol, ProtocolOptions,
+    Convention, POSES_SCHEMA, PairError, PairRow, PairSet, PosesReport, Protocol, ProtocolOptions,
     ProtocolResult, ThresholdTest, TranslationSign, evaluate_protocol,
 };
 

@@ -159,6 +159,23 @@ pub enum ProtocolResult {
     Co3d(super::co3d::Co3dResult),
 }
 
+/// One scored ground-truth pair (the CLI's `--pairs` CSV; not in the JSON report).
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct PairRow {
+    /// First image (COLMAP: `src`), an index into the ground-truth images.
+    pub i: usize,
+    /// Second image (COLMAP: `tgt`).
+    pub j: usize,
+    /// Both images registered (else the errors are the protocol's failure value).
+    pub registered: bool,
+    /// Rotation error, degrees.
+    pub rotation_deg: f64,
+    /// Translation-direction error, degrees.
+    pub translation_deg: f64,
+    /// The pair's error as the protocol combines them, degrees.
+    pub error_deg: f64,
+}
+
 /// A poses report (`sfmeval.poses/1`).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct PosesReport {
@@ -182,6 +199,32 @@ pub struct PosesReport {
     pub result: ProtocolResult,
     /// Problems worth a line.
     pub notes: Vec<Note>,
+    /// Every scored ground-truth pair, in the protocol's order (not serialized).
+    #[serde(skip)]
+    pub pair_rows: Vec<PairRow>,
+}
+
+impl PosesReport {
+    /// [`Self::pair_rows`] as CSV (`i` and `j` as ground-truth image names), numbers in Rust's
+    /// shortest round-trip form.
+    pub fn pairs_csv(&self, gt: &Reconstruction) -> String {
+        let name = |k: usize| gt.images.get(k).map(|i| i.name.as_str()).unwrap_or("");
+        let mut s = String::from(
+            "image_i,image_j,registered,rotation_error_deg,translation_error_deg,error_deg\n",
+        );
+        for r in &self.pair_rows {
+            s.push_str(&format!(
+                "{},{},{},{},{},{}\n",
+                name(r.i),
+                name(r.j),
+                u8::from(r.registered),
+                r.rotation_deg,
+                r.translation_deg,
+                r.error_deg
+            ));
+        }
+        s
+    }
 }
 
 /// The inputs every protocol shares: ground-truth poses in GT order, the matched estimated
@@ -247,12 +290,54 @@ pub(crate) fn quaternion(r: &Mat3) -> [f64; 4] {
     q.map(|v| v * s)
 }
 
-/// The `eps`-floored quaternion rotation error both IMC's `evaluate_R_t` and VGGSfM's
-/// `rotation_angle` compute, in radians: `acos(1 − 2·max(eps, 1 − (q·q_gt)²))` with
+/// The `eps`-floored quaternion rotation error of IMC's `evaluate_R_t`, in radians:
+/// `acos(1 − 2·max(eps, 1 − (q·q_gt)²))` of the quaternions divided by `norm + eps`,
 /// `eps = 1e-15`.
 pub(crate) fn quaternion_error_rad(r_gt: &Mat3, r_est: &Mat3) -> f64 {
-    let (a, b) = (quaternion(r_gt), quaternion(r_est));
-    let dot = a[0] * b[0] + a[1] * b[1] + a[2] * b[2] + a[3] * b[3];
+    let eps = 1e-15;
+    let unit = |q: [f64; 4]| {
+        let n = (q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]).sqrt() + eps;
+        q.map(|v| v / n)
+    };
+    let (a, b) = (unit(quaternion(r_gt)), unit(quaternion(r_est)));
+    let dot = b[0] * a[0] + b[1] * a[1] + b[2] * a[2] + b[3] * a[3];
+    let loss = (1.0 - dot * dot).max(eps);
+    libm::acos(1.0 - 2.0 * loss)
+}
+
+/// PyTorch3D's `matrix_to_quaternion` (VGGSfM's `minipytorch3d`): the best-conditioned of the
+/// four candidates (largest `q_abs`, the first on ties), **not normalized**, `w ≥ 0`.
+pub(crate) fn quaternion_pytorch3d(r: &Mat3) -> [f64; 4] {
+    let [[m00, m01, m02], [m10, m11, m12], [m20, m21, m22]] = *r;
+    let pos = |x: f64| if x > 0.0 { x.sqrt() } else { 0.0 };
+    let q_abs = [
+        pos(1.0 + m00 + m11 + m22),
+        pos(1.0 + m00 - m11 - m22),
+        pos(1.0 - m00 + m11 - m22),
+        pos(1.0 - m00 - m11 + m22),
+    ];
+    let by_rijk = [
+        [q_abs[0] * q_abs[0], m21 - m12, m02 - m20, m10 - m01],
+        [m21 - m12, q_abs[1] * q_abs[1], m10 + m01, m02 + m20],
+        [m02 - m20, m10 + m01, q_abs[2] * q_abs[2], m12 + m21],
+        [m10 - m01, m20 + m02, m21 + m12, q_abs[3] * q_abs[3]],
+    ];
+    let mut best = 0usize;
+    for k in 1..4 {
+        if q_abs[k] > q_abs[best] {
+            best = k;
+        }
+    }
+    let den = 2.0 * q_abs[best].max(0.1);
+    let q = by_rijk[best].map(|v| v / den);
+    if q[0] < 0.0 { q.map(|v| -v) } else { q }
+}
+
+/// VGGSfM's `rotation_angle` in radians: `acos(1 − 2·max(eps, 1 − (q_pred·q_gt)²))` of PyTorch3D
+/// quaternions ([`quaternion_pytorch3d`], not normalized), `eps = 1e-15`.
+pub(crate) fn quaternion_error_pytorch3d_rad(r_gt: &Mat3, r_est: &Mat3) -> f64 {
+    let (a, b) = (quaternion_pytorch3d(r_gt), quaternion_pytorch3d(r_est));
+    let dot = b[0] * a[0] + b[1] * a[1] + b[2] * a[2] + b[3] * a[3];
     let loss = (1.0 - dot * dot).max(1e-15);
     libm::acos(1.0 - 2.0 * loss)
 }
@@ -392,17 +477,18 @@ pub fn evaluate_protocol(
     }
     let mut notes = Vec::new();
     let (paired, matched) = pair_poses(gt, est, &mut notes)?;
+    let mut pair_rows = Vec::new();
     let (convention, result) = match protocol {
         Protocol::Colmap => {
-            let (c, r) = super::colmap_benchmark::evaluate(&paired, options);
+            let (c, r) = super::colmap_benchmark::evaluate(&paired, options, &mut pair_rows);
             (c, ProtocolResult::Colmap(r))
         }
         Protocol::Imc => {
-            let (c, r) = super::imc::evaluate(&paired);
+            let (c, r) = super::imc::evaluate(&paired, &mut pair_rows);
             (c, ProtocolResult::Imc(r))
         }
         Protocol::Co3d => {
-            let (c, r) = super::co3d::evaluate(&paired, options);
+            let (c, r) = super::co3d::evaluate(&paired, options, &mut pair_rows);
             (c, ProtocolResult::Co3d(r))
         }
     };
@@ -417,5 +503,6 @@ pub fn evaluate_protocol(
         convention,
         result,
         notes,
+        pair_rows,
     })
 }
