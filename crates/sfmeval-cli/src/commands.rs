@@ -16,7 +16,7 @@ use sfmeval::geometry::{Aabb, GroundTruth};
 use sfmeval::io::{self, ReadLimits};
 use sfmeval::model;
 use sfmeval::pipeline::{self, EvalRequest, ReconInput, read_reconstruction};
-use sfmeval::pose::PoseOptions;
+use sfmeval::pose::{PoseOptions, Protocol, ProtocolOptions, evaluate_protocol};
 use sfmeval_fs::{
     Disk, name_of, path_str, read, read_input_files, read_point_pairs,
     read_reconstruction_with_cameras, read_transform, write_atomic,
@@ -68,6 +68,32 @@ enum Command {
         #[arg(long, value_name = "FILE")]
         transform: Option<PathBuf>,
         /// Write the cameras section (JSON) here.
+        #[arg(long, value_name = "OUT.json")]
+        report: Option<PathBuf>,
+        /// Print the JSON instead of the summary.
+        #[arg(long)]
+        json: bool,
+    },
+    /// A camera-pose benchmark's numbers (COLMAP's benchmark, IMC mAA, CO3D RRA/RTA/AUC), as
+    /// its official code computes them, from relative poses (no alignment).
+    Poses {
+        /// Ground-truth cameras (a dataset's cameras.json, or any model: COLMAP, NVM, ...).
+        #[arg(long, value_name = "FILE")]
+        gt_cameras: PathBuf,
+        /// The reconstruction: a COLMAP model folder, .nvm, Bundler .out, sfm_data.json, cameras.json.
+        #[arg(long, value_name = "PATH")]
+        recon: PathBuf,
+        /// The protocol (docs/poses.md).
+        #[arg(long, value_parser = PossibleValuesParser::new(["colmap", "imc", "co3d"]))]
+        protocol: String,
+        /// COLMAP: the dataset's ground-truth position accuracy (GT units): shorter GT
+        /// baselines get translation error 0, and it is the AUC's min_error (0: off).
+        #[arg(long, value_name = "D", default_value_t = 0.0)]
+        position_accuracy: f64,
+        /// Write every scored ground-truth pair's errors here (CSV).
+        #[arg(long, value_name = "OUT.csv")]
+        pairs: Option<PathBuf>,
+        /// Write the report (sfmeval.poses/1 JSON) here.
         #[arg(long, value_name = "OUT.json")]
         report: Option<PathBuf>,
         /// Print the JSON instead of the summary.
@@ -278,6 +304,23 @@ pub fn run(cli: Cli) -> Result<()> {
             seed,
             samples,
         } => align_cmd(&input, out.as_deref(), seed, samples),
+        Command::Poses {
+            gt_cameras,
+            recon,
+            protocol,
+            position_accuracy,
+            pairs,
+            report,
+            json,
+        } => poses_cmd(
+            &gt_cameras,
+            &recon,
+            &protocol,
+            position_accuracy,
+            pairs.as_deref(),
+            report.as_deref(),
+            json,
+        ),
         Command::Cameras {
             gt_cameras,
             recon,
@@ -621,6 +664,53 @@ fn cameras_cmd(
             "{}",
             summary::render_cameras(&cams, &alignment.method, alignment.scale)
         );
+    }
+    Ok(())
+}
+
+fn poses_cmd(
+    gt_cameras: &Path,
+    recon: &Path,
+    protocol: &str,
+    position_accuracy: f64,
+    pairs: Option<&Path>,
+    report: Option<&Path>,
+    json: bool,
+) -> Result<()> {
+    let protocol = Protocol::parse(protocol)?;
+    let gt = model::read_model_files(&read_input_files(gt_cameras)?)
+        .with_context(|| format!("ground-truth cameras '{}'", gt_cameras.display()))?;
+    let est = read_reconstruction(&name_of(recon), &read_input_files(recon)?)
+        .with_context(|| format!("reconstruction '{}'", recon.display()))?;
+    let est = est.model.ok_or_else(|| {
+        anyhow::anyhow!(
+            "reconstruction '{}' has no cameras (a bare point cloud)",
+            recon.display()
+        )
+    })?;
+    let options = ProtocolOptions {
+        colmap_position_accuracy: position_accuracy,
+        ..ProtocolOptions::default()
+    };
+    let poses = evaluate_protocol(&gt, &est, protocol, &options).with_context(|| {
+        format!(
+            "poses of '{}' against '{}'",
+            recon.display(),
+            gt_cameras.display()
+        )
+    })?;
+    let mut s = serde_json::to_string_pretty(&poses)?;
+    s.push('\n');
+    if let Some(p) = report {
+        write_atomic(p, s.as_bytes())?;
+    }
+    if let Some(p) = pairs {
+        write_atomic(p, poses.pairs_csv(&gt).as_bytes())?;
+    }
+    if json {
+        print!("{s}");
+    } else {
+        print!("{}", summary::render_poses(&poses));
     }
     Ok(())
 }

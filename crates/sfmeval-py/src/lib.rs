@@ -559,6 +559,7 @@ fn _sfmeval(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(_align, m)?)?;
     m.add_function(wrap_pyfunction!(verbs::_read, m)?)?;
     m.add_function(wrap_pyfunction!(verbs::_cameras, m)?)?;
+    m.add_function(wrap_pyfunction!(verbs::_poses, m)?)?;
     m.add_function(wrap_pyfunction!(verbs::_tnt, m)?)?;
     m.add_function(wrap_pyfunction!(verbs::_table, m)?)?;
     m.add_function(wrap_pyfunction!(version, m)?)?;

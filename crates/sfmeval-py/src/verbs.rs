@@ -12,7 +12,7 @@ use sfmeval::geometry::{GroundTruth, Positions};
 use sfmeval::io::{LoadedCloud, ReadLimits};
 use sfmeval::model;
 use sfmeval::pipeline::{self, ReconInput};
-use sfmeval::pose::PoseOptions;
+use sfmeval::pose::{PoseOptions, Protocol, ProtocolOptions, evaluate_protocol};
 use sfmeval::report::Report;
 use sfmeval::transform::Similarity;
 use sfmeval_fs::{
@@ -219,6 +219,57 @@ pub(crate) fn _cameras(
             transform_path.as_deref(),
             transform_json.as_deref(),
         )
+    })
+}
+
+/// `sfmeval poses --gt-cameras G --recon R --protocol P [--position-accuracy D] --report OUT`:
+/// the file's text.
+fn poses_of(
+    gt_cameras: &Path,
+    recon: &Path,
+    protocol: &str,
+    position_accuracy: f64,
+) -> Result<String, Failure> {
+    let protocol = Protocol::parse(protocol)?;
+    let gt = model::read_model_files(&read_input_files(existing(gt_cameras)?)?)
+        .with_context(|| format!("ground-truth cameras '{}'", gt_cameras.display()))?;
+    let est = pipeline::read_reconstruction(&name_of(recon), &read_input_files(existing(recon)?)?)
+        .with_context(|| format!("reconstruction '{}'", recon.display()))?;
+    let est = est.model.ok_or_else(|| {
+        anyhow!(
+            "reconstruction '{}' has no cameras (a bare point cloud)",
+            recon.display()
+        )
+    })?;
+    let options = ProtocolOptions {
+        colmap_position_accuracy: position_accuracy,
+        ..ProtocolOptions::default()
+    };
+    let poses = evaluate_protocol(&gt, &est, protocol, &options).with_context(|| {
+        format!(
+            "poses of '{}' against '{}'",
+            recon.display(),
+            gt_cameras.display()
+        )
+    })?;
+    let mut s = serde_json::to_string_pretty(&poses)?;
+    s.push('\n');
+    Ok(s)
+}
+
+/// `_poses(gt_cameras, recon, protocol, position_accuracy=0.0)`: the JSON `sfmeval poses
+/// --report` writes.
+#[pyfunction]
+#[pyo3(signature = (gt_cameras, recon, protocol, position_accuracy=0.0))]
+pub(crate) fn _poses(
+    py: Python<'_>,
+    gt_cameras: PathBuf,
+    recon: PathBuf,
+    protocol: String,
+    position_accuracy: f64,
+) -> PyResult<String> {
+    hooks::run(py, None, None, |_| {
+        poses_of(&gt_cameras, &recon, &protocol, position_accuracy)
     })
 }
 

@@ -272,6 +272,29 @@ def test_cameras_errors_name_the_file(tmp_path):
         sfmeval.cameras(tmp_path / "none.json", DEMO / "sparse")
 
 
+# ---- poses --------------------------------------------------------------------------------
+
+@pytest.mark.parametrize("protocol", ["colmap", "imc", "co3d"])
+@pytest.mark.parametrize("recon", [MODELS / "colmap_bin", MODELS / "openmvg_colmap"])
+def test_poses_is_the_clis_report(tmp_path, recon, protocol):
+    gt = MODELS / "gt_cameras.json"
+    out = tmp_path / "poses.json"
+    cli("poses", "--gt-cameras", gt, "--recon", recon, "--protocol", protocol,
+        "--position-accuracy", "0.5", "--report", out)
+    p = sfmeval.poses(gt, recon, protocol, position_accuracy=0.5)
+    assert p.to_json().encode() == out.read_bytes()
+    assert json.loads(p.to_json())["result"]["protocol"] == protocol
+
+
+def test_poses_errors_name_the_file(tmp_path):
+    with pytest.raises(sfmeval.InputError) as e:
+        sfmeval.poses(DEMO / "cameras.json", DEMO / "sparse.ply", "imc")
+    assert str(e.value) == cli_error("poses", "--gt-cameras", DEMO / "cameras.json",
+                                     "--recon", DEMO / "sparse.ply", "--protocol", "imc")
+    with pytest.raises(sfmeval.InputError, match="colmap, imc, co3d"):
+        sfmeval.poses(DEMO / "cameras.json", DEMO / "sparse", "eth3d")
+
+
 # ---- tnt ----------------------------------------------------------------------------------
 
 def tnt_scene(tmp_path: Path) -> Path:

@@ -19,13 +19,13 @@ from typing import (
 import numpy as np
 
 from ._sfmeval import (
-    InputError, _align, _cameras, _evaluate, _read, _table, _tnt, align_modes, version,
+    InputError, _align, _cameras, _evaluate, _poses, _read, _table, _tnt, align_modes, version,
 )
 
 __all__ = [
     "Alignment", "CamerasReport", "InputError", "Mesh", "Model", "Note", "PathLike", "PointCloud",
-    "Progress", "Report", "Section", "Tables", "TntReport", "align", "align_modes", "cameras",
-    "evaluate", "read", "table", "tnt", "version",
+    "PosesReport", "Progress", "Report", "Section", "Tables", "TntReport", "align", "align_modes",
+    "cameras", "evaluate", "poses", "read", "table", "tnt", "version",
 ]
 __version__: str = version()
 
@@ -248,6 +248,21 @@ class CamerasReport(_JsonResult):
 
     def to_json(self) -> str:
         """The JSON ``sfmeval cameras --report`` writes, byte for byte."""
+        return self._json
+
+
+class PosesReport(_JsonResult):
+    """A ``sfmeval.poses/1`` report: one pose benchmark protocol's numbers (``result``), its
+    ``convention`` and the counts. ``to_json()`` is the file ``sfmeval poses --report`` writes."""
+
+    __slots__ = ()
+
+    @property
+    def notes(self) -> List[Note]:
+        return [Note(n) for n in self._data["notes"]]
+
+    def to_json(self) -> str:
+        """The JSON ``sfmeval poses --report`` writes, byte for byte."""
         return self._json
 
 
@@ -667,6 +682,29 @@ def cameras(
     t = _transform(transform)
     return CamerasReport(_cameras(os.fspath(gt_cameras), os.fspath(recon),
                                   t["transform_path"], t["transform_json"]))
+
+
+def poses(
+    gt_cameras: PathLike,
+    recon: PathLike,
+    protocol: str,
+    *,
+    position_accuracy: float = 0.0,
+) -> PosesReport:
+    """A camera-pose benchmark's numbers as its official code computes them (``sfmeval
+    poses``; docs/poses.md): ``protocol`` is ``"colmap"`` (COLMAP's reconstruction benchmark),
+    ``"imc"`` (Image Matching Challenge mAA) or ``"co3d"`` (RRA/RTA@5/15/30, AUC@30).
+
+    gt_cameras
+        Ground-truth cameras (a cameras.json, or any model: COLMAP folder, .nvm, ...).
+    recon
+        The reconstruction: a COLMAP model folder, .nvm, Bundler .out, sfm_data.json,
+        cameras.json.
+    position_accuracy
+        COLMAP's ``position_accuracy_gt`` (GT units; 0: off).
+    """
+    return PosesReport(_poses(os.fspath(gt_cameras), os.fspath(recon), protocol,
+                              float(position_accuracy)))
 
 
 def tnt(

@@ -60,6 +60,12 @@ def _cameras(
     transform_path: Optional[str] = ...,
     transform_json: Optional[str] = ...,
 ) -> str: ...
+def _poses(
+    gt_cameras: str,
+    recon: str,
+    protocol: str,
+    position_accuracy: float = ...,
+) -> str: ...
 def _tnt(
     scene: str,
     recon: str,

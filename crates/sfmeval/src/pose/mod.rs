@@ -13,6 +13,22 @@
 //!   30° (the 1°-step cumulative-histogram mean used by recent SfM papers).
 //! - Intrinsics: focal-length error (%) per estimated camera against the GT camera of its
 //!   images, scaled by the width ratio when the estimate used another resolution.
+//! - Benchmark protocols ([`evaluate_protocol`]): COLMAP's reconstruction benchmark, the Image
+//!   Matching Challenge's mAA and CO3D's RRA/RTA/AUC, each as its official code computes it
+//!   (one file each; `protocol.rs` holds what they share).
+
+mod co3d;
+mod colmap_benchmark;
+mod imc;
+mod protocol;
+
+pub use co3d::Co3dResult;
+pub use colmap_benchmark::ColmapResult;
+pub use imc::ImcResult;
+pub use protocol::{
+    Convention, POSES_SCHEMA, PairError, PairRow, PairSet, PosesReport, Protocol, ProtocolOptions,
+    ProtocolResult, ThresholdTest, TranslationSign, evaluate_protocol,
+};
 
 use serde::{Deserialize, Serialize};
 

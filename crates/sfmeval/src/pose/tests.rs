@@ -446,3 +446,129 @@ fn agrees_with_numpy_reference() {
         );
     }
 }
+
+#[test]
+fn protocols_are_gauge_free_and_exact_on_the_ground_truth_in_another_frame() {
+    let gt = gt();
+    let s = Similarity::from_parts(
+        2.5,
+        rot_axis_angle([0.3, -1.0, 0.4], 40.0),
+        [1.0, -2.0, 0.5],
+    );
+    let est = in_recon_frame(&gt, &s);
+    let opts = ProtocolOptions::default();
+    let rep = evaluate_protocol(&gt, &est, Protocol::Colmap, &opts).unwrap();
+    let ProtocolResult::Colmap(c) = &rep.result else {
+        panic!("not colmap")
+    };
+    assert_eq!(c.pairs, 30);
+    assert_eq!(c.recall_percent, vec![100.0; 4]);
+    // acos of a rounded 1 leaves ~1e-6 degrees: the AUC at 0.5° is 100 to ~1e-3 %.
+    assert!(
+        c.auc_percent.iter().all(|a| (a - 100.0).abs() < 1e-3),
+        "{c:?}"
+    );
+    let rep = evaluate_protocol(&gt, &est, Protocol::Imc, &opts).unwrap();
+    let ProtocolResult::Imc(i) = &rep.result else {
+        panic!("not imc")
+    };
+    assert_eq!((i.pairs, i.maa_5, i.maa_10), (15, 1.0, 1.0));
+    let rep = evaluate_protocol(&gt, &est, Protocol::Co3d, &opts).unwrap();
+    let ProtocolResult::Co3d(c) = &rep.result else {
+        panic!("not co3d")
+    };
+    assert_eq!(c.rra_percent, vec![100.0; 3]);
+    assert_eq!(c.auc_percent, 100.0);
+    assert_eq!(rep.pair_rows.len(), 15);
+    // The eps floor of acos(1 - 2 max(1e-15, loss)): 6.3e-8 rad, never 0.
+    assert!(
+        rep.pair_rows
+            .iter()
+            .all(|r| r.rotation_deg > 3e-6 && r.rotation_deg < 1e-5)
+    );
+}
+
+#[test]
+fn a_non_finite_pose_is_unregistered_and_invalidates_the_imc_model() {
+    let gt = gt();
+    let mut est = in_recon_frame(&gt, &Similarity::default());
+    est.images[3].cam_from_world.translation[1] = f64::NAN;
+    let opts = ProtocolOptions::default();
+    let rep = evaluate_protocol(&gt, &est, Protocol::Imc, &opts).unwrap();
+    let ProtocolResult::Imc(i) = &rep.result else {
+        panic!("not imc")
+    };
+    assert!(!i.model_valid);
+    assert_eq!((i.pairs_unregistered, i.maa_10), (15, 0.0));
+    assert_eq!(rep.non_finite, 1);
+    assert!(rep.notes.iter().any(|n| n.code == Code::NonFinitePoses));
+    let rep = evaluate_protocol(&gt, &est, Protocol::Colmap, &opts).unwrap();
+    let ProtocolResult::Colmap(c) = &rep.result else {
+        panic!("not colmap")
+    };
+    assert_eq!(
+        (c.pairs, c.pairs_unregistered, c.pairs_outside_gt),
+        (30, 10, 0)
+    );
+    let rep = evaluate_protocol(&gt, &est, Protocol::Co3d, &opts).unwrap();
+    let ProtocolResult::Co3d(c) = &rep.result else {
+        panic!("not co3d")
+    };
+    assert_eq!(c.pairs_unregistered, 5);
+    // 10 of 15 pairs are perfect, 5 fail every threshold.
+    assert!(
+        c.rra_percent
+            .iter()
+            .all(|r| (r - 200.0 / 3.0).abs() < 1e-12)
+    );
+}
+
+#[test]
+fn colmap_auc_is_the_trapezoid_of_the_recall_curve() {
+    // Recall 0 at 0, 0.5 at 1, 1 at 2: area 0.25 + 0.75 over 2 = 50 %; at 1: 0.25 / 1.
+    let aucs = super::colmap_benchmark::compute_auc(&[1.0, 2.0], &[2.0, 1.0, 4.0], 0.0);
+    assert_eq!(aucs, vec![50.0, 25.0, 75.0]);
+    // min_error 1.5: recall 0.5 from 0 to 1.5, then 1 at 2: (0.75 + 0.375) / 2.
+    let aucs = super::colmap_benchmark::compute_auc(&[1.0, 2.0], &[2.0], 1.5);
+    assert_eq!(aucs, vec![56.25]);
+}
+
+#[test]
+fn pytorch3d_quaternion_equals_the_unit_quaternion_of_a_rotation() {
+    for (axis, deg) in [
+        ([1.0, 2.0, 3.0], 10.0),
+        ([0.0, 0.0, 1.0], 179.0),
+        ([1.0, -1.0, 0.2], 95.0),
+    ] {
+        let r = rot_axis_angle(axis, deg);
+        let (a, b) = (
+            super::protocol::quaternion(&r),
+            super::protocol::quaternion_pytorch3d(&r),
+        );
+        for k in 0..4 {
+            assert!((a[k] - b[k]).abs() < 1e-15, "{a:?} {b:?}");
+        }
+    }
+}
+
+#[test]
+fn unknown_protocols_and_bad_options_are_errors() {
+    assert!(matches!(
+        Protocol::parse("eth3d"),
+        Err(Error::InvalidOption(_))
+    ));
+    let gt = gt();
+    let opts = ProtocolOptions {
+        colmap_thresholds_deg: vec![0.0],
+        ..ProtocolOptions::default()
+    };
+    assert!(evaluate_protocol(&gt, &gt, Protocol::Colmap, &opts).is_err());
+    let mut renamed = gt.clone();
+    for im in &mut renamed.images {
+        im.name = format!("x_{}", im.name);
+    }
+    let err = evaluate_protocol(&gt, &renamed, Protocol::Imc, &ProtocolOptions::default())
+        .unwrap_err()
+        .to_string();
+    assert!(err.contains("none of the 6 estimated image(s)"), "{err}");
+}
