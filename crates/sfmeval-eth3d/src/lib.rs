@@ -5,7 +5,7 @@
 //! reconstruction point against the scans' beams (accurate, inaccurate or unobserved,
 //! [`accuracy`]), the completeness of each scan point ([`completeness`]), both averaged over two
 //! shifted voxel grids ([`voxel`]) for every tolerance in one pass, F1 per tolerance
-//! ([`protocol`]), the coloured clouds the tool writes ([`vis`]) and `sfmeval.eth3d/1`
+//! ([`evaluate`]), the coloured clouds the tool writes ([`vis`]) and `sfmeval.eth3d/1`
 //! ([`report`]).
 //!
 //! Every step is the tool's, in its single-precision arithmetic and in its order of
