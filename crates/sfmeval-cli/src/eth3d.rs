@@ -116,8 +116,18 @@ pub fn eth3d_cmd(args: &Eth3dArgs) -> Result<()> {
         std::fs::create_dir_all(dir)
             .with_context(|| format!("cannot create '{}'", dir.display()))?;
         write_atomic(&dir.join("eth3d.json"), json.as_bytes())?;
-        for (name, bytes) in eth3d::vis::output_files(&evaluation, &recon) {
-            write_atomic(&dir.join(name), &bytes)?;
+        // One cloud in memory at a time (each is 15 bytes a point).
+        for (t, &tolerance) in evaluation.tolerances.iter().enumerate() {
+            let name = eth3d::vis::file_name("completeness", tolerance);
+            write_atomic(
+                &dir.join(name),
+                &eth3d::vis::completeness_ply(&evaluation, t),
+            )?;
+            let name = eth3d::vis::file_name("accuracy", tolerance);
+            write_atomic(
+                &dir.join(name),
+                &eth3d::vis::accuracy_ply(&evaluation, &recon, t),
+            )?;
         }
     }
     if args.json {

@@ -47,6 +47,7 @@ struct SphericalPoint {
     point: [f32; 3],
     direction: [f32; 3],
     radius: f32,
+    inclination: f32,
 }
 
 /// Radius, azimuth and inclination as the tool's `SphericalPoint` computes them.
@@ -94,29 +95,27 @@ impl SphericalGrid {
                         point: *p,
                         direction,
                         radius,
+                        inclination,
                     },
                 )
             });
+        // Cells in order, each cell's points by inclination (non-negative, or NaN last: the
+        // bits order them), for the window of `classify`.
+        let mut keys: Vec<(u32, u32, u32)> = sfmeval::parallel::map_range(located.len(), |k| {
+            (located[k].0, located[k].1.inclination.to_bits(), k as u32)
+        });
+        sfmeval::parallel::sort_unstable(&mut keys);
         let mut starts = vec![0u32; cells + 1];
-        for (c, _) in &located {
+        for (c, _, _) in &keys {
             starts[*c as usize + 1] += 1;
         }
         for c in 0..cells {
             starts[c + 1] += starts[c];
         }
-        let mut next = starts.clone();
-        let mut sorted = vec![
-            SphericalPoint {
-                point: [0.0; 3],
-                direction: [0.0; 3],
-                radius: 0.0,
-            };
-            located.len()
-        ];
-        for (c, p) in located {
-            sorted[next[c as usize] as usize] = p;
-            next[c as usize] += 1;
-        }
+        let sorted: Vec<SphericalPoint> = keys
+            .iter()
+            .map(|&(_, _, k)| located[k as usize].1)
+            .collect();
         grid.starts = starts;
         grid.points = sorted;
         grid
@@ -176,7 +175,8 @@ fn classify(
     let radius_horizontal = (q[0] * q[0] + q[1] * q[1]).sqrt();
     let beam_radius = beam.start_radius + radius * beam.tan_divergence;
     let beam_radius2 = beam_radius * beam_radius;
-    let (vertical, horizontal) = if beam_radius >= radius {
+    let full = beam_radius >= radius;
+    let (vertical, horizontal) = if full {
         (PI_F32, PI_F32)
     } else {
         let v = libm::asinf(beam_radius / radius);
@@ -187,6 +187,17 @@ fn classify(
         };
         (v, h)
     };
+    // The scan points whose beam can hold q are within `vertical` of its direction, so within
+    // `vertical` of its inclination: only that window of each cell (sorted by inclination) is
+    // looked at. The window is widened far beyond float rounding (1e-5 rad, 0.1 %), and used
+    // only away from the poles, where acos is well conditioned; a point outside it is one the
+    // tool rejects too.
+    const POLE: f32 = 0.05;
+    let window = (!full && inclination - vertical > POLE && inclination + vertical < PI_F32 - POLE)
+        .then(|| {
+            let w = vertical * 1.001 + 1e-5;
+            (inclination - w, inclination + w)
+        });
     let (min_a, min_i) = grid.cell_coordinates(azimuth - horizontal, inclination - vertical);
     let (max_a, max_i) = grid.cell_coordinates(azimuth + horizontal, inclination + vertical);
     // The tool's SphericalPointGridIterator, step for step.
@@ -202,7 +213,13 @@ fn classify(
             }
         }
         let cell = wrap(a, CELLS_AZIMUTH) + CELLS_AZIMUTH * i;
-        for s in grid.cell(cell) {
+        let mut points = grid.cell(cell);
+        if let Some((lo, hi)) = window {
+            let a = points.partition_point(|s| s.inclination < lo);
+            let b = points.partition_point(|s| s.inclination <= hi);
+            points = &points[a..b.max(a)];
+        }
+        for s in points {
             let along = dot(&s.direction, q);
             if along < 0.0 {
                 continue;

@@ -117,28 +117,6 @@ pub fn completeness_ply(e: &Eth3dEvaluation, t: usize) -> Vec<u8> {
     pcl_ply(&e.scan_points, colours)
 }
 
-/// Every cloud the tool writes with `--accuracy_cloud_output_path <dir>/accuracy` and
-/// `--completeness_cloud_output_path <dir>/completeness`, as (file name, bytes); a tolerance
-/// given twice is written once (the tool writes the same file twice).
-pub fn output_files(e: &Eth3dEvaluation, reconstruction: &[[f32; 3]]) -> Vec<(String, Vec<u8>)> {
-    let mut out: Vec<(String, Vec<u8>)> = Vec::new();
-    for (t, &tol) in e.tolerances.iter().enumerate() {
-        for (name, bytes) in [
-            (file_name("completeness", tol), completeness_ply(e, t)),
-            (
-                file_name("accuracy", tol),
-                accuracy_ply(e, reconstruction, t),
-            ),
-        ] {
-            match out.iter_mut().find(|(n, _)| *n == name) {
-                Some(slot) => slot.1 = bytes,
-                None => out.push((name, bytes)),
-            }
-        }
-    }
-    out
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -33,19 +33,18 @@ pub fn cell_of(p: &[f32; 3], voxel_size_inv: f32, shift: f32) -> [i32; 3] {
 /// The points' order grouped by cell of the grid with `shift` (cells in key order) and the
 /// bounds of each cell's run in it.
 fn grouped(points: &[[f32; 3]], voxel_size_inv: f32, shift: f32) -> (Vec<u32>, Vec<usize>) {
-    let keys: Vec<[i32; 3]> = sfmeval::parallel::map(points, &sfmeval::progress::NoProgress, |p| {
-        cell_of(p, voxel_size_inv, shift)
+    let mut keyed: Vec<([i32; 3], u32)> = sfmeval::parallel::map_range(points.len(), |i| {
+        (cell_of(&points[i], voxel_size_inv, shift), i as u32)
     });
-    let mut order: Vec<u32> = (0..points.len() as u32).collect();
-    order.sort_unstable_by_key(|&i| (keys[i as usize], i));
+    sfmeval::parallel::sort_unstable(&mut keyed);
     let mut bounds = vec![0usize];
-    for k in 1..order.len() {
-        if keys[order[k] as usize] != keys[order[k - 1] as usize] {
+    for k in 1..keyed.len() {
+        if keyed[k].0 != keyed[k - 1].0 {
             bounds.push(k);
         }
     }
-    bounds.push(order.len());
-    (order, bounds)
+    bounds.push(keyed.len());
+    (keyed.into_iter().map(|(_, i)| i).collect(), bounds)
 }
 
 /// The tool's accuracy per tolerance: per cell, `accurate / (accurate + inaccurate)` in
