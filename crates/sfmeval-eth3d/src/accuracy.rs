@@ -266,7 +266,12 @@ pub fn classify_points(
         .map(|s| ScanFromGlobal::new(&s.entry.global_from_scan))
         .collect();
     let n = tolerances2.len() as u32;
-    sfmeval::parallel::map(reconstruction, &sfmeval::progress::NoProgress, |p| {
+    // Visited in Morton order (neighbours in space one after the other keep the scans' cells in
+    // cache; a reconstruction file's order is often shuffled), results in input order.
+    let as_f64: Vec<sfmeval::geometry::Point3> =
+        reconstruction.iter().map(|p| p.map(f64::from)).collect();
+    sfmeval::parallel::map_points(&as_f64, &sfmeval::progress::NoProgress, |q| {
+        let p = &q.map(|c| c as f32);
         let mut out = Classification {
             first_accurate: n,
             inaccurate: false,
