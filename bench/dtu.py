@@ -13,7 +13,6 @@ The scan is tests/python/dtu_scene.py's (the demo statue as a 100 mm figurine in
 --quick (CI, about 30 s): 100k STL points, 100k reconstruction points, one round.
 """
 import argparse
-import statistics
 import json
 import sys
 import tempfile
@@ -22,21 +21,10 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "bench"))
 sys.path.insert(0, str(ROOT / "tests" / "python"))
-from compare import run_with_peak  # noqa: E402
+from timing import measure  # noqa: E402
 import dtu_scene  # noqa: E402
 
 PORT = ROOT / "tests" / "python" / "dtu_port.py"
-
-
-def measure(cmd, rounds, result):
-    walls, peaks, out = [], [], ""
-    for _ in range(rounds):
-        wall, peak, rc, out, err = run_with_peak(cmd)
-        if rc != 0:
-            raise SystemExit(f"bench: {' '.join(map(str, cmd[:3]))} failed: {(out + err)[-800:]}")
-        walls.append(wall)
-        peaks.append(peak)
-    return statistics.median(walls), max(peaks), result(out)
 
 
 def main():

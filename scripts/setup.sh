@@ -28,6 +28,9 @@ if [ ${#missing[@]} -gt 0 ]; then
   apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
 fi
 
+# ETH3D's evaluation tool, the reference of `sfmeval eth3d` (about 45 s on two cores, once).
+scripts/build-eth3d-tool.sh
+
 # --- Rust ------------------------------------------------------------------
 rustup target list --installed | grep -q wasm32-unknown-unknown || rustup target add wasm32-unknown-unknown
 # the standard library's source: the page's threaded wasm rebuilds std with atomics (-Z build-std)

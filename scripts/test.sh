@@ -109,6 +109,10 @@ check bench-tnt-quick .venv/bin/python bench/tanksandtemples.py --quick
 # The DTU evaluation against its Python port, quick mode (about 10 s).
 check bench-dtu-quick .venv/bin/python bench/dtu.py --quick
 
+# ETH3D's evaluation against its official C++ tool (built once by scripts/build-eth3d-tool.sh),
+# quick mode (about 10 s).
+check bench-eth3d-quick .venv/bin/python bench/eth3d.py --quick
+
 # The Python package (crates/sfmeval-py): its wheel built, installed in a fresh venv and tested
 # against the CLI's reports byte for byte.
 check python-package scripts/check-python-package.sh

@@ -692,3 +692,127 @@ def test_dtu_mat_dimensions_that_disagree_with_the_data_are_refused(sfmeval_bin,
     root = _dtu_with_mask(dtu_dataset, tmp_path, _mat_header() + m)
     code, _, err = _run_dtu(sfmeval_bin, root)
     assert code == 1 and "ObsMask1_10.mat" in err and "64" in err, err
+
+
+# ---------------------------------------------------------------- ETH3D (sfmeval eth3d)
+
+ETH3D_MLP = """<!DOCTYPE MeshLabDocument>
+<MeshLabProject>
+ <MeshGroup>
+  <MLMesh label="scan1.ply" filename="scan1.ply">
+   <MLMatrix44>
+1 0 0 2 
+0 1 0 0 
+0 0 1 0.5 
+0 0 0 1 
+</MLMatrix44>
+  </MLMesh>
+ </MeshGroup>
+</MeshLabProject>
+"""
+
+
+@pytest.fixture(scope="module")
+def eth3d_scene_dir(tmp_path_factory):
+    """A tiny valid ETH3D layout (a project posing one scan) and a reconstruction."""
+    root = tmp_path_factory.mktemp("eth3d_hostile")
+    pts = surface_points(500)
+    cloud_ply(root / "scan1.ply", pts, double=False)
+    (root / "scan_alignment.mlp").write_text(ETH3D_MLP)
+    cloud_ply(root / "recon.ply", [(x + 2, y, z + 0.5) for x, y, z in pts], double=False)
+    return root
+
+
+def _run_eth3d(sfmeval_bin, root, mlp="scan_alignment.mlp", recon="recon.ply"):
+    code, out, err, rss, secs = run_measured(sfmeval_bin, "eth3d", "--gt", root / mlp,
+                                             "--recon", root / recon, "--json")
+    assert rss is not None and rss < MAX_RSS_KB, f"peak RSS {rss} KB"
+    assert "panicked" not in err, err
+    return code, out, err
+
+
+def _eth3d_with(eth3d_scene_dir, tmp_path, mlp_text=None, scan_bytes=None):
+    import shutil
+    root = tmp_path / "eth3d"
+    shutil.copytree(eth3d_scene_dir, root)
+    if mlp_text is not None:
+        (root / "scan_alignment.mlp").write_text(mlp_text)
+    if scan_bytes is not None:
+        (root / "scan1.ply").write_bytes(scan_bytes)
+    return root
+
+
+def test_eth3d_valid_layout_is_measured(sfmeval_bin, eth3d_scene_dir):
+    code, out, err = _run_eth3d(sfmeval_bin, eth3d_scene_dir)
+    assert code == 0, err
+    rep = json.loads(out)
+    jsonschema.validate(rep, json.loads((ROOT / "schemas" / "eth3d.schema.json").read_text()))
+    # The reconstruction is the scan itself: complete and accurate at every tolerance.
+    assert all(t["completeness"] == 1.0 and t["accuracy"] == 1.0 for t in rep["tolerances"])
+
+
+@pytest.mark.parametrize("mlp, words", [
+    ("<MeshLabProject><MeshGroup>", ["not XML"]),
+    ("", ["not XML"]),
+    ("<Project/>", ["MeshLabProject"]),
+    ("<MeshLabProject></MeshLabProject>", ["MeshGroup"]),
+    ("<MeshLabProject><MeshGroup></MeshGroup></MeshLabProject>", ["no scans"]),
+    (ETH3D_MLP.replace(' filename="scan1.ply"', ""), ["no filename"]),
+    (ETH3D_MLP.replace("0 0 1 0.5 \n", ""), ["12 numbers"]),
+    (ETH3D_MLP.replace("0.5", "nan"), ["non-finite"]),
+    (ETH3D_MLP.replace("0.5", "inf"), ["non-finite"]),
+    (ETH3D_MLP.replace("0.5", "1e39"), ["non-finite"]),
+    (ETH3D_MLP.replace("0.5", "zero"), ["not a number"]),
+    (ETH3D_MLP.replace("0 0 0 1 \n", "0 0 0 2 \n"), ["last row"]),
+    (ETH3D_MLP.replace("<MLMatrix44>", "<Other>").replace("</MLMatrix44>", "</Other>"), ["MLMatrix44"]),
+])
+def test_eth3d_malformed_project_is_refused_naming_it(sfmeval_bin, eth3d_scene_dir, tmp_path, mlp, words):
+    root = _eth3d_with(eth3d_scene_dir, tmp_path, mlp_text=mlp)
+    code, _, err = _run_eth3d(sfmeval_bin, root)
+    assert code == 1 and "scan_alignment.mlp" in err, err
+    for w in words:
+        assert w in err, err
+
+
+def test_eth3d_missing_scan_is_named(sfmeval_bin, eth3d_scene_dir, tmp_path):
+    root = _eth3d_with(eth3d_scene_dir, tmp_path, mlp_text=ETH3D_MLP.replace('filename="scan1.ply"',
+                                                                             'filename="nowhere/scan9.ply"'))
+    code, _, err = _run_eth3d(sfmeval_bin, root)
+    assert code == 1 and "scan9.ply" in err and "scan_alignment.mlp" in err, err
+
+
+@pytest.mark.parametrize("cut", [0, 40, 100, -1])
+def test_eth3d_truncated_scan_is_refused_naming_it(sfmeval_bin, eth3d_scene_dir, tmp_path, cut):
+    whole = (eth3d_scene_dir / "scan1.ply").read_bytes()
+    root = _eth3d_with(eth3d_scene_dir, tmp_path, scan_bytes=whole[:cut] if cut >= 0 else whole[:-5])
+    code, _, err = _run_eth3d(sfmeval_bin, root)
+    assert code == 1 and "scan1.ply" in err, err
+
+
+def test_eth3d_non_finite_scan_point_is_refused(sfmeval_bin, eth3d_scene_dir, tmp_path):
+    root = tmp_path / "nf"
+    root.mkdir()
+    (root / "scan_alignment.mlp").write_text(ETH3D_MLP)
+    cloud_ply(root / "scan1.ply", [(0.0, 0.0, 0.0), (float("nan"), 1.0, 1.0)], double=False)
+    (root / "recon.ply").write_bytes((eth3d_scene_dir / "recon.ply").read_bytes())
+    code, _, err = _run_eth3d(sfmeval_bin, root)
+    assert code == 1 and "scan1.ply" in err and ("finite" in err or "NaN" in err), err
+
+
+@pytest.mark.parametrize("cut", [10, 100, -1])
+def test_eth3d_truncated_reconstruction_is_refused(sfmeval_bin, eth3d_scene_dir, tmp_path, cut):
+    whole = (eth3d_scene_dir / "recon.ply").read_bytes()
+    root = _eth3d_with(eth3d_scene_dir, tmp_path)
+    (root / "recon.ply").write_bytes(whole[:cut] if cut >= 0 else whole[:-5])
+    code, _, err = _run_eth3d(sfmeval_bin, root)
+    assert code == 1 and "recon.ply" in err, err
+
+
+def test_eth3d_huge_coordinates_finish(sfmeval_bin, eth3d_scene_dir, tmp_path):
+    """Reconstruction points at 1e38 (float max is 3.4e38): the voxel keys overflow as the tool's
+    int conversions do; the run finishes with a valid report."""
+    root = _eth3d_with(eth3d_scene_dir, tmp_path)
+    cloud_ply(root / "recon.ply", [(1e38, -1e38, 1e38), (2.0, 0.0, 0.5), (-3e38, 0.0, 0.0)], double=False)
+    code, out, err = _run_eth3d(sfmeval_bin, root)
+    assert code == 0, err
+    jsonschema.validate(json.loads(out), json.loads((ROOT / "schemas" / "eth3d.schema.json").read_text()))

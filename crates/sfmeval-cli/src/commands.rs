@@ -118,6 +118,9 @@ enum Command {
     /// mean accuracy, mean completeness and overall in mm, as the benchmark's Python port
     /// computes them.
     Dtu(Box<crate::dtu::DtuArgs>),
+    /// ETH3D's multi-view evaluation on a scene's laser scans (a MeshLab project): accuracy,
+    /// completeness and F1 per tolerance, as the benchmark's official tool computes them.
+    Eth3d(Box<crate::eth3d::Eth3dArgs>),
     /// Write a model's cameras as a Tanks and Temples .log trajectory (one frame per image).
     Log(LogArgs),
     /// Table I and the comparison table of evaluation reports, as `sfmeval-runner report`
@@ -340,6 +343,7 @@ pub fn run(cli: Cli) -> Result<()> {
         } => info(&file, &ReadLimits::triangles(max_triangles)),
         Command::Tnt(args) => tnt_cmd(&args),
         Command::Dtu(args) => crate::dtu::dtu_cmd(&args),
+        Command::Eth3d(args) => crate::eth3d::eth3d_cmd(&args),
         Command::Log(args) => log_cmd(&args),
         Command::Table(args) => table_cmd(&args),
         Command::Export(args) => export_cmd(&args),

@@ -3,6 +3,7 @@
 mod commands;
 mod concurrent;
 mod dtu;
+mod eth3d;
 mod progress;
 mod summary;
 mod table;

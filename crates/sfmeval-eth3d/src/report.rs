@@ -1,0 +1,140 @@
+//! The `sfmeval.eth3d/1` report: per tolerance the tool's three numbers (as the `float`s it
+//! computes, written in their shortest form) and the counts behind them; the scans and options.
+
+use serde::Serialize;
+
+use crate::protocol::Eth3dEvaluation;
+use crate::scene::Eth3dScene;
+
+/// The report's schema name.
+pub const ETH3D_SCHEMA: &str = "sfmeval.eth3d/1";
+
+/// One evaluation's report.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Eth3dReport {
+    /// [`ETH3D_SCHEMA`].
+    pub schema: &'static str,
+    /// The MeshLab project's name.
+    pub ground_truth: String,
+    /// The reconstruction's name.
+    pub reconstruction: String,
+    /// The options.
+    pub options: Eth3dReportOptions,
+    /// Points of the reconstruction.
+    pub reconstruction_points: usize,
+    /// The scans in the project's order.
+    pub scans: Vec<Eth3dReportScan>,
+    /// Voxel cells (both grids) holding scan points: the completeness's denominator.
+    pub completeness_cells: usize,
+    /// One entry per tolerance, smallest first.
+    pub tolerances: Vec<Eth3dTolerance>,
+}
+
+/// The tool's options.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Eth3dReportOptions {
+    /// Voxel size (m).
+    pub voxel_size: f32,
+    /// Beam radius at the scanner (m).
+    pub beam_start_radius: f32,
+    /// Beam divergence half-angle (degrees).
+    pub beam_divergence_halfangle_deg: f32,
+}
+
+/// One scan.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Eth3dReportScan {
+    /// Its label in the project, if any.
+    pub label: Option<String>,
+    /// Its file.
+    pub file: String,
+    /// Its points.
+    pub points: usize,
+}
+
+/// One tolerance's results.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Eth3dTolerance {
+    /// The tolerance (m).
+    pub tolerance: f32,
+    /// Accuracy in [0, 1]: the mean over voxel cells of accurate / (accurate + inaccurate).
+    pub accuracy: f32,
+    /// Completeness in [0, 1]: the mean over voxel cells of complete / scan points.
+    pub completeness: f32,
+    /// F1 of the two.
+    pub f1: f32,
+    /// Reconstruction points within the tolerance of a scan point on whose beam they lie.
+    pub accurate_points: usize,
+    /// Reconstruction points in front of scan points (seen through), not accurate.
+    pub inaccurate_points: usize,
+    /// Reconstruction points neither: left out of the accuracy.
+    pub unobserved_points: usize,
+    /// Scan points with a reconstruction point within the tolerance.
+    pub complete_points: usize,
+    /// Voxel cells (both grids) with an accurate or inaccurate point: the accuracy's
+    /// denominator.
+    pub accuracy_cells: usize,
+}
+
+impl Eth3dReport {
+    /// The report of evaluation `e` on `scene` (named `ground_truth`) of `reconstruction`.
+    pub fn new(
+        e: &Eth3dEvaluation,
+        scene: &Eth3dScene,
+        ground_truth: &str,
+        reconstruction: &str,
+    ) -> Eth3dReport {
+        let tolerances = (0..e.tolerances.len())
+            .map(|t| {
+                let t32 = t as u32;
+                let accurate = e.first_accurate.iter().filter(|&&f| t32 >= f).count();
+                let inaccurate = e
+                    .first_accurate
+                    .iter()
+                    .zip(&e.inaccurate)
+                    .filter(|&(&f, &i)| t32 < f && i)
+                    .count();
+                Eth3dTolerance {
+                    tolerance: e.tolerances[t],
+                    accuracy: e.accuracy[t],
+                    completeness: e.completeness[t],
+                    f1: e.f1[t],
+                    accurate_points: accurate,
+                    inaccurate_points: inaccurate,
+                    unobserved_points: e.first_accurate.len() - accurate - inaccurate,
+                    complete_points: e.first_complete.iter().filter(|&&f| t32 >= f).count(),
+                    accuracy_cells: e.accuracy_cells[t],
+                }
+            })
+            .collect();
+        Eth3dReport {
+            schema: ETH3D_SCHEMA,
+            ground_truth: ground_truth.to_string(),
+            reconstruction: reconstruction.to_string(),
+            options: Eth3dReportOptions {
+                voxel_size: e.options.voxel_size,
+                beam_start_radius: e.options.beam_start_radius,
+                beam_divergence_halfangle_deg: e.options.beam_divergence_halfangle_deg,
+            },
+            reconstruction_points: e.first_accurate.len(),
+            scans: scene
+                .scans
+                .iter()
+                .map(|s| Eth3dReportScan {
+                    label: s.entry.label.clone(),
+                    file: s.file.clone(),
+                    points: s.points.len(),
+                })
+                .collect(),
+            completeness_cells: e.completeness_cells,
+            tolerances,
+        }
+    }
+
+    /// The report as pretty JSON with a final newline.
+    pub fn to_json(&self) -> String {
+        let mut s = serde_json::to_string_pretty(self).unwrap_or_default();
+        s.push('\n');
+        s
+    }
+}
