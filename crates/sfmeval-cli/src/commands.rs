@@ -436,8 +436,14 @@ fn export_cmd(args: &ExportArgs) -> Result<()> {
     let recon = if run_folder && args.recon_cameras.is_none() {
         // a runner's run folder: its reconstruction as the runner's report reads it
         let files = sfmeval_table::layout::read_run_reconstruction(&Disk, path_str(&args.recon)?)?;
+        // errors name the part of the run folder they are about: model/ or sparse.ply
+        let part = if files.contains_key(sfmeval_table::layout::SPARSE_PLY) {
+            sfmeval_table::layout::SPARSE_PLY
+        } else {
+            sfmeval_table::layout::MODEL_DIR
+        };
         read_reconstruction(&name_of(&args.recon), &files)
-            .with_context(|| format!("run folder '{}'", args.recon.display()))?
+            .with_context(|| format!("reconstruction '{}'", args.recon.join(part).display()))?
     } else {
         read_reconstruction_with_cameras(
             &args.recon,
