@@ -1,7 +1,8 @@
 """Driven by test_blender_compare.py inside Blender (PyPI bpy or Debian's blender), on data/demo
 (no rendering): a PLY (sparse.ply) and a COLMAP model (sparse/) imported as files, vertices of
 both deleted in Edit Mode, Automatic and Refine on the selected one, Evaluate; then a real report
-with its messages reworded, shown by the panel. What the test needs to redo it with the CLI is
+with its messages reworded, shown by the panel; then a vertex added in Edit Mode, which Evaluate
+must report. What the test needs to redo it with the CLI is
 dumped to JSON.
 
 argv (after --): ZIP DATASET OUT_JSON SFMEVAL"""
@@ -125,6 +126,33 @@ with open(reworded, "w") as f:
 cpanel.load_report(item, reworded)
 res["reworded_labels"] = panel_labels(bpy.types.SFMEVAL_PT_compare, scene, icons=True)
 res["notes"] = rep["notes"]
+
+# Table I as Evaluate wrote it (the failed evaluation below rewrites it)
+res["table_files"] = {n: open(os.path.join(ds, "compare", n), encoding="utf-8").read()
+                      for n in ("table1.md", "table1.csv")}
+
+# A vertex added in Edit Mode where vertex 0 was deleted: its index attribute is 0 (the
+# default), a row no other vertex has now, but it has no source point; Evaluate must say so.
+obj = c.recons[ply_name].object
+for o in bpy.context.selected_objects:
+    o.select_set(False)
+bpy.context.view_layer.objects.active = obj
+obj.select_set(True)
+bpy.ops.object.mode_set(mode="EDIT")
+bm = bmesh.from_edit_mesh(obj.data)
+bm.verts.ensure_lookup_table()
+bmesh.ops.delete(bm, geom=[bm.verts[0]], context="VERTS")
+bm.verts.new((0.125, 0.25, 0.5))
+bmesh.update_edit_mesh(obj.data)
+bpy.ops.object.mode_set(mode="OBJECT")
+c.active_recon = names.index(ply_name)
+report_before = open(c.recons[ply_name].report, "rb").read()
+c.message = ""
+bpy.ops.sfmeval.compare_evaluate()
+item = c.recons[ply_name]
+res["added_vertex"] = {"status": item.status, "message": item.message, "panel": c.message,
+                       "report_unchanged": open(item.report, "rb").read() == report_before
+                       if item.report and os.path.isfile(item.report) else None}
 with open(out_json, "w") as f:
     json.dump(res, f)
 print("FLOAT64 DONE")

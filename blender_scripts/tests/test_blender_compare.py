@@ -429,7 +429,8 @@ def test_float64_points_selected_rows_and_notes(blender, addon_zip, bins, tmp_pa
     rows still present, and its report is byte for byte `sfmeval eval` on the same points,
     transform and cameras (ATE and rotation errors included). Automatic and Refine act on the
     selected row only, Refine is one `sfmeval align --align icp` from the moved placement, Table
-    I is `sfmeval table`'s, and a report whose messages are reworded shows the same notes."""
+    I is `sfmeval table`'s, a report whose messages are reworded shows the same notes, and a
+    vertex added in Edit Mode is reported, not measured."""
     ds = tmp_path / "demo"
     shutil.copytree(os.path.join(REPO, "data", "demo"), ds)
     out = tmp_path / "f64.json"
@@ -511,6 +512,12 @@ def test_float64_points_selected_rows_and_notes(blender, addon_zip, bins, tmp_pa
         assert s["ate"] == (rep["cameras"] or {}).get("ate_rmse")
     # the COLMAP model's cameras: ATE and rotation errors are those `sfmeval eval` gives the
     # model itself (camera alignment, whatever aligned the points)
+    # a vertex added in Edit Mode (index attribute 0, vertex 0 deleted): told, not measured
+    added = res["added_vertex"]
+    assert added["status"] != "ok", added
+    text = added["message"] + " " + added["panel"]
+    assert "1 of its" in text and "added, duplicated or moved in Edit Mode" in text, added
+    assert added["report_unchanged"] in (True, None), added
     rep = json.loads(open(res["items"][colmap_name]["report"]).read())
     cli = tmp_path / "model.json"
     subprocess.run([bins["sfmeval"], "eval", "--dataset", str(ds), "--recon", str(ds / "sparse"),
@@ -531,7 +538,7 @@ def test_float64_points_selected_rows_and_notes(blender, addon_zip, bins, tmp_pa
                    ["%s=%s" % (n, res["items"][n]["report"]) for n in (ply_name, colmap_name)] +
                    ["--dataset", "demo", "--out", str(table)], check=True, capture_output=True)
     for name in ("table1.md", "table1.csv"):
-        assert (table / name).read_bytes() == (ds / "compare" / name).read_bytes(), name
+        assert (table / name).read_text(encoding="utf-8") == res["table_files"][name], name
     assert (table / "table1.md").read_text() in res["table_text"]
     # notes by level: the reworded report's warnings shown with their new words, infos not
     shown = [(t, icon) for t, icon in res["reworded_labels"] if t.startswith("REWORDED")]

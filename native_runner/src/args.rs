@@ -357,8 +357,10 @@ pub struct Table1Args {
     pub presets: Vec<String>,
     /// Real scenes besides the generated datasets: folders in the Tanks and Temples layout
     /// (images/ plus SCENE.ply, SCENE.json, SCENE_trans.txt, SCENE_COLMAP_SfM.log, the
-    /// folder named after the scene), run like the others and evaluated with the benchmark's
-    /// protocol at the scene's τ.
+    /// folder named after the scene), evaluated with the benchmark's protocol at the scene's
+    /// τ, or DTU scans (images/, cameras.json in the scan's frame in mm, Points/stl/ and
+    /// ObsMask/ as the benchmark ships them), evaluated with the DTU protocol after the camera
+    /// alignment; run like the others.
     #[arg(long = "scene", value_name = "DIR")]
     pub scenes: Vec<PathBuf>,
     /// The dataset generator.

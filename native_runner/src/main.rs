@@ -16,6 +16,7 @@ mod batch;
 mod chart;
 mod commands;
 mod dataset;
+mod dtu;
 mod env;
 mod exec;
 mod files;

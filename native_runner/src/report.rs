@@ -1,6 +1,8 @@
 //! `sfmeval-runner report`: evaluates every finished run with the sfmeval core (the dataset's
 //! ground truth prepared once, `auto` alignment with its cameras.json, optional crop), writes
-//! one `sfmeval.report/3` per run and the comparison tables (Markdown, CSV, HTML).
+//! one `sfmeval.report/3` per run and the comparison tables (Markdown, CSV, HTML). A Tanks and
+//! Temples scene's runs get the benchmark's protocol (`tnt.rs`), a DTU scan's the DTU protocol
+//! (`dtu.rs`).
 
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
@@ -84,6 +86,10 @@ pub fn report(args: &ReportArgs) -> Result<Vec<Row>> {
             rows.extend(report_tnt_dataset(&ds, &ds_dir, &records, args)?);
             continue;
         }
+        if let Some(scan) = crate::dtu::scan_number(&ds_dir) {
+            rows.extend(report_dtu_dataset(scan, &ds_dir, &records, args)?);
+            continue;
+        }
         let mut gt = if any_ok {
             match load_gt(&ds_dir) {
                 Ok(g) => Some(g),
@@ -156,6 +162,30 @@ fn report_tnt_dataset(
                 "Tanks and Temples scene {}: {e}",
                 ds_dir.display()
             )),
+        })
+    })
+}
+
+/// The rows of a DTU scan's runs, evaluated with the DTU protocol after the camera alignment.
+fn report_dtu_dataset(
+    scan: u32,
+    ds_dir: &Path,
+    records: &[(RunRecord, &PathBuf)],
+    args: &ReportArgs,
+) -> Result<Vec<Row>> {
+    let any_ok = records.iter().any(|(r, _)| r.status == Status::Ok);
+    // Read only when some run needs it; unused otherwise.
+    let read = if any_ok {
+        crate::dtu::read_scan(ds_dir, scan).map_err(|e| format!("{e:#}"))
+    } else {
+        Err(String::new())
+    };
+    dataset_rows(records, args, |rec, dir| {
+        Ok(match &read {
+            Ok((dtu_scan, gt_cameras)) => {
+                crate::dtu::evaluate_run(scan, dtu_scan, gt_cameras, dir, rec, &args.out)
+            }
+            Err(e) => Err(anyhow::anyhow!("DTU scan {}: {e}", ds_dir.display())),
         })
     })
 }

@@ -103,7 +103,7 @@ def build(root: Path, sfmeval_bin: str, stl_points=200_000, dense_points=300_000
     rng = np.random.default_rng(7)
     dense, _ = trimesh.sample.sample_surface(mesh, dense_points, seed=2)
     dense = dense + rng.normal(0, 0.15, dense.shape)
-    centre = dense[12345]
+    centre = dense[12345 % len(dense)]
     dense = dense[np.linalg.norm(dense - centre, axis=1) > 12.0]
     lo, hi = bb[0] - 60, bb[1] + 120
     inside = np.concatenate([rng.uniform(bb[0], bb[1], (500, 3)), rng.uniform(lo, hi, (3000, 3))])

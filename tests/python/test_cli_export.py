@@ -122,3 +122,30 @@ def test_export_bad_input_names_the_file(sfmeval_bin, tmp_path, name, content, m
     if message:
         assert message in p.stderr, p.stderr
     assert not out.exists()
+
+
+def test_export_of_a_run_folder_is_what_the_runner_evaluates(sfmeval_bin, tmp_path):
+    """A runner's run folder (run.json beside model/ and sparse.ply) exports by the run-folder
+    layout of sfmeval-table, as the runner's report reads it: the model's float64 points and
+    cameras when model/ holds one, else sparse.ply; not sparse.ply's float32 copy of them."""
+    import shutil
+    demo = ROOT / "data" / "demo"
+    run = tmp_path / "copy"
+    shutil.copytree(demo / "sparse", run / "model")
+    shutil.copy(demo / "sparse.ply", run / "sparse.ply")
+    (run / "run.json").write_text("{}")
+    for recon, out in ((run, "run"), (demo / "sparse", "model")):
+        p = export(sfmeval_bin, recon, tmp_path / out)
+        assert p.returncode == 0, p.stderr
+    for f in ("points.ply", "cameras.json"):
+        assert (tmp_path / "run" / f).read_bytes() == (tmp_path / "model" / f).read_bytes(), f
+    shutil.rmtree(run / "model")
+    p = export(sfmeval_bin, run, tmp_path / "ply")
+    assert p.returncode == 0, p.stderr
+    assert not (tmp_path / "ply" / "cameras.json").exists()
+    pts, _, _ = read_ply(tmp_path / "ply" / "points.ply")
+    ply, _, _ = read_ply(demo / "sparse.ply")
+    assert np.array_equal(pts, ply)
+    (run / "sparse.ply").unlink()
+    p = export(sfmeval_bin, run, tmp_path / "none")
+    assert p.returncode == 1 and str(run) in p.stderr and "sparse.ply" in p.stderr, p.stderr

@@ -103,3 +103,94 @@ def test_missing_and_wrong_files_are_named(sfmeval_bin, scene, tmp_path):
     p = subprocess.run([sfmeval_bin, "dtu", "--dataset", str(scene["dataset"]), "--scan", "1",
                         "--recon", str(far)], capture_output=True, text=True)
     assert p.returncode == 1 and "far.ply" in p.stderr and "bounding box" in p.stderr, p.stderr
+
+
+def write_colmap_text(folder, points):
+    """A COLMAP text model holding only these 3D points (no camera), repr() doubles."""
+    folder.mkdir(parents=True)
+    (folder / "cameras.txt").write_text("# Camera list\n")
+    (folder / "images.txt").write_text("# Image list\n")
+    (folder / "points3D.txt").write_text("".join(
+        f"{i + 1} {float(x)!r} {float(y)!r} {float(z)!r} 200 200 200 0.5\n" for i, (x, y, z) in enumerate(points)))
+    return folder
+
+
+def write_nvm(path, points):
+    """An NVM_V3 file holding one camera and these points (no measurements)."""
+    lines = ["NVM_V3", "", "1", "a.jpg 100 1 0 0 0 0 0 0 0 0", "", str(len(points))]
+    lines += [f"{float(x)!r} {float(y)!r} {float(z)!r} 200 200 200 0" for x, y, z in points]
+    path.write_text("\n".join(lines) + "\n\n0\n")
+    return path
+
+
+def write_obj(path, vertices, faces):
+    path.write_text("".join(f"v {float(x)!r} {float(y)!r} {float(z)!r}\n" for x, y, z in vertices)
+                    + "".join(f"f {a + 1} {b + 1} {c + 1}\n" for a, b, c in faces))
+    return path
+
+
+def ply_arrays(path):
+    """x y z (double) and the faces of a PLY dtu_scene.write_ply wrote."""
+    head, data = body(path)
+    text = head.decode()
+    n = int(text.split("element vertex ")[1].split()[0])
+    points = np.frombuffer(data[:n * 24], dtype="<f8").reshape(n, 3)
+    faces = None
+    if "element face" in text:
+        rec = np.frombuffer(data[n * 24:], dtype=[("n", "u1"), ("v", "<i4", (3,))])
+        faces = rec["v"]
+    return points, faces
+
+
+@pytest.mark.parametrize("kind", ["colmap", "nvm", "obj", "glb"])
+def test_any_reconstruction_equals_the_port_on_the_ply_of_its_points(sfmeval_bin, scene,
+                                                                      tmp_path, kind):
+    """`sfmeval dtu` reads SfM models and meshes as `sfmeval eval` does; each gives the port's
+    numbers (and error clouds) on the PLY of the same points: an SfM model's 3D points (the
+    dense case, as COLMAP text and NVM), a mesh sampled as the evaluator samples it (OBJ, and
+    glTF whose float32 vertices the PLY then holds)."""
+    if kind in ("colmap", "nvm"):
+        points, _ = ply_arrays(scene["dense"])
+        recon = (write_colmap_text(tmp_path / "model", points) if kind == "colmap"
+                 else write_nvm(tmp_path / "model.nvm", points))
+        ply, mode = scene["dense"], "pcd"
+    elif kind == "obj":
+        vertices, faces = ply_arrays(scene["mesh"])
+        recon = write_obj(tmp_path / "mesh.obj", vertices, faces)
+        ply, mode = scene["mesh"], "mesh"
+    else:
+        import trimesh
+        vertices, faces = ply_arrays(scene["mesh"])
+        vertices = vertices.astype(np.float32).astype(np.float64)
+        recon = tmp_path / "mesh.glb"
+        recon.write_bytes(trimesh.Trimesh(vertices=vertices, faces=faces, process=False)
+                          .export(file_type="glb"))
+        ply = tmp_path / "mesh32.ply"
+        dtu_scene.write_ply(ply, vertices, faces=faces)
+        mode = "mesh"
+    port = run_port(scene, ply, mode, tmp_path / "port")
+    # auto: a mesh when the file has faces, a model's points otherwise
+    rep = run_sfmeval(sfmeval_bin, scene, recon, "auto", tmp_path / "ours", "--no-shuffle")
+    assert rep["mode"] == mode and rep["reconstruction"] == str(recon)
+    ours = [rep["mean_accuracy"], rep["mean_completeness"], rep["overall"]]
+    assert ours == pytest.approx(port, rel=1e-6, abs=0), (kind, ours, port)
+    for name in ("vis_001_d2s.ply", "vis_001_s2d.ply"):
+        assert body(tmp_path / "ours" / name)[1] == body(tmp_path / "port" / name)[1], name
+    # the same report as the PLY's, but for the name
+    of_ply = run_sfmeval(sfmeval_bin, scene, ply, mode, tmp_path / "ply", "--no-shuffle")
+    assert {**rep, "reconstruction": of_ply["reconstruction"]} == of_ply
+
+
+def test_a_model_without_points_and_mesh_mode_without_faces_are_named(sfmeval_bin, scene,
+                                                                       tmp_path):
+    model = write_colmap_text(tmp_path / "empty", np.zeros((0, 3)))
+    (model / "images.txt").write_text(
+        "1 1 0 0 0 0 0 0 1 a.jpg\n\n")
+    (model / "cameras.txt").write_text("1 SIMPLE_PINHOLE 100 100 50 50 50\n")
+    p = subprocess.run([sfmeval_bin, "dtu", "--dataset", str(scene["dataset"]), "--scan", "1",
+                        "--recon", str(model)], capture_output=True, text=True)
+    assert p.returncode == 1 and str(model) in p.stderr, p.stderr
+    p = subprocess.run([sfmeval_bin, "dtu", "--dataset", str(scene["dataset"]), "--scan", "1",
+                        "--recon", str(scene["sparse"]), "--mode", "mesh"],
+                       capture_output=True, text=True)
+    assert p.returncode == 1 and "no faces" in p.stderr and "sparse.ply" in p.stderr, p.stderr

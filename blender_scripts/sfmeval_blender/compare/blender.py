@@ -297,12 +297,29 @@ def source_points(obj):
 
 def kept_points(obj):
     """The float64 source points of the vertices left in the object's mesh (recon frame), Edit
-    Mode deletions included. A vertex added in Edit Mode has no source point: an error."""
+    Mode deletions included. A vertex added (its index attribute 0, or a copy's), duplicated or
+    moved in Edit Mode has no source point of its own: each is an error naming how many, never
+    a point dropped or measured at another's position. A vertex still has its source row when
+    its index is in range, used once, and its position is that row's float32 value (as the
+    import wrote it)."""
     idx = kept_indices(obj)
     src = source_points(obj)
-    if len(idx) and (idx.min() < 0 or idx.max() >= len(src) or len(np.unique(idx)) != len(idx)):
-        raise ValueError("%s: vertices added or duplicated in Edit Mode have no source point "
-                         "(only deleting points is measured): import it again" % obj.name)
+    if not len(idx):
+        return src[idx]
+    co = np.empty(3 * len(idx), dtype=np.float32)
+    obj.data.vertices.foreach_get("co", co)
+    co = co.reshape(-1, 3)
+    in_range = (idx >= 0) & (idx < len(src))
+    same = np.zeros(len(idx), dtype=bool)
+    same[in_range] = np.all(co[in_range] == src[idx[in_range]].astype(np.float32), axis=1)
+    _, first = np.unique(idx, return_index=True)
+    once = np.zeros(len(idx), dtype=bool)
+    once[first] = True
+    orphans = int(np.count_nonzero(~(same & once)))
+    if orphans:
+        raise ValueError("%s: %d of its %d vertices were added, duplicated or moved in Edit Mode "
+                         "and have no source point (only deleting points is measured): undo "
+                         "that, or import it again" % (obj.name, orphans, len(idx)))
     return src[idx]
 
 
@@ -450,21 +467,19 @@ def measure_item(context, sfmeval, item, crop=None, gt=None):
 
 
 def import_source(context, sfmeval, name, source, run_dir=None):
-    """Imports a reconstruction: a run folder (its sparse.ply with the cameras of its model/) or
-    any file or folder the CLI reads, through ``sfmeval export`` (its points as float64 and its
-    cameras, in its own frame, into compare/NAME/source/). Aligns it automatically; returns
-    (the points object, the cameras file evaluations use or None)."""
+    """Imports a reconstruction: a run folder (read by ``sfmeval export RUN_FOLDER`` with the
+    run-folder layout of sfmeval-table: its model/, else its sparse.ply, exactly what the
+    runner's report evaluates) or any file or folder the CLI reads, through ``sfmeval export``
+    (its points as float64 and its cameras, in its own frame, into compare/NAME/source/).
+    Aligns it automatically; returns (the points object, the cameras file evaluations use or
+    None)."""
     ds = require_dataset(context)
     work = work_dir(context, name)
     os.makedirs(work, exist_ok=True)
-    recon, model = source, None
-    if run_dir:
-        recon = os.path.join(run_dir, "sparse.ply")
-        if os.path.isdir(os.path.join(run_dir, "model")):
-            model = os.path.join(run_dir, "model")
+    recon = run_dir or source
     if not os.path.exists(recon):
         raise ValueError("%s does not exist" % recon)
-    points_ply, cameras_json = ev.export(sfmeval, recon, os.path.join(work, "source"), model)
+    points_ply, cameras_json = ev.export(sfmeval, recon, os.path.join(work, "source"))
     gt = gt_override(context)
     a = ev.align(sfmeval, ds, points_ply, work, recon_cameras=cameras_json, gt=gt)
     obj = new_points_object(context, name, plyio.read_vertices(points_ply), cameras_json)

@@ -192,7 +192,10 @@ struct InputArgs {
 #[derive(Args, Debug)]
 struct ExportArgs {
     /// The reconstruction: a PLY point cloud, a COLMAP model folder, an .nvm, a Bundler .out, an
-    /// OpenMVG sfm_data.json or a cameras.json (what `eval --recon` reads).
+    /// OpenMVG sfm_data.json or a cameras.json (what `eval --recon` reads), or a run folder of
+    /// `sfmeval-runner` (its run.json beside model/ or sparse.ply: the reconstruction the
+    /// runner's report evaluates, by the run-folder layout of sfmeval-table: the model, else
+    /// sparse.ply).
     #[arg(value_name = "RECON")]
     recon: PathBuf,
     /// The SfM model whose cameras go with a PLY RECON (as `eval --recon-cameras`: the PLY's
@@ -476,11 +479,25 @@ fn read_recon(input: &InputArgs) -> Result<ReconInput> {
 /// reconstruction's frame. Without cameras, a cameras.json left in DIR by an earlier export is
 /// removed (the folder never mixes two reconstructions).
 fn export_cmd(args: &ExportArgs) -> Result<()> {
-    let recon = read_reconstruction_with_cameras(
-        &args.recon,
-        args.recon_cameras.as_deref(),
-        &name_of(&args.recon),
-    )?;
+    let run_folder = args.recon.join(sfmeval_table::layout::RUN_JSON).is_file();
+    let recon = if run_folder && args.recon_cameras.is_none() {
+        // a runner's run folder: its reconstruction as the runner's report reads it
+        let files = sfmeval_table::layout::read_run_reconstruction(&Disk, path_str(&args.recon)?)?;
+        // errors name the part of the run folder they are about: model/ or sparse.ply
+        let part = if files.contains_key(sfmeval_table::layout::SPARSE_PLY) {
+            sfmeval_table::layout::SPARSE_PLY
+        } else {
+            sfmeval_table::layout::MODEL_DIR
+        };
+        read_reconstruction(&name_of(&args.recon), &files)
+            .with_context(|| format!("reconstruction '{}'", args.recon.join(part).display()))?
+    } else {
+        read_reconstruction_with_cameras(
+            &args.recon,
+            args.recon_cameras.as_deref(),
+            &name_of(&args.recon),
+        )?
+    };
     std::fs::create_dir_all(&args.out)
         .with_context(|| format!("creating the folder '{}'", args.out.display()))?;
     let points = recon.cloud.points.as_f64();

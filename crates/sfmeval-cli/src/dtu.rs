@@ -3,19 +3,21 @@
 
 use std::path::{Path, PathBuf};
 
-use anyhow::{Context as _, Result, bail};
+use anyhow::{Context as _, Result};
 use clap::{Args, ValueEnum};
-use sfmeval_dtu::{self as dtu, DtuInput, DtuOptions, DtuReport, DtuScan, NamedBytes, Shuffle};
-use sfmeval_fs::{read, write_atomic};
+use sfmeval_dtu::{self as dtu, DtuMode, DtuOptions, DtuReport, Shuffle};
+use sfmeval_fs::{DtuRun, run_dtu, write_atomic};
 
-/// How the reconstruction is read.
+use crate::progress::Bars;
+
+/// How a reconstruction with faces is read.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
-pub enum DtuMode {
-    /// A mesh when the PLY has faces, points otherwise.
+pub enum DtuModeArg {
+    /// A mesh when the reconstruction has faces, points otherwise.
     Auto,
     /// A mesh, sampled as the evaluator samples it (its vertices and a grid in each triangle).
     Mesh,
-    /// The PLY's vertices as points (faces ignored).
+    /// The vertices or points only (faces ignored).
     Pcd,
 }
 
@@ -29,12 +31,14 @@ pub struct DtuArgs {
     /// The scan number (24, 37, ...).
     #[arg(long, value_name = "N")]
     scan: u32,
-    /// The reconstruction, in the scan's frame and in mm: a PLY point cloud or mesh.
+    /// The reconstruction, in the scan's frame and in mm: a PLY point cloud or mesh, an OBJ or
+    /// glTF mesh, or an SfM model (COLMAP, NVM, Bundler, OpenMVG, cameras.json) whose 3D points
+    /// are evaluated, read as `sfmeval eval --recon` reads it.
     #[arg(long, value_name = "FILE")]
     recon: PathBuf,
     /// Whether the reconstruction is a mesh to sample or points.
-    #[arg(long, value_enum, default_value_t = DtuMode::Auto)]
-    mode: DtuMode,
+    #[arg(long, value_enum, default_value_t = DtuModeArg::Auto)]
+    mode: DtuModeArg,
     /// Down-sampling density (mm).
     #[arg(long, value_name = "MM", default_value_t = dtu::DOWNSAMPLE_DENSITY)]
     downsample_density: f64,
@@ -66,53 +70,6 @@ pub struct DtuArgs {
 
 /// Runs `sfmeval dtu`.
 pub fn dtu_cmd(args: &DtuArgs) -> Result<()> {
-    let files = [
-        dtu::scan::stl_path(args.scan),
-        dtu::scan::obs_mask_path(args.scan),
-        dtu::scan::plane_path(args.scan),
-    ]
-    .map(|rel| args.dataset.join(rel));
-    let [stl, obs, plane] = files.each_ref().map(|p| p.display().to_string());
-    let bytes = files
-        .iter()
-        .map(|p| read(p))
-        .collect::<Result<Vec<Vec<u8>>>>()?;
-    let scan = DtuScan::read(
-        NamedBytes {
-            name: &stl,
-            bytes: &bytes[0],
-        },
-        NamedBytes {
-            name: &obs,
-            bytes: &bytes[1],
-        },
-        NamedBytes {
-            name: &plane,
-            bytes: &bytes[2],
-        },
-    )?;
-    drop(bytes);
-    let recon_name = args.recon.display().to_string();
-    let ply = sfmeval::io::ply::read_ply(&read(&args.recon)?)
-        .with_context(|| format!("reconstruction '{recon_name}'"))?;
-    let mesh = match args.mode {
-        DtuMode::Auto => !ply.triangles.is_empty(),
-        DtuMode::Mesh => {
-            if ply.triangles.is_empty() {
-                bail!("reconstruction '{recon_name}': --mode mesh, but the PLY has no faces");
-            }
-            true
-        }
-        DtuMode::Pcd => false,
-    };
-    let input = if mesh {
-        DtuInput::Mesh {
-            vertices: ply.vertices.into_f64(),
-            triangles: ply.triangles,
-        }
-    } else {
-        DtuInput::Cloud(ply.vertices.into_f64())
-    };
     let options = DtuOptions {
         downsample_density: args.downsample_density,
         patch_size: args.patch_size,
@@ -124,24 +81,32 @@ pub fn dtu_cmd(args: &DtuArgs) -> Result<()> {
             Shuffle::Seeded(args.seed)
         },
     };
-    let evaluation = dtu::evaluate(&scan, input, &options)
-        .with_context(|| format!("reconstruction '{recon_name}'"))?;
-    let report = DtuReport::new(&evaluation, args.scan, &recon_name, mesh);
-    let json = report.to_json();
+    let run = DtuRun {
+        dataset: &args.dataset,
+        scan: args.scan,
+        recon: &args.recon,
+        mode: match args.mode {
+            DtuModeArg::Auto => DtuMode::Auto,
+            DtuModeArg::Mesh => DtuMode::Mesh,
+            DtuModeArg::Pcd => DtuMode::Pcd,
+        },
+        options,
+    };
+    let outputs = run_dtu(&run, &Bars::new(args.json))?;
     if let Some(path) = &args.report {
-        write_atomic(path, json.as_bytes())?;
+        write_atomic(path, outputs.json.as_bytes())?;
     }
     if let Some(dir) = &args.vis_out {
         std::fs::create_dir_all(dir)
             .with_context(|| format!("cannot create '{}'", dir.display()))?;
-        let (d2s, s2d) = dtu::vis::vis_names(args.scan);
-        write_atomic(&dir.join(d2s), &dtu::vis::d2s_ply(&evaluation))?;
-        write_atomic(&dir.join(s2d), &dtu::vis::s2d_ply(&evaluation, &scan.stl))?;
+        for (name, bytes) in outputs.vis_files() {
+            write_atomic(&dir.join(name), &bytes)?;
+        }
     }
     if args.json {
-        print!("{json}");
+        print!("{}", outputs.json);
     } else {
-        print!("{}", summary(&report, args.vis_out.as_deref()));
+        print!("{}", summary(&outputs.report, args.vis_out.as_deref()));
     }
     Ok(())
 }

@@ -17,3 +17,40 @@ pub use protocol::{
 };
 pub use report::{DTU_SCHEMA, DtuCounts, DtuReport, DtuReportOptions};
 pub use scan::{DtuScan, NamedBytes, ObsMask};
+
+/// How a reconstruction with faces is evaluated.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum DtuMode {
+    /// A mesh when the reconstruction has faces, points otherwise.
+    Auto,
+    /// A mesh, sampled as the evaluator samples it (its vertices and a grid in each triangle).
+    Mesh,
+    /// The vertices or points only (faces ignored).
+    Pcd,
+}
+
+impl DtuMode {
+    /// The mode's name as the CLI and the Python package spell it.
+    pub fn name(self) -> &'static str {
+        match self {
+            DtuMode::Auto => "auto",
+            DtuMode::Mesh => "mesh",
+            DtuMode::Pcd => "pcd",
+        }
+    }
+}
+
+impl std::str::FromStr for DtuMode {
+    type Err = sfmeval::Error;
+
+    fn from_str(s: &str) -> sfmeval::Result<DtuMode> {
+        match s {
+            "auto" => Ok(DtuMode::Auto),
+            "mesh" => Ok(DtuMode::Mesh),
+            "pcd" => Ok(DtuMode::Pcd),
+            _ => Err(sfmeval::Error::InvalidOption(format!(
+                "mode '{s}': expected auto, mesh or pcd"
+            ))),
+        }
+    }
+}

@@ -24,7 +24,7 @@ use rand::{Rng as _, SeedableRng as _};
 use rand_chacha::ChaCha8Rng;
 use sfmeval::distance::KdCloud;
 use sfmeval::geometry::Point3;
-use sfmeval::progress::NoProgress;
+use sfmeval::progress::{NoProgress, Progress, Stage};
 use sfmeval::{Error, Result, parallel};
 
 use crate::scan::DtuScan;
@@ -424,8 +424,14 @@ pub struct DtuEvaluation {
     pub overall: Option<f64>,
 }
 
-/// Runs the evaluation of `input` against `scan`.
-pub fn evaluate(scan: &DtuScan, input: DtuInput, options: &DtuOptions) -> Result<DtuEvaluation> {
+/// Runs the evaluation of `input` against `scan`, telling `progress` of its long stages
+/// (indexing the STL points, accuracy, indexing the reconstruction, completeness).
+pub fn evaluate(
+    scan: &DtuScan,
+    input: DtuInput,
+    options: &DtuOptions,
+    progress: &dyn Progress,
+) -> Result<DtuEvaluation> {
     options.validate()?;
     let mut points = match input {
         DtuInput::Cloud(p) => p,
@@ -497,14 +503,18 @@ pub fn evaluate(scan: &DtuScan, input: DtuInput, options: &DtuOptions) -> Result
     }
     let in_box = data_in.len();
 
+    progress.start(Stage::IndexGroundTruth, 1);
     let stl_index = KdCloud::new(&scan.stl)?;
+    progress.finish();
     let obs_points: Vec<Point3> = observed.iter().map(|&i| downsampled[i as usize]).collect();
+    progress.start(Stage::Accuracy, obs_points.len() as u64);
     let d2s: Vec<f64> =
-        parallel::map_points_with_state(&obs_points, &NoProgress, |start: &mut NearStart, p| {
+        parallel::map_points_with_state(&obs_points, progress, |start: &mut NearStart, p| {
             let (d, k) = stl_index.nearest_from(*p, start.0);
             start.0 = k;
             d
         });
+    progress.finish();
     drop(stl_index);
     drop(obs_points);
 
@@ -517,13 +527,17 @@ pub fn evaluate(scan: &DtuScan, input: DtuInput, options: &DtuOptions) -> Result
         .map(|i| i as u32)
         .collect();
     let above_points: Vec<Point3> = above.iter().map(|&i| scan.stl[i as usize]).collect();
+    progress.start(Stage::IndexReconstruction, 1);
     let data_index = KdCloud::new(&data_in)?;
+    progress.finish();
+    progress.start(Stage::Completeness, above_points.len() as u64);
     let s2d: Vec<f64> =
-        parallel::map_points_with_state(&above_points, &NoProgress, |start: &mut NearStart, p| {
+        parallel::map_points_with_state(&above_points, progress, |start: &mut NearStart, p| {
             let (d, k) = data_index.nearest_from(*p, start.0);
             start.0 = k;
             d
         });
+    progress.finish();
 
     let (mean_d2s, d2s_counted) = capped_mean(&d2s, options.max_dist);
     let (mean_s2d, s2d_counted) = capped_mean(&s2d, options.max_dist);

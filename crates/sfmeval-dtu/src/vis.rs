@@ -68,3 +68,10 @@ pub fn vis_names(scan: u32) -> (String, String) {
         format!("vis_{scan:03}_s2d.ply"),
     )
 }
+
+/// The evaluator's two coloured error clouds of evaluation `e` on scan number `scan` (`stl`
+/// its STL points), by file name: what every front end writes into its output folder.
+pub fn output_files(e: &DtuEvaluation, scan: u32, stl: &[Point3]) -> [(String, Vec<u8>); 2] {
+    let (d2s, s2d) = vis_names(scan);
+    [(d2s, d2s_ply(e)), (s2d, s2d_ply(e, stl))]
+}

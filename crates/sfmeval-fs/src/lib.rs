@@ -2,9 +2,11 @@
 //!
 //! The filesystem layer of the native front ends (the `sfmeval` CLI and `sfmeval-runner`): the
 //! core reads named bytes through [`sfmeval::files::FileSource`]; [`Disk`] is that source over
-//! the real filesystem, and [`write_atomic`] is the one way outputs reach the disk.
+//! the real filesystem, and [`write_atomic`] is the one way outputs reach the disk. [`run_dtu`] is `sfmeval dtu` on files: the scan's files and any reconstruction
+//! `sfmeval eval` reads, for the CLI, the Python package and the runner alike.
 
 mod disk;
+mod dtu;
 mod report_args;
 mod stream;
 mod write;
@@ -13,6 +15,7 @@ pub use disk::{
     Disk, IMAGE_EXTENSIONS, image_names, name_of, path_str, read, read_dataset, read_input_files,
     read_point_pairs, read_transform,
 };
+pub use dtu::{DtuOutputs, DtuRecon, DtuRun, read_dtu_recon, read_dtu_scan, run_dtu};
 pub use report_args::{named, pipeline_and_path};
 pub use stream::{read_reconstruction, read_reconstruction_with_cameras};
 pub use write::write_atomic;

@@ -5,9 +5,9 @@
 //! CLI reads them, arrays go in as the PLY file of the same numbers would be read; the request
 //! is the core's [`EvalRequest`] and the evaluation is [`pipeline::run_owned`], so the report
 //! JSON handed back is the CLI's `--report` file byte for byte. `read`, `align`, `cameras`,
-//! `tnt` and `table` (`verbs.rs`) are the CLI's verbs of those names on the same crates. The
-//! Python side (`python/sfmeval/__init__.py`) only wraps that JSON for attribute access and the
-//! per-point arrays in numpy; it computes nothing.
+//! `tnt`, `dtu` and `table` (`verbs.rs`) are the CLI's verbs of those names on the same
+//! crates. The Python side (`python/sfmeval/__init__.py`) only wraps that JSON for attribute
+//! access and the per-point arrays in numpy; it computes nothing.
 
 mod arrays;
 mod hooks;
@@ -561,6 +561,7 @@ fn _sfmeval(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(verbs::_cameras, m)?)?;
     m.add_function(wrap_pyfunction!(verbs::_poses, m)?)?;
     m.add_function(wrap_pyfunction!(verbs::_tnt, m)?)?;
+    m.add_function(wrap_pyfunction!(verbs::_dtu, m)?)?;
     m.add_function(wrap_pyfunction!(verbs::_table, m)?)?;
     m.add_function(wrap_pyfunction!(version, m)?)?;
     m.add_function(wrap_pyfunction!(align_modes, m)?)?;

@@ -1,6 +1,7 @@
 //! The CLI's other verbs for Python: `read` (what a file holds, as arrays), `cameras`
-//! (`sfmeval cameras`), `tnt` (`sfmeval tnt`) and `table` (`sfmeval table`), each reading its
-//! inputs as the CLI does so that its JSON or text is the CLI's byte for byte.
+//! (`sfmeval cameras`), `tnt` (`sfmeval tnt`), `dtu` (`sfmeval dtu`) and `table`
+//! (`sfmeval table`), each reading its inputs as the CLI does (`dtu` through the same
+//! `sfmeval_fs::run_dtu`) so that its JSON or text is the CLI's byte for byte.
 
 use std::path::{Path, PathBuf};
 
@@ -15,9 +16,10 @@ use sfmeval::pipeline::{self, ReconInput};
 use sfmeval::pose::{PoseOptions, Protocol, ProtocolOptions, evaluate_protocol};
 use sfmeval::report::Report;
 use sfmeval::transform::Similarity;
+use sfmeval_dtu::{DtuMode, DtuOptions, Shuffle};
 use sfmeval_fs::{
-    Disk, name_of, named, path_str, pipeline_and_path, read, read_input_files, read_transform,
-    write_atomic,
+    Disk, DtuRun, name_of, named, path_str, pipeline_and_path, read, read_input_files,
+    read_transform, run_dtu, write_atomic,
 };
 use sfmeval_table::{Row, failed_row, report_row, summary_json, tables};
 use sfmeval_tnt::{self as tnt, IcpCriteria, Registration, Scene, TntRequest};
@@ -455,4 +457,87 @@ pub(crate) fn _table<'py>(
         out.set_item(name, text)?;
     }
     Ok(out)
+}
+
+/// `sfmeval dtu`'s inputs.
+pub(crate) struct DtuInputs {
+    dataset: PathBuf,
+    scan: u32,
+    recon: PathBuf,
+    mode: DtuMode,
+    options: DtuOptions,
+    vis_out: Option<PathBuf>,
+    report: Option<PathBuf>,
+}
+
+/// `sfmeval dtu` on the same inputs: its report JSON, written to `report` and with the error
+/// clouds into `vis_out` when given, as the CLI writes them.
+fn dtu_of(d: &DtuInputs, progress: &dyn sfmeval::progress::Progress) -> Result<String, Failure> {
+    let run = DtuRun {
+        dataset: existing(&d.dataset)?,
+        scan: d.scan,
+        recon: existing(&d.recon)?,
+        mode: d.mode,
+        options: d.options,
+    };
+    let outputs = run_dtu(&run, progress)?;
+    if let Some(path) = &d.report {
+        write_atomic(path, outputs.json.as_bytes())?;
+    }
+    if let Some(dir) = &d.vis_out {
+        std::fs::create_dir_all(dir)
+            .with_context(|| format!("cannot create '{}'", dir.display()))?;
+        for (name, bytes) in outputs.vis_files() {
+            write_atomic(&dir.join(name), &bytes)?;
+        }
+    }
+    Ok(outputs.json)
+}
+
+/// `_dtu(dataset, scan, recon, ...)`: the report `sfmeval dtu --json` prints (written to
+/// `report`, and the error clouds into `vis_out`, when given). An option left `None` is the
+/// CLI's default; `shuffle=False` is `--no-shuffle`.
+#[pyfunction]
+#[pyo3(signature = (dataset, scan, recon, *, mode="auto", downsample_density=None,
+    patch_size=None, max_dist=None, visualize_threshold=None, seed=0, shuffle=true, vis_out=None,
+    report=None, threads=None, progress=None))]
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn _dtu(
+    py: Python<'_>,
+    dataset: PathBuf,
+    scan: u32,
+    recon: PathBuf,
+    mode: &str,
+    downsample_density: Option<f64>,
+    patch_size: Option<f64>,
+    max_dist: Option<f64>,
+    visualize_threshold: Option<f64>,
+    seed: u64,
+    shuffle: bool,
+    vis_out: Option<PathBuf>,
+    report: Option<PathBuf>,
+    threads: Option<usize>,
+    progress: Option<Py<PyAny>>,
+) -> PyResult<String> {
+    let mode: DtuMode = mode.parse().map_err(|e: sfmeval::Error| Failure::from(e))?;
+    let inputs = DtuInputs {
+        dataset,
+        scan,
+        recon,
+        mode,
+        options: DtuOptions {
+            downsample_density: downsample_density.unwrap_or(sfmeval_dtu::DOWNSAMPLE_DENSITY),
+            patch_size: patch_size.unwrap_or(sfmeval_dtu::PATCH_SIZE),
+            max_dist: max_dist.unwrap_or(sfmeval_dtu::MAX_DIST),
+            visualize_threshold: visualize_threshold.unwrap_or(sfmeval_dtu::VISUALIZE_THRESHOLD),
+            shuffle: if shuffle {
+                Shuffle::Seeded(seed)
+            } else {
+                Shuffle::None
+            },
+        },
+        vis_out,
+        report,
+    };
+    hooks::run(py, threads, progress, |p| dtu_of(&inputs, p))
 }

@@ -126,6 +126,33 @@ def test_an_exception_in_the_progress_callback_stops_the_evaluation():
     assert sfmeval.evaluate(**DEMO_ARGS, samples=10_000).accuracy.count == 2529
 
 
+def test_dtu_has_the_threads_and_progress_of_the_other_verbs():
+    dtu = ROOT / "tests/fixtures/dtu"
+    args = (dtu, 1, dtu / "mesh.ply")
+    calls = []
+    r = sfmeval.dtu(*args, threads=1, progress=lambda stage, f: calls.append((stage, f)))
+    stages = list(dict.fromkeys(s for s, _ in calls))
+    assert stages == ["indexing ground truth", "accuracy (recon → GT)",
+                      "indexing reconstruction", "completeness (GT → recon)"], stages
+    for stage in stages:
+        fractions = [f for s, f in calls if s == stage]
+        assert fractions[0] == 0.0 and fractions[-1] == 1.0, (stage, fractions)
+    assert len([f for s, f in calls if s.startswith("accuracy")]) > 10
+    assert r.to_json() == sfmeval.dtu(*args, threads=2).to_json()
+
+    class Stop(Exception):
+        pass
+
+    def stop(stage, fraction):
+        if stage.startswith("accuracy"):
+            raise Stop(stage)
+
+    with pytest.raises(Stop):
+        sfmeval.dtu(*args, progress=stop)
+    with pytest.raises(sfmeval.InputError, match="threads"):
+        sfmeval.dtu(*args, threads=0)
+
+
 CHILD = """
 import signal, sys, time, sfmeval
 # Python's own Ctrl-C handler even where the parent left SIGINT ignored (a shell's background

@@ -1,7 +1,7 @@
 """The package's geometry in memory and its other verbs against the CLI, run with the built
 wheel installed (scripts/check-python-package.sh): arrays give the report of the PLY file of the
-same numbers, and read / align / cameras / tnt / table give what `sfmeval export`, `align`,
-`cameras`, `tnt` and `table` write, byte for byte.
+same numbers, and read / align / cameras / tnt / dtu / table give what `sfmeval export`,
+`align`, `cameras`, `tnt`, `dtu` and `table` write, byte for byte.
 
 SFMEVAL_BIN: the CLI (default target/release/sfmeval).
 """
@@ -25,6 +25,7 @@ DEMO = ROOT / "data/demo"
 CORE = ROOT / "tests/fixtures/core"
 MODELS = ROOT / "tests/fixtures/models"
 TNT = ROOT / "tests/fixtures/tanksandtemples"
+DTU = ROOT / "tests/fixtures/dtu"
 # the demo model's gt_from_recon by camera centres, to 12 digits
 DEMO_START = [[0.24393526577, -0.299850123721, 0.298600929354, 0.00184377389897],
               [-0.000514897229959, -0.34487005783, -0.34589218506, 1.18191757912],
@@ -348,6 +349,78 @@ def test_tnt_errors_name_the_file(tmp_path):
         sfmeval.tnt(scene, DEMO / "sparse.ply", tau=0.01)
     with pytest.raises(FileNotFoundError):
         sfmeval.tnt(tmp_path / "nothing", DEMO / "sparse.ply", trajectory=bad)
+
+
+# ---- dtu ----------------------------------------------------------------------------------
+
+def write_colmap_points(folder: Path, points: np.ndarray) -> Path:
+    """A COLMAP text model holding only these 3D points (ids 1..n, no camera), written here
+    with repr() so that the reader gets the same doubles."""
+    folder.mkdir(parents=True)
+    (folder / "cameras.txt").write_text("# Camera list\n")
+    (folder / "images.txt").write_text("# Image list\n")
+    (folder / "points3D.txt").write_text("".join(
+        f"{i + 1} {float(x)!r} {float(y)!r} {float(z)!r} 128 128 128 0.5\n"
+        for i, (x, y, z) in enumerate(points)))
+    return folder
+
+
+@pytest.mark.parametrize("recon, kwargs, flags", [
+    ("sparse.ply", {}, []),
+    ("dense.ply", {"shuffle": False}, ["--no-shuffle"]),
+    ("dense.ply", {"seed": 3, "max_dist": 5.0}, ["--seed", 3, "--max-dist", 5.0]),
+    ("mesh.ply", {"mode": "mesh", "downsample_density": 0.5},
+     ["--mode", "mesh", "--downsample-density", 0.5]),
+    ("mesh.ply", {"mode": "pcd"}, ["--mode", "pcd"]),
+])
+def test_dtu_is_the_clis_report_and_error_clouds(tmp_path, recon, kwargs, flags):
+    cli_vis, py_vis = tmp_path / "cli", tmp_path / "py"
+    p = cli("dtu", "--dataset", DTU, "--scan", 1, "--recon", DTU / recon, *flags, "--json",
+            "--vis-out", cli_vis, "--report", tmp_path / "cli.json")
+    r = sfmeval.dtu(DTU, 1, DTU / recon, vis_out=py_vis, report=tmp_path / "py.json", **kwargs)
+    assert r.to_json() == p.stdout
+    assert (tmp_path / "py.json").read_bytes() == (tmp_path / "cli.json").read_bytes()
+    names = sorted(f.name for f in cli_vis.iterdir())
+    assert names == ["vis_001_d2s.ply", "vis_001_s2d.ply"]
+    assert sorted(f.name for f in py_vis.iterdir()) == names
+    for name in names:
+        assert (py_vis / name).read_bytes() == (cli_vis / name).read_bytes(), name
+    assert r.scan == 1 and r.mode == ("mesh" if kwargs.get("mode") == "mesh" else "pcd")
+    assert 0 < r.mean_accuracy < r.options.max_dist and r.overall == r.to_dict()["overall"]
+    # without vis_out and report nothing is written, and the numbers are the same
+    assert sfmeval.dtu(DTU, 1, str(DTU / recon), **kwargs).to_json() == p.stdout
+
+
+def test_dtu_of_an_sfm_model_is_that_of_its_points(tmp_path):
+    """A COLMAP model's 3D points give the numbers of the PLY of the same points."""
+    points = sfmeval.read(DTU / "sparse.ply").points.astype(np.float64)
+    model = write_colmap_points(tmp_path / "model", points)
+    p = cli("dtu", "--dataset", DTU, "--scan", 1, "--recon", model, "--json")
+    r = sfmeval.dtu(DTU, 1, model)
+    assert r.to_json() == p.stdout and r.reconstruction == str(model)
+    ply = sfmeval.dtu(DTU, 1, DTU / "sparse.ply").to_dict()
+    assert {**r.to_dict(), "reconstruction": ply["reconstruction"]} == ply
+
+
+def test_dtu_errors_are_the_clis(tmp_path):
+    with pytest.raises(FileNotFoundError):
+        sfmeval.dtu(tmp_path / "nothing", 1, DTU / "sparse.ply")
+    with pytest.raises(FileNotFoundError):
+        sfmeval.dtu(DTU, 1, tmp_path / "nothing.ply")
+    with pytest.raises(sfmeval.InputError) as e:
+        sfmeval.dtu(DTU, 2, DTU / "sparse.ply")
+    assert "stl002_total.ply" in str(e.value)
+    assert str(e.value) == cli_error("dtu", "--dataset", DTU, "--scan", 2, "--recon",
+                                     DTU / "sparse.ply")
+    with pytest.raises(sfmeval.InputError) as e:
+        sfmeval.dtu(DTU, 1, DTU / "sparse.ply", mode="mesh")
+    assert str(DTU / "sparse.ply") in str(e.value) and "no faces" in str(e.value)
+    with pytest.raises(sfmeval.InputError, match="mode 'faces'"):
+        sfmeval.dtu(DTU, 1, DTU / "mesh.ply", mode="faces")
+    with pytest.raises(sfmeval.InputError, match="patch_size|patch size"):
+        sfmeval.dtu(DTU, 1, DTU / "sparse.ply", patch_size=-1.0)
+    with pytest.raises(TypeError):
+        sfmeval.dtu(DTU, 1, DTU / "sparse.ply", vis_out=3)  # type: ignore[arg-type]
 
 
 # ---- table --------------------------------------------------------------------------------

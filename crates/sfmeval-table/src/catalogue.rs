@@ -136,6 +136,7 @@ const fn metric(
 }
 
 const M: Option<&str> = Some("m");
+const MM: Option<&str> = Some("mm");
 const LOWER: Option<Best> = Some(Best::Lower);
 const HIGHER: Option<Best> = Some(Best::Higher);
 
@@ -480,9 +481,40 @@ pub const CATALOGUE: &[Metric] = &[
         Some(3),
         Source::Document,
     ),
+    metric(
+        "report.mean_accuracy",
+        "dtu_accuracy",
+        "DTU accuracy",
+        MM,
+        "DTU: mean accuracy (mm)",
+        LOWER,
+        Some(3),
+        Source::Number(|r, _| r.dtu.as_ref().and_then(|d| d.mean_accuracy)),
+    ),
+    metric(
+        "report.mean_completeness",
+        "dtu_completeness",
+        "DTU completeness",
+        MM,
+        "DTU: mean completeness (mm)",
+        LOWER,
+        Some(3),
+        Source::Number(|r, _| r.dtu.as_ref().and_then(|d| d.mean_completeness)),
+    ),
+    metric(
+        "report.overall",
+        "dtu_overall",
+        "DTU overall",
+        MM,
+        "DTU: overall, the mean of accuracy and completeness (mm)",
+        LOWER,
+        Some(3),
+        Source::Number(|r, _| r.dtu.as_ref().and_then(|d| d.overall)),
+    ),
 ];
 
-/// The wide table's columns (`runs.csv`, `table.md`, the runner's page), in order.
+/// The wide table's columns (`runs.csv`, `table.md`, the runner's page), in order; [`WIDE_DTU`]
+/// follows the per-threshold columns when a row has DTU numbers.
 pub const WIDE: &[&str] = &[
     "run.dataset",
     "run.pipeline",
@@ -504,6 +536,14 @@ pub const WIDE: &[&str] = &[
     "run.peak_memory_mb",
     "run.tool",
     "run.reason",
+];
+
+/// The DTU protocol's columns of the wide table (`sfmeval.dtu/1` keys), shown when some row
+/// was evaluated on a DTU scan.
+pub const WIDE_DTU: &[&str] = &[
+    "report.mean_accuracy",
+    "report.mean_completeness",
+    "report.overall",
 ];
 
 /// The page's Compare table's columns, in order (per-threshold ones grouped by threshold).
@@ -585,7 +625,7 @@ mod tests {
 
     #[test]
     fn every_list_names_catalogue_metrics_once() {
-        for list in [WIDE, COMPARE, SWEEP, SWEEP_VISIBILITY] {
+        for list in [WIDE, WIDE_DTU, COMPARE, SWEEP, SWEEP_VISIBILITY] {
             assert_eq!(metrics_of(list).len(), list.len(), "{list:?}");
         }
         for (i, m) in CATALOGUE.iter().enumerate() {

@@ -1,7 +1,7 @@
 //! What the table cells say: Table I's `mean (points)` or the failure, and the wide table's
 //! columns and values (shared by Markdown, CSV and HTML).
 
-use crate::catalogue::{Metric, Source, WIDE, metrics_of, short};
+use crate::catalogue::{Metric, Source, WIDE, WIDE_DTU, metrics_of, short};
 use crate::order::find;
 use crate::row::Row;
 
@@ -9,9 +9,10 @@ use crate::row::Row;
 pub fn table1_cell(r: Option<&Row>) -> String {
     match r {
         None => "—".into(),
-        Some(r) => match r.mean {
-            Some(m) => format!("{m:.6} ({})", r.points),
-            None => {
+        Some(r) => match (r.mean, r.dtu.as_ref().and_then(|d| d.overall)) {
+            (Some(m), _) => format!("{m:.6} ({})", r.points),
+            (None, Some(overall)) => format!("{overall:.3} mm DTU overall ({})", r.points),
+            (None, None) => {
                 let reason = short(r.reason.as_deref().unwrap_or(""));
                 if reason.starts_with(&r.status) {
                     reason
@@ -33,9 +34,36 @@ pub fn csv_num(v: Option<f64>) -> String {
     v.map(|x| format!("{x}")).unwrap_or_default()
 }
 
-/// The wide table's metrics ([`WIDE`] of the catalogue).
-fn wide_metrics() -> Vec<&'static Metric> {
-    metrics_of(WIDE)
+/// What the wide table's columns depend on: the number of thresholds (the most any row has)
+/// and whether some row has DTU numbers.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct WideShape {
+    /// Thresholds of the per-threshold columns.
+    pub n_tau: usize,
+    /// Whether the DTU columns ([`WIDE_DTU`]) are shown.
+    pub dtu: bool,
+}
+
+/// The wide table's shape for `rows`.
+pub fn wide_shape(rows: &[Row]) -> WideShape {
+    WideShape {
+        n_tau: n_tau(rows),
+        dtu: rows.iter().any(|r| r.dtu.is_some()),
+    }
+}
+
+/// The wide table's metrics ([`WIDE`] of the catalogue, with [`WIDE_DTU`] after the
+/// per-threshold ones when `dtu`).
+fn wide_metrics(dtu: bool) -> Vec<&'static Metric> {
+    let mut keys: Vec<&str> = WIDE.to_vec();
+    if dtu {
+        let after = keys
+            .iter()
+            .rposition(|k| k.contains("[*]"))
+            .map_or(keys.len(), |i| i + 1);
+        keys.splice(after..after, WIDE_DTU.iter().copied());
+    }
+    metrics_of(&keys)
 }
 
 /// The thresholds in percent of the diagonal that name per-threshold columns: the first row's
@@ -57,7 +85,7 @@ fn threshold_percents(rows: &[Row]) -> Vec<f64> {
 pub fn wide_columns(rows: &[Row]) -> Vec<String> {
     let pcts = threshold_percents(rows);
     let mut cols = Vec::new();
-    for_columns(&wide_metrics(), pcts.len(), |m, k| {
+    for_columns(&wide_metrics(wide_shape(rows).dtu), pcts.len(), |m, k| {
         cols.push(m.header_with_unit(k.map(|k| pcts[k])));
     });
     cols
@@ -90,10 +118,10 @@ pub(crate) fn for_columns(
 }
 
 /// One row's values in the wide table: numbers rounded for Markdown and HTML (the catalogue's
-/// decimals), in full for CSV (`csv`), with `n_tau` thresholds.
-pub fn wide_values(r: &Row, n_tau: usize, csv: bool) -> Vec<String> {
+/// decimals), in full for CSV (`csv`), in the table's `shape`.
+pub fn wide_values(r: &Row, shape: WideShape, csv: bool) -> Vec<String> {
     let mut v = Vec::new();
-    for_columns(&wide_metrics(), n_tau, |m, k| {
+    for_columns(&wide_metrics(shape.dtu), shape.n_tau, |m, k| {
         v.push(cell_text(m, r, k.unwrap_or(0), csv));
     });
     v
@@ -127,12 +155,12 @@ pub fn wide_for_html(
     datasets: &[String],
     pipes: &[String],
 ) -> (Vec<String>, Vec<(String, Vec<String>)>) {
-    let nt = n_tau(rows);
+    let shape = wide_shape(rows);
     let mut out = Vec::new();
     for d in datasets {
         for p in pipes {
             if let Some(r) = find(rows, d, p) {
-                out.push((r.status.clone(), wide_values(r, nt, false)));
+                out.push((r.status.clone(), wide_values(r, shape, false)));
             }
         }
     }

@@ -18,6 +18,19 @@ pub struct Prf {
     pub f_score: f64,
 }
 
+/// The DTU protocol's numbers of a run on a DTU scan (`sfmeval.dtu/1`, in mm).
+#[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
+pub struct DtuNumbers {
+    /// The scan number.
+    pub scan: u32,
+    /// Mean accuracy (reconstruction → STL points, observed points, capped), mm.
+    pub mean_accuracy: Option<f64>,
+    /// Mean completeness (STL points above the plane → reconstruction, capped), mm.
+    pub mean_completeness: Option<f64>,
+    /// The mean of the two, mm.
+    pub overall: Option<f64>,
+}
+
 /// One run in the comparison.
 #[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
 pub struct Row {
@@ -72,4 +85,8 @@ pub struct Row {
     /// for a run that was not evaluated. Table I's caption names it.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub alignment: Option<String>,
+    /// The DTU protocol's numbers, for a run on a DTU scan (its other distance fields are then
+    /// none: the protocol's report has no per-point distances in metres).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub dtu: Option<DtuNumbers>,
 }

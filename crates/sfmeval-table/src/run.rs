@@ -5,7 +5,7 @@
 use serde::{Deserialize, Serialize};
 use sfmeval::report::Report;
 
-use crate::row::{Prf, Row};
+use crate::row::{DtuNumbers, Prf, Row};
 
 /// Schema id of run.json.
 pub const RUN_SCHEMA: &str = "sfmeval.run/1";
@@ -152,6 +152,7 @@ pub fn base_row(rec: &RunFacts) -> Row {
         cdf: Vec::new(),
         report: None,
         alignment: None,
+        dtu: None,
     }
 }
 
@@ -243,6 +244,17 @@ pub fn tnt_row(
         f_score: report.f_score,
     }];
     row.cdf = cdf_points(precision_distances);
+    row.report = Some(report_path(&rec.dataset, &rec.pipeline));
+    row
+}
+
+/// The row of a run evaluated with the DTU protocol (`sfmeval.dtu/1` numbers, `points` the
+/// reconstruction's points before down-sampling) after the camera alignment its report names.
+pub fn dtu_row(rec: &RunFacts, numbers: DtuNumbers, points: u64, alignment: &str) -> Row {
+    let mut row = base_row(rec);
+    row.alignment = Some(alignment.to_string());
+    row.points = points;
+    row.dtu = Some(numbers);
     row.report = Some(report_path(&rec.dataset, &rec.pipeline));
     row
 }

@@ -3,7 +3,7 @@
 
 use serde::Serialize;
 
-use crate::cells::{csv_num, n_tau, table1_cell, wide_columns, wide_values};
+use crate::cells::{csv_num, table1_cell, wide_columns, wide_shape, wide_values};
 use crate::csv::CsvWriter;
 use crate::order::{dataset_order, find, pipeline_order};
 use crate::row::Row;
@@ -40,8 +40,13 @@ pub fn tables(rows: &[Row]) -> Tables {
         }
         t1.push('\n');
     }
+    let dtu_note = if rows.iter().any(|r| r.dtu.is_some()) {
+        " On a DTU scan the cell is the DTU protocol's overall in mm (the mean of its accuracy and completeness)."
+    } else {
+        ""
+    };
     let t1_md = format!(
-        "# Table I: mean distance to the ground truth (m) and number of points\n\nEach cell: mean reconstruction → ground-truth distance in metres (after {}), and in parentheses the number of points; failed runs show why.\n\n{t1}",
+        "# Table I: mean distance to the ground truth (m) and number of points\n\nEach cell: mean reconstruction → ground-truth distance in metres (after {}), and in parentheses the number of points; failed runs show why.{dtu_note}\n\n{t1}",
         alignment_caption(rows)
     );
     let mut csv = CsvWriter::new();
@@ -75,7 +80,7 @@ pub fn tables(rows: &[Row]) -> Tables {
     let table1_csv = csv.finish();
     // Wide table.
     let cols = wide_columns(rows);
-    let nt = n_tau(rows);
+    let shape = wide_shape(rows);
     let mut ordered: Vec<&Row> = Vec::new();
     for d in &datasets {
         for p in &pipes {
@@ -86,12 +91,15 @@ pub fn tables(rows: &[Row]) -> Tables {
     }
     let mut wide = format!("| {} |\n|{}\n", cols.join(" | "), "---|".repeat(cols.len()));
     for r in &ordered {
-        wide.push_str(&format!("| {} |\n", wide_values(r, nt, false).join(" | ")));
+        wide.push_str(&format!(
+            "| {} |\n",
+            wide_values(r, shape, false).join(" | ")
+        ));
     }
     let mut wcsv = CsvWriter::new();
     wcsv.record(&cols);
     for r in &ordered {
-        wcsv.record(wide_values(r, nt, true));
+        wcsv.record(wide_values(r, shape, true));
     }
     let table_md = format!(
         "{t1_md}\n# All runs\n\nP/R/F at thresholds in % of the ground-truth bounding-box diagonal; camera errors after the same alignment, centre errors also in % of the scene radius (mean distance of the ground-truth cameras from their centroid).\n\n{wide}"
@@ -225,6 +233,40 @@ mod tests {
         assert!(tables(&rows).table1_md.contains(
             "(after each run's own alignment: `given` alignment or the Tanks and Temples protocol's registration)"
         ));
+    }
+
+    #[test]
+    fn dtu_rows_add_the_dtu_columns_and_their_overall_in_table_one() {
+        let plain = vec![row("a", "colmap", Some(0.25))];
+        assert!(!tables(&plain).runs_csv.contains("DTU"));
+        let mut dtu = row("scan1", "zz", None);
+        dtu.status = "ok".into();
+        dtu.reason = None;
+        dtu.dtu = Some(crate::row::DtuNumbers {
+            scan: 1,
+            mean_accuracy: Some(0.5),
+            mean_completeness: Some(1.25),
+            overall: Some(0.875),
+        });
+        let rows = vec![row("a", "colmap", Some(0.25)), dtu];
+        let t = tables(&rows);
+        let lines: Vec<&str> = t.runs_csv.lines().collect();
+        assert!(
+            lines[0].contains(",F@0.5%,DTU accuracy (mm),DTU completeness (mm),DTU overall (mm),"),
+            "{}",
+            lines[0]
+        );
+        assert!(lines[1].contains(",0.3333333333333333,,,,"), "{}", lines[1]);
+        assert!(lines[2].contains(",,,,0.5,1.25,0.875,"), "{}", lines[2]);
+        assert!(
+            t.table1_md
+                .contains("| scan1 | — | 0.875 mm DTU overall (100) |")
+        );
+        assert!(t.table1_md.contains("DTU protocol's overall in mm"));
+        assert!(t.table_md.contains("| 0.500 | 1.250 | 0.875 |"));
+        // the summary keeps the numbers; rows without them have no `dtu` key
+        let s = summary_json(&rows).unwrap();
+        assert_eq!(s.matches("\"dtu\"").count(), 1);
     }
 
     #[test]

@@ -246,7 +246,7 @@ impl Plan {
     }
 
     /// `table1`: one dataset per preset, rendered, then the `--scene` folders (Tanks and
-    /// Temples scenes) as they are.
+    /// Temples scenes, DTU scans) as they are.
     pub fn table1(a: &Table1Args) -> Result<Plan> {
         a.exec.check()?;
         let mut datasets: Vec<DatasetPlan> = Vec::new();
@@ -260,9 +260,11 @@ impl Plan {
         }
         for scene in &a.scenes {
             let ds = Dataset::open(scene)?;
-            if !crate::tnt::is_scene(&ds.dir, &ds.name) {
+            if !crate::tnt::is_scene(&ds.dir, &ds.name)
+                && crate::dtu::scan_number(&ds.dir).is_none()
+            {
                 bail!(
-                    "--scene {}: no {name}_trans.txt and {name}_COLMAP_SfM.log in it (the Tanks and Temples layout, folder named after the scene)",
+                    "--scene {}: neither a Tanks and Temples scene (no {name}_trans.txt and {name}_COLMAP_SfM.log in it, folder named after the scene) nor a DTU scan (no Points/stl/stlNNN_total.ply with ObsMask/ObsMaskN_10.mat and ObsMask/PlaneN.mat)",
                     scene.display(),
                     name = ds.name
                 );

@@ -3,7 +3,7 @@
 The Python face of the sfmeval core (Rust): ``evaluate`` reads the files as the ``sfmeval``
 CLI reads them (arrays as the PLY file of the same numbers) and runs the core's evaluation, so
 ``Report.to_json()`` is byte for byte the report ``sfmeval eval --report`` writes for the same
-inputs; ``align``, ``cameras``, ``tnt`` and ``table`` are the CLI's verbs of those names and
+inputs; ``align``, ``cameras``, ``tnt``, ``dtu`` and ``table`` are the CLI's verbs of those names and
 ``read`` gives a file's geometry as numpy arrays. Nothing here computes a number: the results
 give attribute access to the core's JSON and numpy views of the per-point arrays.
 """
@@ -19,13 +19,14 @@ from typing import (
 import numpy as np
 
 from ._sfmeval import (
-    InputError, _align, _cameras, _evaluate, _poses, _read, _table, _tnt, align_modes, version,
+    InputError, _align, _cameras, _dtu, _evaluate, _poses, _read, _table, _tnt, align_modes,
+    version,
 )
 
 __all__ = [
-    "Alignment", "CamerasReport", "InputError", "Mesh", "Model", "Note", "PathLike", "PointCloud",
-    "PosesReport", "Progress", "Report", "Section", "Tables", "TntReport", "align", "align_modes",
-    "cameras", "evaluate", "poses", "read", "table", "tnt", "version",
+    "Alignment", "CamerasReport", "DtuReport", "InputError", "Mesh", "Model", "Note", "PathLike",
+    "PointCloud", "PosesReport", "Progress", "Report", "Section", "Tables", "TntReport", "align",
+    "align_modes", "cameras", "dtu", "evaluate", "poses", "read", "table", "tnt", "version",
 ]
 __version__: str = version()
 
@@ -279,6 +280,18 @@ class TntReport(_JsonResult):
 
     def to_json(self) -> str:
         """The ``report.json`` of ``sfmeval tnt``, byte for byte."""
+        return self._json
+
+
+class DtuReport(_JsonResult):
+    """A ``sfmeval.dtu/1`` report (``mean_accuracy``, ``mean_completeness``, ``overall`` in mm,
+    ``counts``, ``options``, ``mode``). ``to_json()`` is what ``sfmeval dtu --json`` prints and
+    ``--report`` writes."""
+
+    __slots__ = ()
+
+    def to_json(self) -> str:
+        """The report of ``sfmeval dtu``, byte for byte."""
         return self._json
 
 
@@ -760,6 +773,60 @@ def tnt(
         trajectory=_path(trajectory, "trajectory"), transform_path=transform_path,
         transform_text=transform_text, tau=tau, seed=seed, out=_path(out, "out"),
         threads=threads, progress=progress,
+    ))
+
+
+def dtu(
+    dataset: PathLike,
+    scan: int,
+    recon: PathLike,
+    *,
+    mode: str = "auto",
+    downsample_density: Optional[float] = None,
+    patch_size: Optional[float] = None,
+    max_dist: Optional[float] = None,
+    visualize_threshold: Optional[float] = None,
+    seed: int = 0,
+    shuffle: bool = True,
+    vis_out: Optional[PathLike] = None,
+    report: Optional[PathLike] = None,
+    threads: Optional[int] = None,
+    progress: Optional[Progress] = None,
+) -> DtuReport:
+    """The DTU MVS evaluation (``sfmeval dtu``) of a reconstruction on a scan, as the
+    benchmark's Python port (DTUeval-python) computes it: mean accuracy, mean completeness and
+    overall, in mm. ``to_json()`` is the report ``sfmeval dtu --json`` prints.
+
+    dataset
+        The ground-truth folder as the benchmark ships it: Points/stl/stlNNN_total.ply,
+        ObsMask/ObsMaskN_10.mat and ObsMask/PlaneN.mat.
+    scan
+        The scan number (24, 37, ...).
+    recon
+        The reconstruction, in the scan's frame and in mm: a PLY point cloud or mesh, an OBJ
+        or glTF mesh, or an SfM model (COLMAP, NVM, Bundler, OpenMVG, cameras.json) whose 3D
+        points are evaluated. Its path as given is its name in the report.
+    mode
+        ``"auto"`` (a mesh when it has faces), ``"mesh"`` (sampled as the evaluator samples
+        it) or ``"pcd"`` (the points or vertices only).
+    downsample_density, patch_size, max_dist, visualize_threshold
+        The protocol's options in mm (default: the CLI's, 0.2, 60, 20 and 10).
+    seed, shuffle
+        The seed of the shuffle before down-sampling; ``shuffle=False`` down-samples in the
+        input's order (``--no-shuffle``).
+    vis_out
+        Write the evaluator's coloured error clouds vis_NNN_d2s.ply and vis_NNN_s2d.ply here.
+    report
+        Write the report here.
+    threads, progress
+        As ``evaluate``'s.
+    """
+    return DtuReport(_dtu(
+        os.fspath(dataset), scan, os.fspath(recon), mode=mode,
+        downsample_density=downsample_density, patch_size=patch_size, max_dist=max_dist,
+        visualize_threshold=visualize_threshold, seed=seed, shuffle=shuffle,
+        vis_out=_path(vis_out, "vis_out"), report=_path(report, "report"), threads=threads,
+        progress=progress,
     ))
 
 

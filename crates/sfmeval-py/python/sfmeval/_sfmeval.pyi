@@ -80,6 +80,23 @@ def _tnt(
     threads: Optional[int] = ...,
     progress: Optional[Callable[[str, float], Any]] = ...,
 ) -> str: ...
+def _dtu(
+    dataset: str,
+    scan: int,
+    recon: str,
+    *,
+    mode: str = ...,
+    downsample_density: Optional[float] = ...,
+    patch_size: Optional[float] = ...,
+    max_dist: Optional[float] = ...,
+    visualize_threshold: Optional[float] = ...,
+    seed: int = ...,
+    shuffle: bool = ...,
+    vis_out: Optional[str] = ...,
+    report: Optional[str] = ...,
+    threads: Optional[int] = ...,
+    progress: Optional[Callable[[str, float], Any]] = ...,
+) -> str: ...
 def _table(reports: List[str], dataset: Optional[str] = ..., failed: List[str] = ...) -> Dict[str, str]: ...
 def version() -> str: ...
 def align_modes() -> List[str]: ...
