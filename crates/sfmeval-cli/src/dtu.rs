@@ -3,9 +3,9 @@
 
 use std::path::{Path, PathBuf};
 
-use anyhow::{Context as _, Result, bail};
+use anyhow::{Context as _, Result};
 use clap::{Args, ValueEnum};
-use sfmeval_dtu::{self as dtu, DtuInput, DtuOptions, DtuReport, DtuScan, NamedBytes, Shuffle};
+use sfmeval_dtu::{self as dtu, DtuOptions, DtuReport, DtuScan, NamedBytes, ReconMode, Shuffle};
 use sfmeval_fs::{read, write_atomic};
 
 /// How the reconstruction is read.
@@ -93,26 +93,13 @@ pub fn dtu_cmd(args: &DtuArgs) -> Result<()> {
     )?;
     drop(bytes);
     let recon_name = args.recon.display().to_string();
-    let ply = sfmeval::io::ply::read_ply(&read(&args.recon)?)
+    let mode = match args.mode {
+        DtuMode::Auto => ReconMode::Auto,
+        DtuMode::Mesh => ReconMode::Mesh,
+        DtuMode::Pcd => ReconMode::Pcd,
+    };
+    let (input, mesh) = dtu::read_reconstruction(&read(&args.recon)?, mode)
         .with_context(|| format!("reconstruction '{recon_name}'"))?;
-    let mesh = match args.mode {
-        DtuMode::Auto => !ply.triangles.is_empty(),
-        DtuMode::Mesh => {
-            if ply.triangles.is_empty() {
-                bail!("reconstruction '{recon_name}': --mode mesh, but the PLY has no faces");
-            }
-            true
-        }
-        DtuMode::Pcd => false,
-    };
-    let input = if mesh {
-        DtuInput::Mesh {
-            vertices: ply.vertices.into_f64(),
-            triangles: ply.triangles,
-        }
-    } else {
-        DtuInput::Cloud(ply.vertices.into_f64())
-    };
     let options = DtuOptions {
         downsample_density: args.downsample_density,
         patch_size: args.patch_size,
@@ -146,40 +133,8 @@ pub fn dtu_cmd(args: &DtuArgs) -> Result<()> {
     Ok(())
 }
 
-fn mm(v: Option<f64>) -> String {
-    v.map_or_else(
-        || "none (no distance below max_dist)".into(),
-        |v| format!("{v:.6} mm"),
-    )
-}
-
 fn summary(r: &DtuReport, vis: Option<&Path>) -> String {
-    let c = &r.counts;
-    let mut s = format!(
-        "DTU evaluation, scan {} ({}: {} points, {} after down-sampling to {} mm, {} in the bounding box, {} observed)\n",
-        r.scan,
-        r.mode,
-        c.points,
-        c.downsampled,
-        r.options.downsample_density,
-        c.in_bounding_box,
-        c.observed
-    );
-    s += &format!(
-        "  mean accuracy      {}  ({} of {} distances below {} mm)\n",
-        mm(r.mean_accuracy),
-        c.accuracy_below_max_dist,
-        c.observed,
-        r.options.max_dist
-    );
-    s += &format!(
-        "  mean completeness  {}  ({} of {} STL points above the plane below {} mm)\n",
-        mm(r.mean_completeness),
-        c.completeness_below_max_dist,
-        c.stl_above_plane,
-        r.options.max_dist
-    );
-    s += &format!("  overall            {}\n", mm(r.overall));
+    let mut s = r.summary();
     if let Some(dir) = vis {
         s += &format!("  error clouds written to {}\n", dir.display());
     }

@@ -5,12 +5,14 @@
 //! mesh, the down-sampling, the bounding box and observation-mask filtering, accuracy and
 //! completeness capped at 20 mm, and the coloured error clouds.
 
+pub mod files;
 pub mod mat;
 mod protocol;
 mod report;
 pub mod scan;
 pub mod vis;
 
+pub use files::{DtuFiles, ReconMode, read_reconstruction, recognise};
 pub use protocol::{
     DOWNSAMPLE_DENSITY, DtuEvaluation, DtuInput, DtuOptions, MAX_DIST, PATCH_SIZE, Shuffle,
     VISUALIZE_THRESHOLD, evaluate, pairwise_sum, radius_filter, sample_mesh, shuffle,
