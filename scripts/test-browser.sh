@@ -9,7 +9,8 @@
 # reports equal the CLI's, and without the headers the single-thread fallback; tests/browser/dense.mjs:
 # a dense PLY streamed into the page, a too-large one refused; tests/browser/ux.mjs:
 # layout at 1366×768 and 1920×1080, errors in view, keyboard, axe-core, cancel; tests/browser/compare.mjs:
-# a runner runs folder compared in the page equals `sfmeval-runner report`'s table and reports).
+# a runner runs folder compared in the page equals `sfmeval-runner report`'s table and reports;
+# tests/browser/dtu.mjs: the DTU evaluation in npm and in the page equals `sfmeval dtu`).
 # SFMEVAL_BENCH=1 also runs the speed benchmarks (bench/data; not tests): whole eval in the page
 # with threads off and on against native with 1 and 2 threads (tests/browser/bench.mjs), and per
 # operation in Node (tests/browser/bench-ops.mjs).
@@ -156,6 +157,21 @@ else
   fail "compare: making the runs folder" "$log/runner.log"
 fi
 echo "compare: $((SECONDS - t)) s (screenshots compare*.png in $out)"
+
+# DTU: a scan in DTU's layout (tests/python/dtu_scene.py, a small dense cloud), evaluated by the npm
+# package in Node and by the page's section 6 in Chromium: report, summary and error clouds equal
+# `sfmeval dtu`'s (tests/browser/dtu.mjs)
+t=$SECONDS
+rm -rf "$out/dtu-scene"
+if .venv/bin/python -c "import sys, pathlib; sys.path.insert(0, 'tests/python'); import dtu_scene; dtu_scene.build(pathlib.Path(sys.argv[1]), sys.argv[2], dense_points=20000)" \
+  "$out/dtu-scene" "$ROOT/target/release/sfmeval" >"$log/dtu-scene.log" 2>&1; then
+  node tests/browser/dtu.mjs --npm target/web/npm --cli target/release/sfmeval --scene "$out/dtu-scene" --out "$out" \
+    --url "http://127.0.0.1:$port/" >"$log/dtu.log" 2>&1
+  count dtu "$log/dtu.log" $?
+else
+  fail "dtu: making the scan" "$log/dtu-scene.log"
+fi
+echo "dtu: $((SECONDS - t)) s (screenshots dtu-*.png in $out)"
 
 if [ "${SFMEVAL_BENCH:-0}" = 1 ]; then
   node tests/browser/bench.mjs --url "http://127.0.0.1:$port/" --cli target/release/sfmeval 2>&1 | tee "$log/bench.log"

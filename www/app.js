@@ -13,6 +13,7 @@ import { currentCrop, cropText } from './crop.js';
 import { showResults, showCameraScale, prAt } from './results.js';
 import { reportNotes } from './notes.js';
 import { setupCompare, drawCameras } from './compare.js';
+import { setupDtu } from './dtu.js';
 
 onWorkerEvents({
   onProgress: (m) => {
@@ -130,18 +131,25 @@ initCore().then((m) => {
 hideProgress();
 showError('');
 updateRunButton();
+/** Claims the worker for a Compare or a DTU evaluation (false while another run is under way). */
+const setRunning = (b) => {
+  if (b && (state.running || state.restoring)) return false;
+  state.running = b;
+  if (b) setRunNote('Running: progress below; Cancel stops it.');
+  else { hideProgress(); if (!state.restoring) setRunNote(''); }
+  updateRunButton();
+  return true;
+};
 const compare = setupCompare({
   call, viewer, measureOptions: options, showError, download,
   gtName: () => (state.gt ? state.gt.name : null),
   showComparison: () => showView('comparison'),
   setRunning: (b) => {
-    if (b && (state.running || state.restoring)) return false;
-    state.running = b;
-    if (b) setRunNote('Comparing: progress below; Cancel stops it.');
-    else { hideProgress(); if (!state.restoring) setRunNote(''); }
-    updateRunButton();
-    return true;
+    const ok = setRunning(b);
+    if (ok && b) setRunNote('Comparing: progress below; Cancel stops it.');
+    return ok;
   },
 });
+const dtu = setupDtu({ call, showError, download, setRunning });
 // for tests and scripting
-window.sfmeval = { compare, state, call, currentCrop, cropText, prAt, reportNotes, matrixText, alignedTransform };
+window.sfmeval = { compare, dtu, state, call, currentCrop, cropText, prAt, reportNotes, matrixText, alignedTransform };

@@ -9,10 +9,7 @@ import { Viewer } from './viewer.js';
 import { dropZone, entryFiles } from './files.js';
 import { $, esc } from './util.js';
 import { MSG } from './core.js';
-import { clearComparisonStale } from './ui.js';
-
-/** Model files outside run folders (loose files, model folders), by extension. */
-const MODEL_EXT = /\.(bin|txt|nvm|out|json|ply)$/i;
+import { clearComparisonStale, markComparisonStale } from './ui.js';
 
 /** A COLMAP model's files: together they are one model (as the Reconstruction input reads them). */
 const COLMAP_FILE = /^(cameras|images|points3D|rigs|frames)\.(txt|bin)$/i;
@@ -26,9 +23,10 @@ const COLMAP_FILE = /^(cameras|images|points3D|rigs|frames)\.(txt|bin)$/i;
  * (cameras/images/points3D .txt or .bin) are one model named by that folder (`model` for loose
  * files, as the Reconstruction input names them), and every other model file (PLY, NVM, Bundler
  * .out, sfm_data.json) is one item named by the file; a name that repeats is prefixed by the
- * file's own folder.
+ * file's own folder. Which files are model files is the core's rule: `modelFiles(paths)` gives
+ * those of `paths` that are.
  */
-export async function groupItems(fileList, runFiles) {
+export async function groupItems(fileList, runFiles, modelFiles) {
   const files = Array.from(fileList).map((f) => ({ f, path: (f.webkitRelativePath || f.name).replace(/^\/+/, '') }));
   const runs = files.filter((x) => x.path.split('/').pop() === 'run.json' && x.path.includes('/'));
   const items = [];
@@ -44,11 +42,12 @@ export async function groupItems(fileList, runFiles) {
   } else {
     // by each file's own folder ('' for loose files)
     const byFolder = new Map();
+    const models = new Set(await modelFiles(files.map((x) => x.path)));
     for (const x of files) {
       const cut = x.path.lastIndexOf('/');
       const dir = cut < 0 ? '' : x.path.slice(0, cut);
       const name = x.path.slice(cut + 1);
-      if (!MODEL_EXT.test(name)) continue;
+      if (!models.has(x.path)) continue;
       if (!byFolder.has(dir)) byFolder.set(dir, []);
       byFolder.get(dir).push({ name, f: x.f });
     }
@@ -138,11 +137,12 @@ export function setupCompare({ call, viewer, measureOptions, showError, download
     showError(msg, 'file-runs');
   };
   const runFiles = async (paths) => (await call(MSG.runFiles, { paths })).files;
+  const modelFiles = async (paths) => (await call(MSG.modelFiles, { paths })).paths;
   let picks = 0; // the latest pick wins over an earlier one still being grouped
   const take = async (files) => {
     const pick = ++picks;
     let items;
-    try { items = await groupItems(files, runFiles); } catch (err) { if (pick === picks) fail(`compare: ${err.message}`); return; }
+    try { items = await groupItems(files, runFiles, modelFiles); } catch (err) { if (pick === picks) fail(`compare: ${err.message}`); return; }
     if (pick !== picks) return;
     if (!items.length) fail('compare: no reconstruction found (a runs folder needs <pipeline>/run.json; a model folder its model files)');
     else setItems(items);
@@ -157,6 +157,27 @@ export function setupCompare({ call, viewer, measureOptions, showError, download
     } catch (err) { fail(`compare: ${err.message}`); }
   });
 
+  /**
+   * What of the Measure and Crop sections a comparison was measured with; when one of them
+   * changes after a Compare, the comparison goes out of date (as for the ground truth).
+   */
+  const measured = () => {
+    const b = measureOptions();
+    return { 'τ': JSON.stringify([b.tau, b.tau_percent_of_diagonal]), samples: String(b.samples), seed: String(b.seed), crop: JSON.stringify(b.crop) };
+  };
+  const checkMeasured = () => {
+    if (!state.measuredWith) return;
+    const now = measured();
+    const changed = Object.keys(now).filter((k) => now[k] !== state.measuredWith[k]);
+    if (changed.length) markComparisonStale(`${changed.join(', ')} changed since this comparison`);
+  };
+  for (const id of ['tau', 'tau-rel', 'samples', 'seed', 'max-distance', 'crop-kind']) {
+    $(id).addEventListener('input', checkMeasured);
+    $(id).addEventListener('change', checkMeasured);
+  }
+  // the crop volume moved in the viewer, fitted or imported (crop.js announces every change)
+  document.addEventListener('sfmeval-crop-change', checkMeasured);
+
   async function run() {
     if (!state.items.length) return;
     const name = gtName();
@@ -168,6 +189,7 @@ export function setupCompare({ call, viewer, measureOptions, showError, download
     const problems = [];
     const base = measureOptions();
     const options = { tau: base.tau, tau_percent_of_diagonal: base.tau_percent_of_diagonal, samples: base.samples, seed: base.seed, crop: base.crop, align: 'auto' };
+    const with_ = measured();
     try {
       for (const [k, it] of state.items.entries()) {
         $('compare-status').textContent = `evaluating ${k + 1}/${state.items.length}: ${it.pipeline}…`;
@@ -205,6 +227,7 @@ export function setupCompare({ call, viewer, measureOptions, showError, download
       const { tables, table } = await call(MSG.comparisonTables, { entries: entries.map((e) => ({ row: e.row, report: e.report })) });
       state.tables = tables;
       state.table = table;
+      state.measuredWith = with_;
       clearComparisonStale();
       render();
       // the results pane now shows the comparison, its table at the top (in view)

@@ -44,6 +44,8 @@ function contains(v, x, y, z) {
 }
 let keptQueued = false;
 export function scheduleKept() {
+  // whoever measured with the crop (Compare) checks whether it changed
+  document.dispatchEvent(new Event('sfmeval-crop-change'));
   if (keptQueued) return;
   keptQueued = true;
   requestAnimationFrame(() => { keptQueued = false; updateKept(); });

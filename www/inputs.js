@@ -266,15 +266,22 @@ for (const [kind, input] of [['recon', 'file-recon'], ['gt', 'file-gt'], ['cams'
   $(input).addEventListener('change', (e) => handleFiles(kind, e.target.files));
   dropZone($(`drop-${kind}`), async (entries, files) => {
     if ((kind === 'recon' || kind === 'depth') && entries.length === 1 && entries[0].isDirectory) {
-      try { handleFiles(kind, await folderFiles(entries[0])); } catch (err) { inputFailed(kind, err); }
+      try { handleFiles(kind, await folderFiles(kind, entries[0])); } catch (err) { inputFailed(kind, err); }
     } else {
       handleFiles(kind, files);
     }
   });
 }
-/** The model or depth-map files under a dropped folder, with webkitRelativePath-like names. */
-async function folderFiles(dir) {
-  return (await entryFiles(dir)).filter((f) => /\.(bin|txt|nvm|out|json|ply|npy)$/i.test(f.name));
+/**
+ * The model files (the core's rule, `isModelFile`) or the depth maps (`.npy`) under a dropped
+ * folder, with webkitRelativePath-like names.
+ */
+async function folderFiles(kind, dir) {
+  const files = await entryFiles(dir);
+  if (kind === 'depth') return files.filter((f) => /\.npy$/i.test(f.name));
+  const { paths } = await call(MSG.modelFiles, { paths: files.map((f) => f.webkitRelativePath) });
+  const keep = new Set(paths);
+  return files.filter((f) => keep.has(f.webkitRelativePath));
 }
 
 function handleFiles(kind, files) {

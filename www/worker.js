@@ -5,7 +5,8 @@
 // thread, scalar). Both are the npm package's API; `init` picks one.
 let api = null;
 let version, loadGroundTruth, loadReconstruction, loadReconstructionFile, loadCameras, raw, cropFile, parseCrop,
-  parseTransform, parsePointPairs, errorColors, POSE_STRIDE, comparisonTables, compareTable, runReconstructionFiles, runRow;
+  parseTransform, parsePointPairs, errorColors, POSE_STRIDE, comparisonTables, compareTable, runReconstructionFiles, runRow,
+  isModelFile, dtuFiles, evaluateDtu;
 
 // (module (func (result v128) i32.const 0 i8x16.splat i8x16.popcnt)): valid only with SIMD128
 const SIMD_PROBE = new Uint8Array([0, 97, 115, 109, 1, 0, 0, 0, 1, 5, 1, 96, 0, 1, 123, 3, 2, 1, 0,
@@ -73,22 +74,19 @@ function posesInGt(poses, m, s) {
 }
 
 /**
- * The frusta of an evaluation: the ground-truth cameras, and the estimated ones after the
- * alignment their errors were measured after (the report's `cameras.alignment`), coloured by
- * centre error (viridis, clipped at the errors' 95th percentile as the points' map is at the
- * distances'; grey where the image has no ground truth). Null parts without cameras.
+ * The frusta of an evaluation `e` of reconstruction `r`: the ground-truth cameras, and the
+ * estimated ones after the alignment their errors were measured after (the report's
+ * `cameras.alignment`), with their centre errors, colours and colour clip as the core gives them
+ * (`cameraErrors`, `cameraColors`, `cameraClip`). Null parts without cameras.
  */
-function cameraData(r, report) {
+function cameraData(e, r, report) {
   const gtPoses = gt.hasCameras ? gt.cameraPoses() : null;
   const cams = report.cameras;
   const poses = r.cameraPoses();
   if (!cams || !poses.length) return { gtPoses, estPoses: null, estColors: null, estErrors: null, camClip: null };
   const m = cams.alignment.gt_from_recon.flat();
   const estPoses = posesInGt(poses, m, cams.alignment.scale);
-  const byName = new Map(cams.images.map((im) => [im.estimated_name, im.center_error]));
-  const estErrors = Float64Array.from(r.cameraNames(), (n) => byName.get(n) ?? NaN);
-  const camClip = cams.center_error.percentiles.p95;
-  return { gtPoses, estPoses, estErrors, estColors: errorColors(estErrors, camClip), camClip };
+  return { gtPoses, estPoses, estErrors: e.cameraErrors(r), estColors: e.cameraColors(r), camClip: e.cameraClip() };
 }
 
 /**
@@ -114,6 +112,7 @@ const handlers = {
       ({
         version, loadGroundTruth, loadReconstruction, loadReconstructionFile, loadCameras, raw, cropFile, parseCrop,
         parseTransform, parsePointPairs, errorColors, POSE_STRIDE, comparisonTables, compareTable, runReconstructionFiles, runRow,
+        isModelFile, dtuFiles, evaluateDtu,
       } = core);
     }
     // threads: the pool's size (1: the single-thread build); threadsOff: why threads are off;
@@ -221,7 +220,7 @@ const handlers = {
     const samplePoints = sampleLabels ? e.completenessPointsF32() : null;
     const extra = sampleLabels ? [sampleLabels.buffer, samplePoints.buffer] : [];
     const reportJson = e.reportJson();
-    const cameras = cameraData(recon, JSON.parse(reportJson));
+    const cameras = cameraData(e, recon, JSON.parse(reportJson));
     return {
       reply: {
         reportJson, pointsInGt, distances, status, completeness, colors, clip, sortedKept, sortedComp,
@@ -263,7 +262,7 @@ const handlers = {
         const pointsInGt = e.pointsInGtF32();
         const clip = e.defaultClip();
         const colors = e.colors(clip);
-        const cameras = cameraData(r, report);
+        const cameras = cameraData(e, r, report);
         return {
           reply: { reportJson, row, kept, comp, pointsInGt, colors, clip, cameras, ms: performance.now() - t0 },
           transfer: [kept.buffer, comp.buffer, pointsInGt.buffer, colors.buffer],
@@ -274,6 +273,31 @@ const handlers = {
   /** Which of a run folder's files (paths relative to it) form its reconstruction: `[[path, name]]`. */
   runFiles({ paths }) {
     return { files: runReconstructionFiles(paths) };
+  },
+  /** Which of `paths` are model files (the core's rule, `isModelFile`): the model files Compare reads. */
+  modelFiles({ paths }) {
+    return { paths: paths.filter((p) => isModelFile(p)) };
+  },
+  /** What the DTU evaluation makes of these file names (the core's recognition): roles, scan, what is missing. */
+  dtuFiles({ names }) {
+    return { found: dtuFiles(names) };
+  },
+  /**
+   * The DTU evaluation of the dropped scan files (`{name: ArrayBuffer}`), as `sfmeval dtu`: the
+   * `sfmeval.dtu/1` report, the summary and its result lines, and the two error clouds.
+   */
+  dtu({ files, options }) {
+    const bytes = {};
+    for (const [n, b] of Object.entries(files)) bytes[n] = new Uint8Array(b);
+    const t0 = performance.now();
+    const r = evaluateDtu(bytes, options);
+    try {
+      const d2s = r.d2sPly(), s2d = r.s2dPly();
+      return {
+        reply: { reportJson: r.reportJson, summary: r.summary, lines: r.resultLines, visNames: r.visNames, d2s, s2d, ms: performance.now() - t0 },
+        transfer: [d2s.buffer, s2d.buffer],
+      };
+    } finally { r.free(); }
   },
   /** The row of a run that did not end ok, from its run.json text. */
   runRowOnly({ runJson }) {

@@ -171,6 +171,21 @@ try {
     check('frusta-colour-follows-centre-error', monotone && lum(hi) > lum(lo) + 50 && errs.every(Number.isFinite),
       JSON.stringify({ lo: [errs[lo], col.slice(3 * lo, 3 * lo + 3)], hi: [errs[hi], col.slice(3 * hi, 3 * hi + 3)] }));
   } else check('frusta-colour-follows-centre-error', false, 'no colours');
+  // the frusta's colours and clip are the core's (Evaluation.cameraColors / cameraClip): the
+  // core's colour map at the core's clip, and the page keeps no clip rule or colour map of its own
+  const frusta = await page.evaluate((i) => { const c = window.sfmeval.compare.entries[i].cameras; return { errors: Array.from(c.estErrors), colors: Array.from(c.estColors), clip: c.camClip }; }, idx);
+  const wantFrusta = Array.from(npm.errorColors(frusta.errors, frusta.clip));
+  const pageSources = readdirSync(join(resolve(new URL('../..', import.meta.url).pathname), 'www')).filter((f) => f.endsWith('.js'))
+    .map((f) => [f, readFileSync(join(resolve(new URL('../..', import.meta.url).pathname), 'www', f), 'utf8')]);
+  const clipRule = pageSources.filter(([, t]) => /center_error\.percentiles/.test(t)).map(([f]) => f);
+  check('frusta-colours-and-clip-from-the-core', frusta.colors.length === 3 * frusta.errors.length && frusta.colors.every((v, i) => v === wantFrusta[i])
+    && frusta.clip === entry.p95 && clipRule.length === 0, JSON.stringify({ clipRule, clip: frusta.clip, p95: entry.p95, first: frusta.colors.slice(0, 6), want: wantFrusta.slice(0, 6) }));
+  // which files are model files is the core's rule (isModelFile), not a list in the page
+  const extLists = pageSources.filter(([, t]) => /\bnvm\b[^\n]*\bout\b|MODEL_EXT/.test(t)).map(([f]) => f);
+  const modelNames = ['a/cameras.txt', 'b/x.PLY', 'c/sfm_data.json', 'd/img.jpg', 'e/m.nvm', 'f/b.out', 'g/r.bmp', 'h/log.txt'];
+  const pickedModels = await page.evaluate((ns) => window.sfmeval.call('modelFiles', { paths: ns }).then((r) => r.paths, (e) => String(e)), modelNames);
+  check('compare-model-files-are-the-cores', extLists.length === 0 && JSON.stringify(pickedModels) === JSON.stringify(modelNames.filter((n) => npm.isModelFile(n))),
+    JSON.stringify({ extLists, pickedModels }));
   await page.uncheck('#show-est-cams');
   const hidden = await page.evaluate(() => window.sfmevalViewer.cameraCounts());
   check('frusta-toggle', hidden.estCams.visible === false && hidden.gtCams.visible === true, JSON.stringify(hidden));
@@ -441,6 +456,21 @@ try {
   await compareAgain();
   const fresh = await page.evaluate(() => [document.getElementById('cmp-stale-note').hidden, document.body.dataset.compareStale]);
   check('compare-again-is-current', fresh[0] === true && fresh[1] === undefined, JSON.stringify(fresh));
+  // 16. it goes out of date too when what it was measured with changes: τ, then the samples, then
+  //     the crop (each named in the note), as `sfmeval-runner report` would measure otherwise
+  const staleNote = () => page.evaluate(() => [document.body.dataset.compareStale, document.getElementById('cmp-stale-note').textContent]);
+  await page.fill('#tau-rel', '0.5,1,3');
+  const afterTau = await staleNote();
+  await page.fill('#samples', '900000');
+  const afterSamples = await staleNote();
+  await page.selectOption('#crop-kind', 'sphere');
+  await page.waitForTimeout(100);
+  const afterCrop = await staleNote();
+  check('compare-out-of-date-when-tau-samples-or-crop-change', afterTau[0] === '1' && /τ/.test(afterTau[1]) && !/samples/.test(afterTau[1])
+    && /samples/.test(afterSamples[1]) && /crop/.test(afterCrop[1]), JSON.stringify({ afterTau, afterSamples, afterCrop }));
+  await page.selectOption('#crop-kind', 'none');
+  await page.fill('#tau-rel', '');
+  await page.fill('#samples', '1000000');
 
   check('compare-no-request-leaves-origin', requests.every((u) => u.startsWith(origin) || u.startsWith('blob:') || u.startsWith('data:')), requests.filter((u) => !u.startsWith(origin)).join(' '));
   check('compare-no-console-errors', consoleErrors.length === 0, consoleErrors.join(' | '));

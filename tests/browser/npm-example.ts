@@ -4,7 +4,7 @@
 // The @ts-expect-error lines must stay errors: if the types loosened (`report: any`) or lost a
 // field's type, tsc would fail on the unused directive.
 import { readFile, writeFile } from 'node:fs/promises';
-import { init, evaluate, loadReconstruction, type Code, type Note, type Report, type Statistics } from 'sfmeval';
+import { init, evaluate, loadReconstruction, evaluateDtu, dtuFiles, type Code, type DtuReport, type Note, type Report, type Statistics } from 'sfmeval';
 
 await init();
 const result = evaluate({
@@ -61,3 +61,22 @@ console.log(same === report, mean, p95, bins.length, stats.count, f, row, schema
   code, warnings, icpRejected, noSuchCode, badLevel, stage, radius);
 await writeFile('report.json', result.reportJson);
 result.free();
+
+// the DTU evaluation: the report's types generated from sfmeval-dtu's Rust types
+const scanFiles = {
+  'stl001_total.ply': await readFile('stl001_total.ply'),
+  'ObsMask1_10.mat': await readFile('ObsMask1_10.mat'),
+  'Plane1.mat': await readFile('Plane1.mat'),
+  'recon.ply': await readFile('recon.ply'),
+};
+const found = dtuFiles(Object.keys(scanFiles));
+if (found.missing.length) console.log(`missing: ${found.missing.join('; ')}`);
+const dtu = evaluateDtu(scanFiles, { mode: 'pcd' });
+const dtuReport: DtuReport = dtu.report;
+const overall: number | null = dtuReport.overall;
+const observed: number = dtuReport.counts.observed;
+const dtuSchema: 'sfmeval.dtu/1' = dtuReport.schema;
+// @ts-expect-error: the DTU report has no `accuracy` section (its means are top-level)
+console.log(dtuReport.accuracy.mean);
+console.log(overall, observed, dtuSchema, dtu.resultLines.join('\n'));
+dtu.free();

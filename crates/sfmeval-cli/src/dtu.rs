@@ -111,40 +111,8 @@ pub fn dtu_cmd(args: &DtuArgs) -> Result<()> {
     Ok(())
 }
 
-fn mm(v: Option<f64>) -> String {
-    v.map_or_else(
-        || "none (no distance below max_dist)".into(),
-        |v| format!("{v:.6} mm"),
-    )
-}
-
 fn summary(r: &DtuReport, vis: Option<&Path>) -> String {
-    let c = &r.counts;
-    let mut s = format!(
-        "DTU evaluation, scan {} ({}: {} points, {} after down-sampling to {} mm, {} in the bounding box, {} observed)\n",
-        r.scan,
-        r.mode,
-        c.points,
-        c.downsampled,
-        r.options.downsample_density,
-        c.in_bounding_box,
-        c.observed
-    );
-    s += &format!(
-        "  mean accuracy      {}  ({} of {} distances below {} mm)\n",
-        mm(r.mean_accuracy),
-        c.accuracy_below_max_dist,
-        c.observed,
-        r.options.max_dist
-    );
-    s += &format!(
-        "  mean completeness  {}  ({} of {} STL points above the plane below {} mm)\n",
-        mm(r.mean_completeness),
-        c.completeness_below_max_dist,
-        c.stl_above_plane,
-        r.options.max_dist
-    );
-    s += &format!("  overall            {}\n", mm(r.overall));
+    let mut s = r.summary();
     if let Some(dir) = vis {
         s += &format!("  error clouds written to {}\n", dir.display());
     }

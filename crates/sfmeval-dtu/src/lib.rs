@@ -5,12 +5,14 @@
 //! mesh, the down-sampling, the bounding box and observation-mask filtering, accuracy and
 //! completeness capped at 20 mm, and the coloured error clouds.
 
+pub mod files;
 pub mod mat;
 mod protocol;
 mod report;
 pub mod scan;
 pub mod vis;
 
+pub use files::{DtuFiles, read_reconstruction, recognise};
 pub use protocol::{
     DOWNSAMPLE_DENSITY, DtuEvaluation, DtuInput, DtuOptions, MAX_DIST, PATCH_SIZE, Shuffle,
     VISUALIZE_THRESHOLD, evaluate, pairwise_sum, radius_filter, sample_mesh, shuffle,
@@ -37,6 +39,38 @@ impl DtuMode {
             DtuMode::Mesh => "mesh",
             DtuMode::Pcd => "pcd",
         }
+    }
+}
+
+impl DtuMode {
+    /// The evaluator's input from a reconstruction's `vertices` and `triangles` (empty for
+    /// points): a mesh or points as the mode says, and whether it is a mesh. `what` names the
+    /// reconstruction in the error of `mesh` mode on one without faces.
+    pub fn input(
+        self,
+        vertices: Vec<sfmeval::geometry::Point3>,
+        triangles: Vec<[u32; 3]>,
+        what: &str,
+    ) -> sfmeval::Result<(DtuInput, bool)> {
+        let mesh = match self {
+            DtuMode::Auto => !triangles.is_empty(),
+            DtuMode::Mesh if triangles.is_empty() => {
+                return Err(sfmeval::Error::InvalidContent(format!(
+                    "mode mesh, but {what} has no faces"
+                )));
+            }
+            DtuMode::Mesh => true,
+            DtuMode::Pcd => false,
+        };
+        let input = if mesh {
+            DtuInput::Mesh {
+                vertices,
+                triangles,
+            }
+        } else {
+            DtuInput::Cloud(vertices)
+        };
+        Ok((input, mesh))
     }
 }
 

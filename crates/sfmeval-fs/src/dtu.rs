@@ -5,7 +5,7 @@
 
 use std::path::Path;
 
-use anyhow::{Context as _, Result, bail};
+use anyhow::{Context as _, Result};
 use sfmeval::dataset::DatasetPaths;
 use sfmeval::geometry::{GroundTruth, Point3};
 use sfmeval::io::{self, ReadLimits};
@@ -94,22 +94,9 @@ pub fn read_dtu_recon(path: &Path, mode: DtuMode) -> Result<DtuRecon> {
         Some(f) => format!("the {} file", f.to_ascii_uppercase()),
         None => "an SfM model's points".to_string(),
     };
-    let mesh = match mode {
-        DtuMode::Auto => !triangles.is_empty(),
-        DtuMode::Mesh if triangles.is_empty() => {
-            bail!("reconstruction '{name}': mode mesh, but {what} has no faces")
-        }
-        DtuMode::Mesh => true,
-        DtuMode::Pcd => false,
-    };
-    let input = if mesh {
-        DtuInput::Mesh {
-            vertices,
-            triangles,
-        }
-    } else {
-        DtuInput::Cloud(vertices)
-    };
+    let (input, mesh) = mode
+        .input(vertices, triangles, &what)
+        .with_context(context)?;
     Ok(DtuRecon { input, mesh })
 }
 

@@ -6,10 +6,14 @@ import type {
 } from './sfmeval_wasm.js';
 import * as rawBindings from './sfmeval_wasm.js';
 import type { Report, Volume } from './report.js';
+import type { DtuReport } from './dtu-report.js';
 
 /** The report's types (`Report`, its sections, `Note`, the note `Code`s, ...), generated from the
  * core's Rust types (`report.d.ts`, `scripts/gen-report-types.sh`). */
 export * from './report.js';
+/** The DTU report's types (`DtuReport`, `DtuReportOptions`, `DtuCounts`), generated likewise
+ * (`dtu-report.d.ts`). */
+export * from './dtu-report.js';
 
 /** File contents by (relative) file name. */
 export type Files = Record<string, Uint8Array | ArrayBuffer | ArrayBufferView | string>;
@@ -122,6 +126,15 @@ export interface EvaluationResult {
   runRow(runJson: string): RunRow;
   /** The accuracy 95th percentile (the CLI's default colour clip). */
   defaultClip(): number;
+  /** The estimated cameras' colour clip (the centre errors' 95th percentile), undefined without
+   * pose errors. */
+  cameraClip(): number | undefined;
+  /** Per registered image of `recon` (its `cameraPoses()` order), the camera-centre error (NaN:
+   * no ground-truth image of that name). */
+  cameraErrors(recon: RawReconstruction): Float64Array;
+  /** The estimated frusta's colours `r, g, b` in `recon`'s `cameraPoses()` order: the centre
+   * error in the points' colour map clipped at `cameraClip()`, grey without a ground-truth image. */
+  cameraColors(recon: RawReconstruction): Uint8Array;
   /** Frees the wasm memory of this result. */
   free(): void;
 }
@@ -288,6 +301,65 @@ export function compareTable(entries: { row: RunRow; report?: Report | null }[])
 
 /** Viewer colours: r,g,b per value, viridis saturating at `clip` (the points' map), NaN grey. */
 export function errorColors(values: ArrayLike<number>, clip: number): Uint8Array;
+
+/** Whether a file can be part of an SfM model or a cloud, by its extension (the core's rule). */
+export function isModelFile(path: string): boolean;
+
+/** What the DTU evaluation makes of a set of file names (`dtuFiles`). */
+export interface DtuFiles {
+  /** The scan number the ground-truth files' names give, null when none or when they disagree. */
+  scan: number | null;
+  /** `stl{NNN}_total.ply`. */
+  stl: string | null;
+  /** `ObsMask{N}_10.mat`. */
+  obs_mask: string | null;
+  /** `Plane{N}.mat`. */
+  plane: string | null;
+  /** Any other `.ply`. */
+  reconstruction: string | null;
+  /** What is still needed, one sentence each. */
+  missing: string[];
+  /** What does not fit together (two scans, two reconstructions), one sentence each. */
+  problems: string[];
+  /** Names that are none of the above. */
+  ignored: string[];
+}
+/** Sorts file names into the DTU scan's files. */
+export function dtuFiles(names: string[]): DtuFiles;
+
+/** The options of `evaluateDtu`, as `sfmeval dtu`'s flags (mm). */
+export interface DtuOptions {
+  mode?: 'auto' | 'mesh' | 'pcd';
+  downsample_density?: number;
+  patch_size?: number;
+  max_dist?: number;
+  visualize_threshold?: number;
+  /** The shuffle's seed (default 0). */
+  seed?: number;
+  /** Down-sample in the input's order instead (`--no-shuffle`). */
+  no_shuffle?: boolean;
+}
+/** One DTU evaluation. */
+export interface DtuResult {
+  /** The `sfmeval.dtu/1` JSON, byte for byte what `sfmeval dtu --report` writes. */
+  readonly reportJson: string;
+  /** The parsed report. */
+  readonly report: DtuReport;
+  /** The summary `sfmeval dtu` prints. */
+  readonly summary: string;
+  /** Its mean accuracy, mean completeness and overall lines. */
+  readonly resultLines: string[];
+  /** The error clouds' names, `[vis_NNN_d2s.ply, vis_NNN_s2d.ply]`. */
+  readonly visNames: string[];
+  /** The accuracy error cloud (`sfmeval dtu --vis-out`). */
+  d2sPly(): Uint8Array;
+  /** The completeness error cloud. */
+  s2dPly(): Uint8Array;
+  /** Frees the wasm memory of this result. */
+  free(): void;
+}
+/** The DTU MVS evaluation of a scan's files (STL points, ObsMask, Plane, reconstruction PLY). */
+export function evaluateDtu(files: Files, options?: DtuOptions): DtuResult;
 
 /** Numbers per camera of `cameraPoses()`: centre (3), world_from_cam row-major (9), tangents of
  * the half field of view in x and y (0 when unknown). */

@@ -173,6 +173,9 @@ function wrap(e) {
     /** This run's row of the comparison tables (`summary.json`'s), from its run.json text. */
     runRow: (runJson) => JSON.parse(e.runRow(runJson)),
     defaultClip: () => e.defaultClip(),
+    cameraClip: () => e.cameraClip(),
+    cameraErrors: (recon) => e.cameraErrors(recon),
+    cameraColors: (recon) => e.cameraColors(recon),
     free: () => e.free(),
   };
   return r;
@@ -272,6 +275,45 @@ export function metricCatalogue() {
 /** Viewer colours (`Uint8Array` r,g,b per value: viridis saturating at `clip`, NaN grey). */
 export function errorColors(values, clip) {
   return wasm.errorColors(Float64Array.from(values), clip);
+}
+
+/**
+ * Whether a file can be part of an SfM model or a cloud, by its extension (the core's rule): the
+ * model files of a folder, as `sfmeval eval --recon DIR` and the runner read them.
+ */
+export function isModelFile(path) {
+  return wasm.isModelFile(path);
+}
+
+/**
+ * What the DTU evaluation makes of these file names: `{scan, stl, obs_mask, plane,
+ * reconstruction, missing, problems, ignored}` (`stl{NNN}_total.ply`, `ObsMask{N}_10.mat`,
+ * `Plane{N}.mat`, any other `.ply` the reconstruction; `missing` and `problems` are sentences).
+ */
+export function dtuFiles(names) {
+  return wasm.dtuFiles(JSON.stringify(names));
+}
+
+/**
+ * The DTU MVS evaluation of a scan, as `sfmeval dtu`: `files` maps the names of the STL points,
+ * the observation mask, the ground plane and the reconstruction PLY to their bytes (recognised
+ * by `dtuFiles`); `options`: `{mode, downsample_density, patch_size, max_dist,
+ * visualize_threshold, seed, no_shuffle}` as the CLI's flags. Returns `{reportJson, report,
+ * summary, resultLines, visNames, d2sPly(), s2dPly(), free()}`: `reportJson` byte for byte what
+ * `sfmeval dtu --report` writes.
+ */
+export function evaluateDtu(files, options) {
+  const e = wasm.evaluateDtu(fileMap(files), options ?? {});
+  return {
+    reportJson: e.reportJson,
+    get report() { return JSON.parse(this.reportJson); },
+    summary: e.summary,
+    resultLines: e.resultLines,
+    visNames: e.visNames(),
+    d2sPly: () => e.d2sPly(),
+    s2dPly: () => e.s2dPly(),
+    free: () => e.free(),
+  };
 }
 
 /** Numbers per camera in `GroundTruth.cameraPoses()` / `Reconstruction.cameraPoses()`:

@@ -26,10 +26,12 @@ use sfmeval::progress::{Progress, Stage};
 use sfmeval::transform::Similarity;
 use wasm_bindgen::prelude::*;
 
+mod dtu;
 mod poses;
 mod stream;
 mod table;
 
+pub use dtu::{DtuEvaluation, dtu_files, evaluate_dtu};
 pub use poses::error_colors;
 pub use stream::ReconstructionStream;
 pub use table::{
@@ -38,6 +40,13 @@ pub use table::{
 /// `initThreadPool(n)`: starts the pool of `n` Web Workers the threaded build's maps run on.
 #[cfg(feature = "threads")]
 pub use wasm_bindgen_rayon::init_thread_pool;
+
+/// Whether a file can be part of an SfM model or a cloud, by its extension (the core's rule,
+/// `sfmeval::files::is_model_file`): which files of a picked folder are reconstructions.
+#[wasm_bindgen(js_name = isModelFile)]
+pub fn is_model_file(path: &str) -> bool {
+    sfmeval::files::is_model_file(path)
+}
 
 /// Threads the core's parallel maps use: the pool's size in the threaded build, 1 otherwise.
 #[wasm_bindgen(js_name = threadCount)]

@@ -6,7 +6,7 @@ use sfmeval::colormap::distance_color;
 use sfmeval::model::Reconstruction as Model;
 use wasm_bindgen::prelude::*;
 
-use crate::{GroundTruth, Reconstruction};
+use crate::{Evaluation, GroundTruth, Reconstruction};
 
 /// Numbers per camera in [`poses`].
 pub const POSE_STRIDE: usize = 14;
@@ -94,4 +94,63 @@ pub fn error_colors(values: &[f64], clip: f64) -> Uint8Array {
         })
         .collect();
     Uint8Array::from(flat.as_slice())
+}
+
+/// The clip of the estimated frusta's colours: the camera-centre errors' 95th percentile, as the
+/// points' map clips at the accuracy's (`Evaluation.defaultClip()`).
+fn camera_clip(cams: &sfmeval::report::CamerasSection) -> f64 {
+    cams.errors.center_error.percentiles.p95
+}
+
+#[wasm_bindgen]
+impl Evaluation {
+    /// The colour clip of the estimated cameras (the centre errors' 95th percentile, GT units),
+    /// `undefined` without pose errors.
+    #[wasm_bindgen(js_name = cameraClip)]
+    pub fn camera_clip(&self) -> Option<f64> {
+        self.inner.report.cameras.as_ref().map(camera_clip)
+    }
+
+    /// Per registered image of `recon` (the order of its `cameraPoses()`), its camera-centre
+    /// error (NaN when no ground-truth image has its name), as the report lists them.
+    #[wasm_bindgen(js_name = cameraErrors)]
+    pub fn camera_errors(&self, recon: &Reconstruction) -> Float64Array {
+        Float64Array::from(self.errors_of(recon).as_slice())
+    }
+
+    /// The estimated frusta's colours (`r0, g0, b0, ...`, the order of `recon.cameraPoses()`):
+    /// the centre error in the points' colour map clipped at [`Self::camera_clip`], grey where no
+    /// ground-truth image has the name; empty without pose errors.
+    #[wasm_bindgen(js_name = cameraColors)]
+    pub fn camera_colors(&self, recon: &Reconstruction) -> Uint8Array {
+        match self.inner.report.cameras.as_ref() {
+            Some(cams) => error_colors(&self.errors_of(recon), camera_clip(cams)),
+            None => Uint8Array::new_with_length(0),
+        }
+    }
+}
+
+impl Evaluation {
+    fn errors_of(&self, recon: &Reconstruction) -> Vec<f64> {
+        let Some(cams) = self.inner.report.cameras.as_ref() else {
+            return Vec::new();
+        };
+        let by_name: std::collections::HashMap<&str, f64> = cams
+            .errors
+            .images
+            .iter()
+            .map(|im| (im.estimated_name.as_str(), im.center_error))
+            .collect();
+        recon
+            .input
+            .model
+            .as_ref()
+            .map(|m| {
+                m.images
+                    .iter()
+                    .map(|im| by_name.get(im.name.as_str()).copied().unwrap_or(f64::NAN))
+                    .collect()
+            })
+            .unwrap_or_default()
+    }
 }

@@ -59,7 +59,7 @@ pub fn comparison_tables(rows_json: &str) -> Result<JsValue, JsError> {
         .map_err(|e| js_err("tables", e.to_string()))
 }
 
-fn to_js<T: serde::Serialize>(what: &str, v: &T) -> Result<JsValue, JsError> {
+pub(crate) fn to_js<T: serde::Serialize>(what: &str, v: &T) -> Result<JsValue, JsError> {
     v.serialize(&serde_wasm_bindgen::Serializer::json_compatible())
         .map_err(|e| js_err(what, e.to_string()))
 }

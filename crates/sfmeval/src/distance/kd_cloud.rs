@@ -88,7 +88,7 @@ impl KdCloud {
     /// as `(d², slot)` into `out`; returns how many, and the squared radius below which every
     /// point is among them (`radius2`, or the `K`-th distance when `K` were found). `p` must be
     /// finite.
-    pub(crate) fn nearest_k_below<const K: usize>(
+    pub fn nearest_k_below<const K: usize>(
         &self,
         p: Point3,
         radius2: f64,
