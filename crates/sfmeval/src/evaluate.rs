@@ -169,7 +169,7 @@ impl Evaluation {
     }
 
     /// Every reconstructed point in the ground-truth frame, in input order (a new vector of
-    /// 24 bytes a point; exports use [`Evaluation::for_each_point_in_gt`]).
+    /// 24 bytes a point; exports use `Evaluation::for_each_point_in_gt`).
     pub fn points_in_gt(&self) -> Vec<Point3> {
         let t = self.gt_from_recon;
         let slot_of = self.slot_of_input();

@@ -101,7 +101,7 @@ impl PreparedGroundTruth {
     }
 
     /// The closest ground-truth point to `p` (for ICP correspondences), starting from `hint`
-    /// as [`Self::distance_from`] does.
+    /// as `distance_from` does.
     pub fn closest_point(&self, p: Point3, hint: &mut MeshHint) -> (Point3, f64) {
         match &self.index {
             GtIndex::Mesh(m) => {

@@ -20,14 +20,16 @@
 mod co3d;
 mod colmap_benchmark;
 mod imc;
+mod poses_report;
 mod protocol;
 
 pub use co3d::Co3dResult;
 pub use colmap_benchmark::ColmapResult;
 pub use imc::ImcResult;
+pub use poses_report::{POSES_SCHEMA, PosesReport, ProtocolResult, evaluate_protocol};
 pub use protocol::{
-    Convention, POSES_SCHEMA, PairError, PairRow, PairSet, PosesReport, Protocol, ProtocolOptions,
-    ProtocolResult, ThresholdTest, TranslationSign, evaluate_protocol,
+    Convention, PairError, PairRow, PairSet, Protocol, ProtocolOptions, ThresholdTest,
+    TranslationSign,
 };
 
 use serde::{Deserialize, Serialize};

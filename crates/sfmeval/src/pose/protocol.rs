@@ -17,9 +17,6 @@ use crate::model::matching::match_images;
 use crate::model::{Mat3, Reconstruction, mat_mul, mat_vec, transpose};
 use crate::note::{Code, Note};
 
-/// The schema name of a poses report.
-pub const POSES_SCHEMA: &str = "sfmeval.poses/1";
-
 /// A pose benchmark protocol.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "lowercase")]
@@ -58,7 +55,7 @@ impl Protocol {
     }
 }
 
-/// Options of [`evaluate_protocol`]; the defaults are each protocol's official ones.
+/// Options of [`super::evaluate_protocol`]; the defaults are each protocol's official ones.
 #[derive(Debug, Clone, PartialEq)]
 pub struct ProtocolOptions {
     /// COLMAP: AUC and recall thresholds in degrees (official default 0.5, 1, 5, 10).
@@ -147,18 +144,6 @@ pub struct Convention {
     pub rotation_error: String,
 }
 
-/// The result of one protocol.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(tag = "protocol", rename_all = "lowercase")]
-pub enum ProtocolResult {
-    /// COLMAP's reconstruction benchmark.
-    Colmap(super::colmap_benchmark::ColmapResult),
-    /// Image Matching Challenge mAA.
-    Imc(super::imc::ImcResult),
-    /// CO3D RRA / RTA / AUC.
-    Co3d(super::co3d::Co3dResult),
-}
-
 /// One scored ground-truth pair (the CLI's `--pairs` CSV; not in the JSON report).
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct PairRow {
@@ -174,57 +159,6 @@ pub struct PairRow {
     pub translation_deg: f64,
     /// The pair's error as the protocol combines them, degrees.
     pub error_deg: f64,
-}
-
-/// A poses report (`sfmeval.poses/1`).
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct PosesReport {
-    /// `sfmeval.poses/1`.
-    pub schema: String,
-    /// Ground-truth images.
-    pub ground_truth: usize,
-    /// Registered images of the (largest) estimated model.
-    pub registered: usize,
-    /// Registered images matched to a ground-truth image by name.
-    pub matched: usize,
-    /// Registered images whose name matches no ground-truth image.
-    pub unmatched_estimated: usize,
-    /// Estimated poses that are NaN or infinite.
-    pub non_finite: usize,
-    /// Separate models the SfM tool produced (the largest is evaluated).
-    pub models: usize,
-    /// The protocol's convention.
-    pub convention: Convention,
-    /// The protocol's numbers.
-    pub result: ProtocolResult,
-    /// Problems worth a line.
-    pub notes: Vec<Note>,
-    /// Every scored ground-truth pair, in the protocol's order (not serialized).
-    #[serde(skip)]
-    pub pair_rows: Vec<PairRow>,
-}
-
-impl PosesReport {
-    /// [`Self::pair_rows`] as CSV (`i` and `j` as ground-truth image names), numbers in Rust's
-    /// shortest round-trip form.
-    pub fn pairs_csv(&self, gt: &Reconstruction) -> String {
-        let name = |k: usize| gt.images.get(k).map(|i| i.name.as_str()).unwrap_or("");
-        let mut s = String::from(
-            "image_i,image_j,registered,rotation_error_deg,translation_error_deg,error_deg\n",
-        );
-        for r in &self.pair_rows {
-            s.push_str(&format!(
-                "{},{},{},{},{},{}\n",
-                name(r.i),
-                name(r.j),
-                u8::from(r.registered),
-                r.rotation_deg,
-                r.translation_deg,
-                r.error_deg
-            ));
-        }
-        s
-    }
 }
 
 /// The inputs every protocol shares: ground-truth poses in GT order, the matched estimated
@@ -359,7 +293,7 @@ pub(crate) fn folded_translation_error_rad(t_gt: Point3, t_est: Point3) -> f64 {
 
 /// Pairs `est` with `gt` by image name; errors for an empty ground truth, a non-finite one and
 /// no common image.
-fn pair_poses(
+pub(super) fn pair_poses(
     gt: &Reconstruction,
     est: &Reconstruction,
     notes: &mut Vec<Note>,
@@ -440,69 +374,4 @@ fn pair_poses(
         );
     }
     Ok((paired, matched))
-}
-
-/// One protocol's numbers for `est` against `gt` (see the module docs).
-///
-/// Errors: [`Error::Empty`] when the ground truth has no images or no estimated image matches a
-/// ground-truth name; [`Error::NonFinite`] for a non-finite ground-truth pose;
-/// [`Error::InvalidOption`] for thresholds that are not positive and finite.
-pub fn evaluate_protocol(
-    gt: &Reconstruction,
-    est: &Reconstruction,
-    protocol: Protocol,
-    options: &ProtocolOptions,
-) -> Result<PosesReport> {
-    let positive = |v: &[f64], what: &str| -> Result<()> {
-        if v.is_empty() || v.iter().any(|t| !(t.is_finite() && *t > 0.0)) {
-            return Err(Error::InvalidOption(format!(
-                "{what} must be positive and finite, got {v:?}"
-            )));
-        }
-        Ok(())
-    };
-    positive(&options.colmap_thresholds_deg, "COLMAP thresholds")?;
-    positive(&options.co3d_thresholds_deg, "CO3D thresholds")?;
-    if !(options.co3d_auc_max_deg.is_finite() && options.co3d_auc_max_deg >= 1.0) {
-        return Err(Error::InvalidOption(format!(
-            "the CO3D AUC's largest threshold must be at least 1 degree, got {}",
-            options.co3d_auc_max_deg
-        )));
-    }
-    let pa = options.colmap_position_accuracy;
-    if !(pa.is_finite() && pa >= 0.0) {
-        return Err(Error::InvalidOption(format!(
-            "the position accuracy must be finite and not negative, got {pa}"
-        )));
-    }
-    let mut notes = Vec::new();
-    let (paired, matched) = pair_poses(gt, est, &mut notes)?;
-    let mut pair_rows = Vec::new();
-    let (convention, result) = match protocol {
-        Protocol::Colmap => {
-            let (c, r) = super::colmap_benchmark::evaluate(&paired, options, &mut pair_rows);
-            (c, ProtocolResult::Colmap(r))
-        }
-        Protocol::Imc => {
-            let (c, r) = super::imc::evaluate(&paired, &mut pair_rows);
-            (c, ProtocolResult::Imc(r))
-        }
-        Protocol::Co3d => {
-            let (c, r) = super::co3d::evaluate(&paired, options, &mut pair_rows);
-            (c, ProtocolResult::Co3d(r))
-        }
-    };
-    Ok(PosesReport {
-        schema: POSES_SCHEMA.into(),
-        ground_truth: gt.images.len(),
-        registered: est.images.len(),
-        matched,
-        unmatched_estimated: paired.outliers,
-        non_finite: paired.non_finite,
-        models: est.num_models(),
-        convention,
-        result,
-        notes,
-        pair_rows,
-    })
 }
