@@ -113,6 +113,10 @@ check bench-dtu-quick .venv/bin/python bench/dtu.py --quick
 # quick mode (about 10 s).
 check bench-eth3d-quick .venv/bin/python bench/eth3d.py --quick
 
+# The pose protocols (COLMAP's benchmark, IMC's mAA, CO3D's RRA/RTA) against their official code
+# (tests/third_party/), quick mode: 60 images, one round, the numbers must agree (a few seconds).
+check bench-poses-quick .venv/bin/python bench/poses.py --quick
+
 # The Python package (crates/sfmeval-py): its wheel built, installed in a fresh venv and tested
 # against the CLI's reports byte for byte.
 check python-package scripts/check-python-package.sh
