@@ -286,7 +286,7 @@ impl Plan {
             Some(scripts),
             &a.pipelines,
             datasets,
-            a.slurm.render_shards,
+            a.slurm.render_shards(),
         )
     }
 
@@ -355,7 +355,7 @@ impl Plan {
             Some(scripts),
             &a.pipelines,
             datasets,
-            a.slurm.render_shards,
+            a.slurm.render_shards(),
         )?;
         Ok((plan, sweep_plan))
     }
@@ -432,6 +432,11 @@ impl Plan {
             )
         })?;
         Ok((ds, k % n))
+    }
+
+    /// The render tasks of the `d`-th dataset (its shards, in order).
+    pub fn render_tasks_of(&self, d: usize) -> std::ops::Range<usize> {
+        d * self.render_shards..(d + 1) * self.render_shards
     }
 
     /// Finalize task `k`: its dataset.
