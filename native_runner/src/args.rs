@@ -544,4 +544,26 @@ mod tests {
         assert!(e.starts_with("--align points needs point pairs"), "{e}");
         assert!(request("nonsense").is_err());
     }
+
+    /// `SlurmArgs` alone on a command line.
+    #[derive(Parser)]
+    struct Where {
+        #[command(flatten)]
+        slurm: SlurmArgs,
+    }
+
+    fn shards(args: &[&str]) -> usize {
+        Where::try_parse_from(std::iter::once("test").chain(args.iter().copied()))
+            .unwrap()
+            .slurm
+            .render_shards()
+    }
+
+    #[test]
+    fn render_shards_default_to_one_locally_and_four_on_slurm() {
+        assert_eq!(shards(&[]), 1);
+        assert_eq!(shards(&["--executor", "slurm"]), 4);
+        assert_eq!(shards(&["--render-shards", "3"]), 3);
+        assert_eq!(shards(&["--executor", "slurm", "--render-shards", "2"]), 2);
+    }
 }

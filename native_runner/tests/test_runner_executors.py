@@ -115,9 +115,9 @@ def tree(root):
 def test_render_shards_through_both_executors_give_the_same_dataset(runner_bin, cluster,
                                                                     tmp_path):
     """The local executor runs the plan's render tasks and finalize as the Slurm jobs do: with
-    --render-shards 2 both make the same dataset byte for byte (images, depth maps, masks,
-    cameras.json, dataset.json, ground_truth.glb, scene.blend; timing.json holds the measured
-    times) and a table1.json of the same keys."""
+    --render-shards 2 both make the same dataset byte for byte (the 8 images, cameras.json,
+    dataset.json, ground_truth.glb and sparse_gt/'s COLMAP text model; timing.json holds the
+    measured times and where each part ran) and a table1.json of the same keys."""
     pytest.importorskip("bpy")
     local = tmp_path / "local"
     p = run_cli(runner_bin, *TABLE1, "--out", local)
@@ -137,8 +137,9 @@ def test_render_shards_through_both_executors_give_the_same_dataset(runner_bin, 
     assert sorted(a) == sorted(b)
     images = [f for f in a if f.startswith("images" + os.sep)]
     assert len(images) == 8
-    for f in ("cameras.json", "dataset.json", "ground_truth.glb"):
-        assert f in a, sorted(a)
+    gt = [os.path.join("sparse_gt", f) for f in ("cameras.txt", "images.txt", "points3D.txt")]
+    assert sorted(f for f in a if f not in images) == \
+        ["cameras.json", "dataset.json", "ground_truth.glb"] + gt + ["timing.json"], sorted(a)
     assert [f for f in sorted(a) if a[f] != b[f]] == ["timing.json"]
     for t in (local, slurm):
         parts = load(t / "datasets" / NAME / "timing.json")["parts"]

@@ -501,7 +501,7 @@ impl Plan {
 }
 
 /// The plan of a batch: its command line `argv`, output folder, tools, generator (absolute;
-/// none for `run`), pipelines and datasets (rendered in `render_shards` parts each on Slurm,
+/// none for `run`), pipelines and datasets (rendered in `render_shards` parts each,
 /// or, with `dir`, existing folders); the cells are the datasets by name × the pipelines (as
 /// `run`'s grid).
 fn make_plan(
