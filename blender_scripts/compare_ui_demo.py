@@ -1,6 +1,7 @@
 """The Compare pipelines panel in a real Blender window (manual check and the README picture):
 the run operator runs modally (timers keep firing while the pipelines run), then import, crop,
-evaluate, and a screenshot of the window.
+evaluate, Table I (the text block the panel writes) in a text editor below the 3D view, and a
+screenshot of the window.
 
     xvfb-run -s "-screen 0 1600x1500x24" blender --factory-startup -noaudio \\
         --window-geometry 0 0 1600 1500 EMPTY.blend -P blender_scripts/compare_ui_demo.py -- \\
@@ -9,6 +10,11 @@ evaluate, and a screenshot of the window.
 EMPTY.blend: any saved startup file (a file on the command line skips the splash screen).
 DATASET is a rendered dataset; pycolmap-global is run on it (into DATASET/runs/) and every run
 folder there is imported. Prints "UI ticks during the run: N" (N > 0: Blender stayed usable).
+
+The README picture (docs/blender-compare-panel.jpg): the `small` preset rendered without depth
+and masks; in DATASET/runs/ `sfmeval-runner run` made pycolmap, a bare cloud (`--custom
+cloud-only=cp OPENMVG_RUN/sparse.ply {out}/`) and a failing custom run (`zz-failed`); window
+1600x2300, the screenshot cut above the timeline (1600x2098) and saved as JPEG quality 80.
 """
 
 import sys
@@ -33,9 +39,23 @@ state = {"phase": "start", "t0": 0.0}
 
 def view3d():
     win = bpy.context.window_manager.windows[0]
-    area = next(a for a in win.screen.areas if a.type == "VIEW_3D")
+    area = max((a for a in win.screen.areas if a.type == "VIEW_3D"), key=lambda a: a.height)
     region = next(r for r in area.regions if r.type == "WINDOW")
     return win, area, region
+
+
+def show_table_below(win, area):
+    """A text editor below the 3D view showing the text block Table I is written into."""
+    with bpy.context.temp_override(window=win, area=area):
+        bpy.ops.screen.area_split(direction="HORIZONTAL", factor=0.13)
+    below = min((a for a in win.screen.areas if a.type == "VIEW_3D"), key=lambda a: a.height)
+    below.type = "TEXT_EDITOR"
+    space = below.spaces.active
+    space.text = bpy.data.texts[cpanel.TABLE_TEXT]
+    space.show_word_wrap = True
+    space.show_line_numbers = False
+    space.show_syntax_highlight = False
+    space.top = 0
 
 
 def tick():
@@ -86,6 +106,13 @@ def _tick():
             c.crop_object.scale = (0.45, 0.45, 0.5)
             c.use_max_distance, c.max_distance = True, 0.05
             bpy.ops.sfmeval.compare_evaluate()
+            state["phase"] = "table"
+            return 0.5
+        if state["phase"] == "table":
+            show_table_below(win, area)
+            state["phase"] = "frame"
+            return 0.5
+        if state["phase"] == "frame":
             shading = area.spaces.active.shading
             shading.type, shading.color_type = "SOLID", "VERTEX"
             for o in bpy.context.view_layer.objects:

@@ -393,9 +393,11 @@ pub struct SlurmArgs {
     /// two) into OUT/slurm/ and submit them as job arrays chained by dependencies.
     #[arg(long, default_value = "local", value_parser = ["local", "slurm"])]
     pub executor: String,
-    /// Slurm: render tasks per dataset (task i renders the views k with k % n == i).
-    #[arg(long, default_value_t = 4)]
-    pub render_shards: usize,
+    /// Render tasks per dataset, with either executor (task i renders the views k with
+    /// k % n == i, then a finalize writes the ground truth; one task renders the dataset in
+    /// one generator call). Default: 1 locally, 4 on Slurm.
+    #[arg(long, value_name = "N")]
+    pub render_shards: Option<usize>,
     /// Slurm: partition of every stage (a `--stage` partition overrides it).
     #[arg(long)]
     pub partition: Option<String>,
@@ -419,6 +421,12 @@ impl SlurmArgs {
     /// Whether the batch goes to Slurm.
     pub fn is_slurm(&self) -> bool {
         self.executor == "slurm"
+    }
+
+    /// Render tasks per dataset: `--render-shards`, else 1 locally and 4 on Slurm.
+    pub fn render_shards(&self) -> usize {
+        self.render_shards
+            .unwrap_or(if self.is_slurm() { 4 } else { 1 })
     }
 
     /// Fails when a Slurm-only option is given without `--executor slurm` (`slurm_resume`:
@@ -535,5 +543,27 @@ mod tests {
         let e = request("points").unwrap_err().to_string();
         assert!(e.starts_with("--align points needs point pairs"), "{e}");
         assert!(request("nonsense").is_err());
+    }
+
+    /// `SlurmArgs` alone on a command line.
+    #[derive(Parser)]
+    struct Where {
+        #[command(flatten)]
+        slurm: SlurmArgs,
+    }
+
+    fn shards(args: &[&str]) -> usize {
+        Where::try_parse_from(std::iter::once("test").chain(args.iter().copied()))
+            .unwrap()
+            .slurm
+            .render_shards()
+    }
+
+    #[test]
+    fn render_shards_default_to_one_locally_and_four_on_slurm() {
+        assert_eq!(shards(&[]), 1);
+        assert_eq!(shards(&["--executor", "slurm"]), 4);
+        assert_eq!(shards(&["--render-shards", "3"]), 3);
+        assert_eq!(shards(&["--executor", "slurm", "--render-shards", "2"]), 2);
     }
 }

@@ -1,5 +1,5 @@
 //! The Blender dataset generator (`blender_scripts/generate.py`, run in the venv's bpy): where
-//! it is, its resolved config, and rendering one dataset into a folder.
+//! it is, its resolved config, and one call of it.
 
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
@@ -8,7 +8,6 @@ use anyhow::{Context, Result, bail};
 use serde_json::Value as Json;
 
 use crate::exec::{Step, run_step};
-use crate::files::{partial_name, replace_dir};
 
 /// The `blender_scripts` folder: given, `$SFMEVAL_BLENDER_SCRIPTS`, beside an ancestor of the
 /// binary, or under the working directory.
@@ -34,47 +33,36 @@ pub fn find_blender_scripts(given: Option<&Path>) -> Result<PathBuf> {
         .context("blender_scripts/generate.py not found: pass --blender-scripts DIR")
 }
 
-/// Runs the Blender generator (`generate.py ARGS --out TMP`) into a temporary folder beside
-/// `dest`, logging to `dest.log`, and moves the dataset into `dest` when it succeeded; returns
-/// the seconds spent. A failure names the generator's last error line. `who` prefixes the
-/// progress line (`table1`, `sweep`).
-pub fn render_dataset(
-    who: &str,
+/// One call of the Blender generator: `generate.py ARGS --out OUT` run from `cwd` (where the
+/// relative model paths of `--set` are read), in its own process group, its output appended
+/// to `log`; returns its wall seconds. A failure names the generator's last error line.
+pub fn run_generator(
+    label: &str,
     python: &Path,
     scripts: &Path,
     args: &[String],
-    dest: &Path,
+    out: &Path,
+    cwd: &Path,
+    log: &Path,
 ) -> Result<f64> {
-    let tmp = partial_name(dest);
-    if tmp.exists() {
-        std::fs::remove_dir_all(&tmp)?;
-    }
     let mut argv = vec![
         python.to_string_lossy().to_string(),
         scripts.join("generate.py").to_string_lossy().to_string(),
     ];
     argv.extend(args.iter().cloned());
     argv.push("--out".into());
-    argv.push(tmp.to_string_lossy().to_string());
-    let parent = dest.parent().unwrap_or(Path::new("."));
-    let name = dest
-        .file_name()
-        .map(|n| n.to_string_lossy().to_string())
-        .unwrap_or_default();
-    let log = parent.join(format!("{name}.log"));
-    eprintln!(
-        "{who}: rendering {name} → {} (log {})",
-        dest.display(),
-        log.display()
-    );
-    let step = Step::new(&format!("generate {name}"), argv, parent);
-    let r = run_step(&step, &log, Instant::now() + Duration::from_secs(48 * 3600));
+    argv.push(out.to_string_lossy().to_string());
+    let step = Step::new(label, argv, cwd);
+    // this call's part of the log: it may hold earlier calls' output
+    let start = std::fs::metadata(log).map_or(0, |m| m.len());
+    let r = run_step(&step, log, Instant::now() + Duration::from_secs(48 * 3600));
     if !r.success() {
-        let _ = std::fs::remove_dir_all(&tmp);
-        let tail = std::fs::read_to_string(&log)
+        let tail = std::fs::read(log)
             .ok()
-            .and_then(|t| {
-                t.lines()
+            .and_then(|bytes| {
+                let mine = bytes.get(start as usize..).unwrap_or_default();
+                String::from_utf8_lossy(mine)
+                    .lines()
                     .rev()
                     .find(|l| l.contains("error"))
                     .map(str::to_string)
@@ -82,7 +70,6 @@ pub fn render_dataset(
             .unwrap_or_default();
         bail!("{} {tail} (see {})", r.failure_reason(), log.display());
     }
-    replace_dir(&tmp, dest)?;
     Ok(r.wall_seconds)
 }
 

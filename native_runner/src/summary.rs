@@ -37,8 +37,8 @@ pub struct TaskWithoutResult {
 /// The times of a `table1` (seconds).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Table1Timing {
-    /// Per dataset rendered by this batch: locally the generator's wall time, on Slurm the
-    /// render time its parts measured (`timing.json`'s `render_seconds_total`).
+    /// Per dataset rendered by this batch: locally the wall time of its generator calls, on
+    /// Slurm the render time its parts measured (`timing.json`'s `render_seconds_total`).
     pub render_seconds: BTreeMap<String, f64>,
     /// Per dataset rendered by this batch: mean render seconds of a view (`timing.json`).
     pub render_seconds_per_view: BTreeMap<String, f64>,

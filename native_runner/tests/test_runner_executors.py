@@ -88,3 +88,75 @@ def test_one_run_plan_through_both_executors_gives_the_same_summary(runner_bin, 
     run_cli(runner_bin, "run", *grid, "--out", local, "--resume")
     again = load(local / "batch.json")
     assert again["runs_executed"] == {} and again["runs_reused"] == 4
+
+
+# A tiny table1: one preset, 8 views at 160x90, 2 samples per pixel, in 2 render shards; the
+# "pipeline" copies data/demo's sparse.ply (no SfM tool: the renders are what is compared).
+TABLE1 = ["table1", "--quick", "--presets", "statue", "--render-shards", "2",
+          "--pipelines", "copy", "--custom", PIPES[3], "--samples", "20000",
+          "--set", "camera.resolution=[160, 90]", "--set", "render.samples=2",
+          "--set", "views.orbits=[{elevation_deg=20.0, count=8}]"]
+TABLE1_SLURM = ["--executor", "slurm", "--stage", "render:cpus=1,mem=1G",
+                "--stage", "finalize:cpus=1,mem=1G", "--stage", "run:cpus=1,mem=500M",
+                "--stage", "collect:cpus=1,mem=1G"]
+NAME = "statue-quick"
+
+
+def tree(root):
+    """{relative path: bytes} of every file under root."""
+    out = {}
+    for d, _, names in os.walk(root):
+        for n in names:
+            p = os.path.join(d, n)
+            out[os.path.relpath(p, root)] = open(p, "rb").read()
+    return out
+
+
+def test_render_shards_through_both_executors_give_the_same_dataset(runner_bin, cluster,
+                                                                    tmp_path):
+    """The local executor runs the plan's render tasks and finalize as the Slurm jobs do: with
+    --render-shards 2 both make the same dataset byte for byte (the 8 images, cameras.json,
+    dataset.json, ground_truth.glb and sparse_gt/'s COLMAP text model; timing.json holds the
+    measured times and where each part ran) and a table1.json of the same keys."""
+    pytest.importorskip("bpy")
+    local = tmp_path / "local"
+    p = run_cli(runner_bin, *TABLE1, "--out", local)
+    # two render tasks and the finalize, each one generator call logged in datasets/NAME.log
+    log = (local / "datasets" / (NAME + ".log")).read_text()
+    assert [l.split("# ")[-1] for l in log.splitlines() if l.startswith("$ ")] == \
+        ["generate %s --views 0/2" % NAME, "generate %s --views 1/2" % NAME,
+         "generate %s --finalize" % NAME], log[-3000:]
+    assert "in 2 shard(s)" in p.stderr, p.stderr
+    slurm = tmp_path / "slurm"
+    p = run_cli(runner_bin, *TABLE1, "--out", slurm, *TABLE1_SLURM,
+                env={"SLURM_CONF": cluster.conf})
+    assert "submitted render 2/2, finalize 1/1, run 1/1, collect 1/1" in p.stderr, p.stderr
+    cluster.wait_idle(300)
+
+    a, b = tree(local / "datasets" / NAME), tree(slurm / "datasets" / NAME)
+    assert sorted(a) == sorted(b)
+    images = [f for f in a if f.startswith("images" + os.sep)]
+    assert len(images) == 8
+    gt = [os.path.join("sparse_gt", f) for f in ("cameras.txt", "images.txt", "points3D.txt")]
+    assert sorted(f for f in a if f not in images) == \
+        ["cameras.json", "dataset.json", "ground_truth.glb"] + gt + ["timing.json"], sorted(a)
+    assert [f for f in sorted(a) if a[f] != b[f]] == ["timing.json"]
+    for t in (local, slurm):
+        parts = load(t / "datasets" / NAME / "timing.json")["parts"]
+        assert [x["views"] for x in parts] == ["shard 0 2", "shard 1 2"], parts
+
+    mine, theirs = load(local / "table1.json"), load(slurm / "table1.json")
+    assert (mine["executor"], theirs["executor"]) == ("local", "slurm")
+    assert sorted(mine) == sorted(theirs) and sorted(mine["timing"]) == sorted(theirs["timing"])
+    for k in mine:
+        if k not in MEASURED:
+            assert mine[k] == theirs[k], (k, mine[k], theirs[k])
+    assert mine["presets"] == ["statue"] and mine["pipelines"] == ["copy"]
+    for t in (mine, theirs):
+        assert t["timing"]["render_seconds"][NAME] > 0
+
+    # A complete dataset is reused: the local command again renders nothing.
+    p = run_cli(runner_bin, *TABLE1, "--out", local)
+    assert "table1: reusing" in p.stderr and log == \
+        (local / "datasets" / (NAME + ".log")).read_text()
+    assert load(local / "table1.json")["timing"]["render_seconds"] == {}

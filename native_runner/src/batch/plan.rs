@@ -286,7 +286,7 @@ impl Plan {
             Some(scripts),
             &a.pipelines,
             datasets,
-            a.slurm.render_shards,
+            a.slurm.render_shards(),
         )
     }
 
@@ -355,7 +355,7 @@ impl Plan {
             Some(scripts),
             &a.pipelines,
             datasets,
-            a.slurm.render_shards,
+            a.slurm.render_shards(),
         )?;
         Ok((plan, sweep_plan))
     }
@@ -434,6 +434,11 @@ impl Plan {
         Ok((ds, k % n))
     }
 
+    /// The render tasks of the `d`-th dataset (its shards, in order).
+    pub fn render_tasks_of(&self, d: usize) -> std::ops::Range<usize> {
+        d * self.render_shards..(d + 1) * self.render_shards
+    }
+
     /// Finalize task `k`: its dataset.
     pub fn finalize_task(&self, k: usize) -> Result<&DatasetPlan> {
         self.datasets.get(k).with_context(|| {
@@ -496,7 +501,7 @@ impl Plan {
 }
 
 /// The plan of a batch: its command line `argv`, output folder, tools, generator (absolute;
-/// none for `run`), pipelines and datasets (rendered in `render_shards` parts each on Slurm,
+/// none for `run`), pipelines and datasets (rendered in `render_shards` parts each,
 /// or, with `dir`, existing folders); the cells are the datasets by name × the pipelines (as
 /// `run`'s grid).
 fn make_plan(

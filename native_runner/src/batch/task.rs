@@ -1,92 +1,91 @@
-//! The work of a batch's tasks, the same whichever executor runs them: rendering a dataset
-//! (whole, or one part of its views and then the finalize) and running the pipelines of its
-//! cells into a runs folder. The local executor calls these in this process, stage by stage; a
+//! The work of a batch's tasks, the same whichever executor runs them: a render task (a
+//! dataset whole, or one shard of its views), a finalize task, and the pipelines of cells run
+//! into a runs folder. The local executor calls these in this process, stage by stage; a
 //! Slurm job calls them through `sfmeval-runner slurm-task`.
 
-use std::process::Command;
+use std::path::Path;
 
 use anyhow::{Context, Result, bail};
-use sfmeval_fs::write_atomic;
 
 use crate::args::ToolArgs;
-use crate::batch::collect::DatasetOutcome;
 use crate::batch::plan::{DatasetPlan, Job, Plan};
 use crate::dataset::Dataset;
 use crate::env::make_env;
-use crate::generator::render_dataset;
+use crate::files::{partial_name, replace_dir};
+use crate::generator::run_generator;
 use crate::pipelines::{parse_customs, parse_list};
 use crate::run::{BatchOptions, BatchSummary, run_batch};
 
-/// `generate.py ARGS EXTRA --out OUT/datasets/<name>` (a part of the views, `--views i/n`, or
-/// the finalize, `--finalize`), its output into the caller's stderr.
-pub fn generator(plan: &Plan, ds: &DatasetPlan, extra: &[&str]) -> Result<()> {
-    let dir = plan.dataset_dir(&ds.name);
-    let script = plan.blender_scripts()?.join("generate.py");
-    eprintln!(
-        "{}: {} {} {} {} --out {}",
-        ds.name,
-        plan.python.display(),
-        script.display(),
-        ds.generator_args.join(" "),
-        extra.join(" "),
-        dir.display()
-    );
-    // from the datasets folder, as the whole render runs it (relative model paths in --set)
-    let status = Command::new(&plan.python)
-        .current_dir(plan.out.join("datasets"))
-        .arg(&script)
-        .args(&ds.generator_args)
-        .args(extra)
-        .arg("--out")
-        .arg(&dir)
-        .status()
-        .with_context(|| format!("starting {}", plan.python.display()))?;
-    if !status.success() {
-        bail!("the generator failed ({status}) on {}", dir.display());
+/// Render task `k` of the plan, the generator's output appended to `log`; returns its wall
+/// seconds. With one shard it renders its dataset whole in one generator call, through a
+/// temporary folder moved into place once complete (no finalize is left to do); with `n`
+/// shards it renders the views of its shard (`generate.py --views i/n`) into the dataset's
+/// folder, which the finalize task completes.
+pub fn render(plan: &Plan, k: usize, log: &Path) -> Result<f64> {
+    let (ds, shard) = plan.render_task(k)?;
+    let dest = plan.dataset_dir(&ds.name);
+    if plan.render_shards <= 1 {
+        let tmp = partial_name(&dest);
+        if tmp.exists() {
+            std::fs::remove_dir_all(&tmp).with_context(|| format!("removing {}", tmp.display()))?;
+        }
+        let made = generator(plan, ds, &[], &tmp, log);
+        if made.is_err() {
+            let _ = std::fs::remove_dir_all(&tmp);
+        }
+        let seconds = made?;
+        replace_dir(&tmp, &dest)?;
+        return Ok(seconds);
     }
-    Ok(())
+    let views = format!("{shard}/{}", plan.render_shards);
+    generator(plan, ds, &["--views".into(), views], &dest, log)
 }
 
-/// Renders a dataset of the plan whole, in one generator call (through a temporary folder),
-/// or reuses it when it is complete (unless `--fresh`). A sweep's variant is reused only when
-/// the same generator arguments made it (`OUT/datasets/<name>.args.json`).
-pub fn render_whole(plan: &Plan, job: &Job, ds: &DatasetPlan) -> Result<DatasetOutcome> {
-    let dest = plan.dataset_dir(&ds.name);
-    let stamped = matches!(job, Job::Sweep(_));
-    let stamp = plan
-        .out
-        .join("datasets")
-        .join(format!("{}.args.json", ds.name));
-    let stamp_json = serde_json::to_string_pretty(&ds.generator_args)? + "\n";
-    let complete = dest.join("dataset.json").is_file()
-        && dest.join("cameras.json").is_file()
-        && (!stamped
-            || std::fs::read_to_string(&stamp).ok().as_deref() == Some(stamp_json.as_str()));
-    if complete && !job.fresh() {
-        eprintln!("{}: reusing {}", job.name(), dest.display());
-        return Ok(DatasetOutcome::reused());
-    }
-    let rendered = render_dataset(
-        job.name(),
+/// Finalize task `k` of the plan (`generate.py --finalize`: the ground truth, `cameras.json`
+/// and `dataset.json` once its shards are rendered), the generator's output appended to
+/// `log`; returns its wall seconds.
+pub fn finalize(plan: &Plan, k: usize, log: &Path) -> Result<f64> {
+    let ds = plan.finalize_task(k)?;
+    generator(
+        plan,
+        ds,
+        &["--finalize".into()],
+        &plan.dataset_dir(&ds.name),
+        log,
+    )
+}
+
+/// `generate.py ARGS EXTRA --out OUT` for dataset `ds`, from `OUT/datasets` (the relative
+/// model paths in `--set` are read from there).
+fn generator(
+    plan: &Plan,
+    ds: &DatasetPlan,
+    extra: &[String],
+    out: &Path,
+    log: &Path,
+) -> Result<f64> {
+    let label = format!("generate {} {}", ds.name, extra.join(" "));
+    let what = if extra.is_empty() {
+        "the whole dataset".to_string()
+    } else {
+        extra.join(" ")
+    };
+    eprintln!(
+        "{}: generator {what} → {} (log {})",
+        ds.name,
+        out.display(),
+        log.display()
+    );
+    let args: Vec<String> = ds.generator_args.iter().chain(extra).cloned().collect();
+    run_generator(
+        label.trim_end(),
         &plan.python,
         plan.blender_scripts()?,
-        &ds.generator_args,
-        &dest,
-    );
-    match rendered {
-        Ok(seconds) => {
-            if stamped {
-                write_atomic(&stamp, stamp_json.as_bytes())?;
-            }
-            Ok(DatasetOutcome::rendered(Some(seconds)))
-        }
-        Err(e) => {
-            if stamped {
-                let _ = std::fs::remove_file(&stamp);
-            }
-            Err(e)
-        }
-    }
+        &args,
+        out,
+        &plan.out.join("datasets"),
+        log,
+    )
 }
 
 /// Runs the plan's pipelines (only `pipeline`, when given) on `datasets` into `opts.out`, as

@@ -10,7 +10,7 @@ use nix::unistd::Pid;
 use crate::args::SlurmTaskArgs;
 use crate::batch::plan::{Plan, Stage};
 use crate::batch::state::{dataset_done, task_done};
-use crate::batch::task::{generator, run_cells};
+use crate::batch::task::{finalize, render, run_cells};
 use crate::dataset::Dataset;
 use crate::slurm::collect::collect;
 use crate::summary::Executor;
@@ -37,15 +37,9 @@ pub fn slurm_task(a: &SlurmTaskArgs) -> Result<()> {
         return Ok(());
     }
     match stage {
-        Stage::Render => {
-            let (ds, shard) = plan.render_task(k)?;
-            let views = format!("{shard}/{}", plan.render_shards);
-            generator(&plan, ds, &["--views", &views])
-        }
-        Stage::Finalize => {
-            let ds = plan.finalize_task(k)?;
-            generator(&plan, ds, &["--finalize"])
-        }
+        // the generator's output into the task's Slurm log (opened in append mode)
+        Stage::Render => render(&plan, k, &plan.log(stage, k)).map(drop),
+        Stage::Finalize => finalize(&plan, k, &plan.log(stage, k)).map(drop),
         Stage::Run => run_cell(&plan, k),
         Stage::Collect => collect(&plan),
     }
