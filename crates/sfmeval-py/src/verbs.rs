@@ -23,7 +23,7 @@ use sfmeval_fs::{
     Disk, DtuRun, Eth3dRun, name_of, named, path_str, pipeline_and_path, read, read_input_files,
     read_transform, run_dtu, run_eth3d, write_atomic,
 };
-use sfmeval_table::{Row, failed_row, report_row, summary_json, tables};
+use sfmeval_table::{Row, failed_row, read_row_poses, report_row, summary_json, tables};
 use sfmeval_tnt::{self as tnt, IcpCriteria, Registration, Scene, TntRequest};
 
 use crate::{Failure, existing, hooks};
@@ -413,7 +413,11 @@ fn table_rows(
     };
     let mut rows = Vec::new();
     for (pipeline, path, report) in &read {
-        rows.push(report_row(&dataset, pipeline, report, path_str(path)?));
+        let file = path_str(path)?;
+        let mut row = report_row(&dataset, pipeline, report, file);
+        // the pose protocols' reports beside it (sfmeval poses --json), when there
+        row.poses = read_row_poses(&Disk, file)?;
+        rows.push(row);
     }
     for f in failed {
         let Some((pipeline, reason)) = named(f) else {
