@@ -2,8 +2,9 @@
 //! ground truth prepared once, `auto` alignment with its cameras.json, optional crop), writes
 //! one `sfmeval.report/3` per run and the comparison tables (Markdown, CSV, HTML). A Tanks and
 //! Temples scene's runs get the benchmark's protocol (`tnt.rs`), a DTU scan's the DTU protocol
-//! (`dtu.rs`), an ETH3D scene's ETH3D's multi-view protocol (`eth3d.rs`). A run whose dataset has ground-truth cameras also gets the pose protocols
-//! (`sfmeval poses`: COLMAP, IMC, CO3D), their reports beside its report.
+//! (`dtu.rs`), an ETH3D scene's ETH3D's multi-view protocol (`eth3d.rs`). A run whose dataset
+//! has ground-truth cameras also gets the pose protocols (`poses.rs`: `sfmeval poses` for COLMAP,
+//! IMC and CO3D), their reports beside its report.
 
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};

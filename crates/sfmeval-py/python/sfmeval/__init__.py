@@ -896,7 +896,9 @@ def table(
         A folder of runs: every ``PIPELINE/report.json`` directly inside it, by name (what
         ``sfmeval table FOLDER/*/report.json`` reads); or report paths, each
         ``PIPELINE=REPORT.json`` or a path whose parent folder names the pipeline; or a dict
-        ``{pipeline: report path}``.
+        ``{pipeline: report path}``. The pose protocols' reports beside a report
+        (``REPORT.poses-colmap.json``, ``-imc``, ``-co3d``, as the runner writes them) add its
+        pose columns.
     dataset
         The dataset's name in the tables (default: the ground truth's file name, without its
         extension, of the first report).
