@@ -360,7 +360,9 @@ pub struct Table1Args {
     /// folder named after the scene), evaluated with the benchmark's protocol at the scene's
     /// τ, or DTU scans (images/, cameras.json in the scan's frame in mm, Points/stl/ and
     /// ObsMask/ as the benchmark ships them), evaluated with the DTU protocol after the camera
-    /// alignment; run like the others.
+    /// alignment, or ETH3D scenes (images/, cameras.json or dslr_calibration_undistorted/ in
+    /// the scene's frame in metres, dslr_scan_eval/scan_alignment.mlp with its scans),
+    /// evaluated with ETH3D's protocol after the camera alignment; run like the others.
     #[arg(long = "scene", value_name = "DIR")]
     pub scenes: Vec<PathBuf>,
     /// The dataset generator.

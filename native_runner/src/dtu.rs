@@ -63,7 +63,7 @@ pub fn read_scan(dir: &Path, scan: u32) -> Result<(DtuScan, model::Reconstructio
 /// writes in `reports/<ds>/<pipeline>/` its points in the scan's frame ([`RECON_PLY`]), the
 /// alignment ([`ALIGNMENT_JSON`]) and the evaluator's error clouds, and the protocol's report
 /// as `reports/<ds>/<pipeline>.json`, with the CLI's default options (`sfmeval dtu --recon
-/// RECON_PLY` gives the same report but for its name).
+/// RECON_PLY` gives the same report but for its name), and the pose protocols' reports beside it.
 pub fn evaluate_run(
     scan_no: u32,
     scan: &DtuScan,
@@ -115,7 +115,7 @@ pub fn evaluate_run(
     for (file, bytes) in dtu::vis::output_files(&evaluation, scan_no, &scan.stl) {
         write_atomic(&dir.join(file), &bytes)?;
     }
-    Ok(dtu_row(
+    let mut row = dtu_row(
         &rec.facts(),
         DtuNumbers {
             scan: scan_no,
@@ -125,5 +125,8 @@ pub fn evaluate_run(
         },
         report.counts.points as u64,
         "cameras",
-    ))
+    );
+    let poses = crate::poses::run_poses(Some(gt_cameras), &recon);
+    row.poses = crate::poses::write_poses(out, &rel, poses)?;
+    Ok(row)
 }

@@ -2,7 +2,9 @@
 //! ground truth prepared once, `auto` alignment with its cameras.json, optional crop), writes
 //! one `sfmeval.report/3` per run and the comparison tables (Markdown, CSV, HTML). A Tanks and
 //! Temples scene's runs get the benchmark's protocol (`tnt.rs`), a DTU scan's the DTU protocol
-//! (`dtu.rs`).
+//! (`dtu.rs`), an ETH3D scene's ETH3D's multi-view protocol (`eth3d.rs`). A run whose dataset
+//! has ground-truth cameras also gets the pose protocols (`poses.rs`: `sfmeval poses` for COLMAP,
+//! IMC and CO3D), their reports beside its report.
 
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
@@ -90,6 +92,10 @@ pub fn report(args: &ReportArgs) -> Result<Vec<Row>> {
             rows.extend(report_dtu_dataset(scan, &ds_dir, &records, args)?);
             continue;
         }
+        if crate::eth3d::is_scene(&ds_dir) {
+            rows.extend(report_eth3d_dataset(&ds_dir, &records, args)?);
+            continue;
+        }
         let mut gt = if any_ok {
             match load_gt(&ds_dir) {
                 Ok(g) => Some(g),
@@ -107,10 +113,12 @@ pub fn report(args: &ReportArgs) -> Result<Vec<Row>> {
                 ds_dir.display()
             ))),
             Some(g) => match evaluate_run(g, dir, rec, args) {
-                Ok((report, kept)) => {
+                Ok((report, kept, poses)) => {
                     let rel = report_path(&rec.dataset, &rec.pipeline);
                     write_atomic(&args.out.join(&rel), report.to_json().as_bytes())?;
-                    Ok(Ok(evaluated_row(&rec.facts(), &report, &kept)))
+                    let mut row = evaluated_row(&rec.facts(), &report, &kept);
+                    row.poses = crate::poses::write_poses(&args.out, &rel, poses)?;
+                    Ok(Ok(row))
                 }
                 Err(e) => Ok(Err(e)),
             },
@@ -190,6 +198,28 @@ fn report_dtu_dataset(
     })
 }
 
+/// The rows of an ETH3D scene's runs, evaluated with ETH3D's protocol after the camera
+/// alignment.
+fn report_eth3d_dataset(
+    ds_dir: &Path,
+    records: &[(RunRecord, &PathBuf)],
+    args: &ReportArgs,
+) -> Result<Vec<Row>> {
+    let any_ok = records.iter().any(|(r, _)| r.status == Status::Ok);
+    // Read only when some run needs it; unused otherwise.
+    let read = if any_ok {
+        crate::eth3d::read_scene(ds_dir).map_err(|e| format!("{e:#}"))
+    } else {
+        Err(String::new())
+    };
+    dataset_rows(records, args, |rec, dir| {
+        Ok(match &read {
+            Ok(scene) => crate::eth3d::evaluate_run(scene, dir, rec, &args.out),
+            Err(e) => Err(anyhow::anyhow!("ETH3D scene {}: {e}", ds_dir.display())),
+        })
+    })
+}
+
 /// A dataset's rows: each run's row from its run.json, replaced by `evaluate`'s for runs that
 /// ended ok. `evaluate` returns `Err` for what stops the report (an output that cannot be
 /// written) and `Ok(Err)` for a run that cannot be evaluated, whose row then says
@@ -232,7 +262,7 @@ fn evaluate_run(
     dir: &Path,
     rec: &RunRecord,
     args: &ReportArgs,
-) -> Result<(Report, Vec<f64>)> {
+) -> Result<(Report, Vec<f64>, crate::poses::RunPoses)> {
     // the run folder's layout (model/, else sparse.ply) is sfmeval-table's
     let files = sfmeval_table::layout::read_run_reconstruction(&sfmeval_fs::Disk, path_str(dir)?)?;
     let name = format!("{}/{}", rec.dataset, rec.pipeline);
@@ -243,6 +273,7 @@ fn evaluate_run(
         ..EvalRequest::default()
     };
     let evaluation = pipeline::run(gt, &recon, &request, &NoProgress)?;
+    let poses = crate::poses::run_poses(gt.cameras(), &recon);
     let kept: Vec<f64> = evaluation
         .distances
         .iter()
@@ -250,5 +281,5 @@ fn evaluate_run(
         .filter(|(_, s)| matches!(s, sfmeval::evaluate::PointStatus::Kept))
         .map(|(d, _)| *d)
         .collect();
-    Ok((evaluation.report, kept))
+    Ok((evaluation.report, kept, poses))
 }

@@ -3,10 +3,10 @@
 
 use std::path::{Path, PathBuf};
 
-use anyhow::{Context as _, Result, bail};
+use anyhow::{Context as _, Result};
 use clap::Args;
-use sfmeval_eth3d::{self as eth3d, Eth3dOptions, Eth3dReport, Eth3dScene, NamedBytes};
-use sfmeval_fs::{read, write_atomic};
+use sfmeval_eth3d::{self as eth3d, Eth3dOptions, Eth3dReport};
+use sfmeval_fs::{Eth3dRun, run_eth3d, write_atomic};
 
 /// `sfmeval eth3d`'s flags.
 #[derive(Args, Debug)]
@@ -65,75 +65,23 @@ pub fn eth3d_cmd(args: &Eth3dArgs) -> Result<()> {
         beam_start_radius: args.beam_start_radius,
         beam_divergence_halfangle_deg: args.beam_divergence_halfangle_deg,
     };
-    let gt_name = args.gt.display().to_string();
-    let mlp = read(&args.gt)?;
-    // The scans' bytes live here while the scene is read.
-    let mut files: Vec<(String, Vec<u8>)> = Vec::new();
-    let mut read_error = None;
-    let scene = {
-        let entries = eth3d::mlp::read_mlp(&mlp)
-            .map_err(|e| e.in_file("ground-truth project", gt_name.as_str()))?;
-        for entry in &entries {
-            let path = eth3d::mlp::scan_path(&args.gt, &entry.filename);
-            match read(&path) {
-                Ok(b) => files.push((path.display().to_string(), b)),
-                Err(e) => {
-                    read_error = Some(e.context(format!(
-                        "scan '{}' of the ground-truth project '{gt_name}'",
-                        entry.filename
-                    )));
-                    break;
-                }
-            }
-        }
-        if let Some(e) = read_error {
-            return Err(e);
-        }
-        let mut next = files.iter();
-        Eth3dScene::read(
-            NamedBytes {
-                name: &gt_name,
-                bytes: &mlp,
-            },
-            |_| {
-                next.next()
-                    .map(|(name, bytes)| NamedBytes { name, bytes })
-                    .ok_or_else(|| sfmeval::Error::InvalidContent("a scan is missing".into()))
-            },
-        )?
-    };
-    drop(files);
-    let recon_name = args.recon.display().to_string();
-    let recon = eth3d::scene::read_points_f32(&read(&args.recon)?)
-        .with_context(|| format!("reconstruction '{recon_name}'"))?;
-    if recon.is_empty() {
-        bail!("reconstruction '{recon_name}': the PLY has no vertices");
-    }
-    let evaluation = eth3d::evaluate(&scene, &recon, &options)?;
-    let report = Eth3dReport::new(&evaluation, &scene, &gt_name, &recon_name);
-    let json = report.to_json();
+    let outputs = run_eth3d(&Eth3dRun {
+        gt: &args.gt,
+        recon: &args.recon,
+        options: &options,
+    })?;
     if let Some(dir) = &args.out {
         std::fs::create_dir_all(dir)
             .with_context(|| format!("cannot create '{}'", dir.display()))?;
-        write_atomic(&dir.join("eth3d.json"), json.as_bytes())?;
-        // One cloud in memory at a time (each is 15 bytes a point).
-        for (t, &tolerance) in evaluation.tolerances.iter().enumerate() {
-            let name = eth3d::vis::file_name("completeness", tolerance);
-            write_atomic(
-                &dir.join(name),
-                &eth3d::vis::completeness_ply(&evaluation, t),
-            )?;
-            let name = eth3d::vis::file_name("accuracy", tolerance);
-            write_atomic(
-                &dir.join(name),
-                &eth3d::vis::accuracy_ply(&evaluation, &recon, t),
-            )?;
-        }
+        write_atomic(&dir.join("eth3d.json"), outputs.json.as_bytes())?;
+        outputs.write_vis_files(|name, bytes| write_atomic(&dir.join(name), bytes))?;
     }
+    let json = &outputs.json;
+    let report = &outputs.report;
     if args.json {
         print!("{json}");
     } else {
-        print!("{}", summary(&report, args.out.as_deref()));
+        print!("{}", summary(report, args.out.as_deref()));
     }
     Ok(())
 }

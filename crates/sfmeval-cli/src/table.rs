@@ -7,14 +7,16 @@ use std::path::{Path, PathBuf};
 use anyhow::{Context as _, Result, bail};
 use clap::{Args, ValueEnum};
 use sfmeval::report::Report;
-use sfmeval_fs::{named, path_str, pipeline_and_path, read, write_atomic};
-use sfmeval_table::{Row, failed_row, report_row, summary_json, tables};
+use sfmeval_fs::{Disk, named, path_str, pipeline_and_path, read, write_atomic};
+use sfmeval_table::{Row, failed_row, read_row_poses, report_row, summary_json, tables};
 
 /// `sfmeval table`'s flags.
 #[derive(Args, Debug)]
 pub struct TableArgs {
     /// Evaluation reports (`sfmeval eval --report`), each `PIPELINE=REPORT.json` or a path whose
-    /// parent folder names the pipeline (`compare/colmap/report.json` → `colmap`).
+    /// parent folder names the pipeline (`compare/colmap/report.json` → `colmap`). The pose
+    /// protocols' reports beside one (`REPORT.poses-colmap.json`, `-imc`, `-co3d`: `sfmeval poses
+    /// --protocol P --report ...`), when all three are there, add its pose columns.
     #[arg(value_name = "[PIPELINE=]REPORT", required = true)]
     reports: Vec<String>,
     /// The dataset's name in the tables (default: the ground truth's file name, without its
@@ -81,7 +83,11 @@ fn rows(args: &TableArgs) -> Result<Vec<Row>> {
     };
     let mut rows = Vec::new();
     for (pipeline, path, report) in &reports {
-        rows.push(report_row(&dataset, pipeline, report, path_str(path)?));
+        let file = path_str(path)?;
+        let mut row = report_row(&dataset, pipeline, report, file);
+        // the pose protocols' reports beside it (sfmeval poses --json), when there
+        row.poses = read_row_poses(&Disk, file)?;
+        rows.push(row);
     }
     for f in &args.failed {
         let Some((pipeline, reason)) = named(f) else {

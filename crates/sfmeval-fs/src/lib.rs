@@ -3,10 +3,12 @@
 //! The filesystem layer of the native front ends (the `sfmeval` CLI and `sfmeval-runner`): the
 //! core reads named bytes through [`sfmeval::files::FileSource`]; [`Disk`] is that source over
 //! the real filesystem, and [`write_atomic`] is the one way outputs reach the disk. [`run_dtu`] is `sfmeval dtu` on files: the scan's files and any reconstruction
-//! `sfmeval eval` reads, for the CLI, the Python package and the runner alike.
+//! `sfmeval eval` reads, and [`run_eth3d`] is `sfmeval eth3d` on files (the scene's MeshLab project
+//! and its scans, a reconstruction PLY), for the CLI, the Python package and the runner alike.
 
 mod disk;
 mod dtu;
+mod eth3d;
 mod report_args;
 mod stream;
 mod write;
@@ -16,6 +18,7 @@ pub use disk::{
     read_point_pairs, read_transform,
 };
 pub use dtu::{DtuOutputs, DtuRecon, DtuRun, read_dtu_recon, read_dtu_scan, run_dtu};
+pub use eth3d::{Eth3dOutputs, Eth3dRun, eth3d_on_scene, read_eth3d_scene, run_eth3d};
 pub use report_args::{named, pipeline_and_path};
 pub use stream::{read_reconstruction, read_reconstruction_with_cameras};
 pub use write::write_atomic;

@@ -562,6 +562,7 @@ fn _sfmeval(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(verbs::_poses, m)?)?;
     m.add_function(wrap_pyfunction!(verbs::_tnt, m)?)?;
     m.add_function(wrap_pyfunction!(verbs::_dtu, m)?)?;
+    m.add_function(wrap_pyfunction!(verbs::_eth3d, m)?)?;
     m.add_function(wrap_pyfunction!(verbs::_table, m)?)?;
     m.add_function(wrap_pyfunction!(version, m)?)?;
     m.add_function(wrap_pyfunction!(align_modes, m)?)?;

@@ -1,7 +1,8 @@
 //! The CLI's other verbs for Python: `read` (what a file holds, as arrays), `cameras`
-//! (`sfmeval cameras`), `tnt` (`sfmeval tnt`), `dtu` (`sfmeval dtu`) and `table`
-//! (`sfmeval table`), each reading its inputs as the CLI does (`dtu` through the same
-//! `sfmeval_fs::run_dtu`) so that its JSON or text is the CLI's byte for byte.
+//! (`sfmeval cameras`), `tnt` (`sfmeval tnt`), `dtu` (`sfmeval dtu`), `eth3d` (`sfmeval eth3d`)
+//! and `table` (`sfmeval table`), each reading its inputs as the CLI does (`dtu` and `eth3d`
+//! through the same `sfmeval_fs::run_dtu` and `run_eth3d`) so that its JSON or text is the CLI's
+//! byte for byte.
 
 use std::path::{Path, PathBuf};
 
@@ -17,11 +18,12 @@ use sfmeval::pose::{PoseOptions, Protocol, ProtocolOptions, evaluate_protocol};
 use sfmeval::report::Report;
 use sfmeval::transform::Similarity;
 use sfmeval_dtu::{DtuMode, DtuOptions, Shuffle};
+use sfmeval_eth3d::Eth3dOptions;
 use sfmeval_fs::{
-    Disk, DtuRun, name_of, named, path_str, pipeline_and_path, read, read_input_files,
-    read_transform, run_dtu, write_atomic,
+    Disk, DtuRun, Eth3dRun, name_of, named, path_str, pipeline_and_path, read, read_input_files,
+    read_transform, run_dtu, run_eth3d, write_atomic,
 };
-use sfmeval_table::{Row, failed_row, report_row, summary_json, tables};
+use sfmeval_table::{Row, failed_row, read_row_poses, report_row, summary_json, tables};
 use sfmeval_tnt::{self as tnt, IcpCriteria, Registration, Scene, TntRequest};
 
 use crate::{Failure, existing, hooks};
@@ -411,7 +413,11 @@ fn table_rows(
     };
     let mut rows = Vec::new();
     for (pipeline, path, report) in &read {
-        rows.push(report_row(&dataset, pipeline, report, path_str(path)?));
+        let file = path_str(path)?;
+        let mut row = report_row(&dataset, pipeline, report, file);
+        // the pose protocols' reports beside it (sfmeval poses --json), when there
+        row.poses = read_row_poses(&Disk, file)?;
+        rows.push(row);
     }
     for f in failed {
         let Some((pipeline, reason)) = named(f) else {
@@ -540,4 +546,65 @@ pub(crate) fn _dtu(
         report,
     };
     hooks::run(py, threads, progress, |p| dtu_of(&inputs, p))
+}
+
+/// `sfmeval eth3d`'s inputs.
+struct Eth3dInputs {
+    gt: PathBuf,
+    recon: PathBuf,
+    options: Eth3dOptions,
+    out: Option<PathBuf>,
+}
+
+/// `sfmeval eth3d` on the same inputs: its report JSON, written with the coloured clouds into
+/// `out` when given, as the CLI writes them.
+fn eth3d_of(e: &Eth3dInputs) -> Result<String, Failure> {
+    let outputs = run_eth3d(&Eth3dRun {
+        gt: existing(&e.gt)?,
+        recon: existing(&e.recon)?,
+        options: &e.options,
+    })?;
+    if let Some(dir) = &e.out {
+        std::fs::create_dir_all(dir)
+            .with_context(|| format!("cannot create '{}'", dir.display()))?;
+        write_atomic(&dir.join("eth3d.json"), outputs.json.as_bytes())?;
+        outputs.write_vis_files(|name, bytes| write_atomic(&dir.join(name), bytes))?;
+    }
+    Ok(outputs.json)
+}
+
+/// `_eth3d(gt, recon, ...)`: the report `sfmeval eth3d --json` prints (written with the
+/// coloured clouds into `out` when given). An option left `None` is the CLI's default; the
+/// tolerances are the CLI's, each parsed as a double and rounded to `float` as the tool does.
+#[pyfunction]
+#[pyo3(signature = (gt, recon, *, tolerances=None, voxel_size=None, beam_start_radius=None,
+    beam_divergence_halfangle_deg=None, out=None, threads=None))]
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn _eth3d(
+    py: Python<'_>,
+    gt: PathBuf,
+    recon: PathBuf,
+    tolerances: Option<Vec<f64>>,
+    voxel_size: Option<f64>,
+    beam_start_radius: Option<f64>,
+    beam_divergence_halfangle_deg: Option<f64>,
+    out: Option<PathBuf>,
+    threads: Option<usize>,
+) -> PyResult<String> {
+    let defaults = Eth3dOptions::default();
+    let inputs = Eth3dInputs {
+        gt,
+        recon,
+        options: Eth3dOptions {
+            tolerances: tolerances.map_or(defaults.tolerances, |t| {
+                t.into_iter().map(|v| v as f32).collect()
+            }),
+            voxel_size: voxel_size.map_or(defaults.voxel_size, |v| v as f32),
+            beam_start_radius: beam_start_radius.map_or(defaults.beam_start_radius, |v| v as f32),
+            beam_divergence_halfangle_deg: beam_divergence_halfangle_deg
+                .map_or(defaults.beam_divergence_halfangle_deg, |v| v as f32),
+        },
+        out,
+    };
+    hooks::run(py, threads, None, |_| eth3d_of(&inputs))
 }

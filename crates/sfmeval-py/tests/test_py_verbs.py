@@ -1,7 +1,7 @@
 """The package's geometry in memory and its other verbs against the CLI, run with the built
 wheel installed (scripts/check-python-package.sh): arrays give the report of the PLY file of the
-same numbers, and read / align / cameras / tnt / dtu / table give what `sfmeval export`,
-`align`, `cameras`, `tnt`, `dtu` and `table` write, byte for byte.
+same numbers, and read / align / cameras / tnt / dtu / eth3d / table give what `sfmeval export`,
+`align`, `cameras`, `tnt`, `dtu`, `eth3d` and `table` write, byte for byte.
 
 SFMEVAL_BIN: the CLI (default target/release/sfmeval).
 """
@@ -26,6 +26,8 @@ CORE = ROOT / "tests/fixtures/core"
 MODELS = ROOT / "tests/fixtures/models"
 TNT = ROOT / "tests/fixtures/tanksandtemples"
 DTU = ROOT / "tests/fixtures/dtu"
+ETH3D = ROOT / "tests/fixtures/eth3d"
+ETH3D_MLP = ETH3D / "dslr_scan_eval/scan_alignment.mlp"
 # the demo model's gt_from_recon by camera centres, to 12 digits
 DEMO_START = [[0.24393526577, -0.299850123721, 0.298600929354, 0.00184377389897],
               [-0.000514897229959, -0.34487005783, -0.34589218506, 1.18191757912],
@@ -421,6 +423,62 @@ def test_dtu_errors_are_the_clis(tmp_path):
         sfmeval.dtu(DTU, 1, DTU / "sparse.ply", patch_size=-1.0)
     with pytest.raises(TypeError):
         sfmeval.dtu(DTU, 1, DTU / "sparse.ply", vis_out=3)  # type: ignore[arg-type]
+
+
+# ---- eth3d --------------------------------------------------------------------------------
+
+@pytest.mark.parametrize("recon, kwargs, flags", [
+    ("dense.ply", {}, []),
+    ("sparse.ply", {"tolerances": [0.2, 0.05], "voxel_size": 0.02},
+     ["--tolerances", "0.2,0.05", "--voxel-size", 0.02]),
+    ("dense.ply", {"beam_start_radius": 0.002, "beam_divergence_halfangle_deg": 0.05},
+     ["--beam-start-radius", 0.002, "--beam-divergence-halfangle-deg", 0.05]),
+])
+def test_eth3d_is_the_clis_report_and_clouds(tmp_path, recon, kwargs, flags):
+    cli_out, py_out = tmp_path / "cli", tmp_path / "py"
+    p = cli("eth3d", "--gt", ETH3D_MLP, "--recon", ETH3D / recon, *flags, "--json",
+            "--out", cli_out)
+    r = sfmeval.eth3d(ETH3D_MLP, ETH3D / recon, out=py_out, **kwargs)
+    assert r.to_json() == p.stdout
+    names = sorted(f.name for f in cli_out.iterdir())
+    tolerances = kwargs.get("tolerances", [0.01, 0.02, 0.05, 0.1, 0.2, 0.5])
+    assert len(names) == 1 + 2 * len(tolerances) and "eth3d.json" in names
+    assert sorted(f.name for f in py_out.iterdir()) == names
+    for name in names:
+        assert (py_out / name).read_bytes() == (cli_out / name).read_bytes(), name
+    # the report writes each float tolerance in its shortest decimal
+    assert [t.tolerance for t in r.tolerances] == sorted(tolerances)
+    assert all(0 <= t.f1 <= 1 for t in r.tolerances) and r.tolerances[-1].f1 > 0
+    assert r.reconstruction == str(ETH3D / recon) and len(r.scans) == 2
+    # without out nothing is written, and the numbers are the same
+    assert sfmeval.eth3d(str(ETH3D_MLP), str(ETH3D / recon), **kwargs).to_json() == p.stdout
+
+
+def test_eth3d_errors_name_the_file(tmp_path):
+    with pytest.raises(FileNotFoundError):
+        sfmeval.eth3d(tmp_path / "nothing.mlp", ETH3D / "dense.ply")
+    with pytest.raises(FileNotFoundError):
+        sfmeval.eth3d(ETH3D_MLP, tmp_path / "nothing.ply")
+    # a project whose second scan is missing: the error names the scan and the project
+    scene = tmp_path / "dslr_scan_eval"
+    shutil.copytree(ETH3D_MLP.parent, scene)
+    (scene / "scan2.ply").unlink()
+    with pytest.raises(sfmeval.InputError) as e:
+        sfmeval.eth3d(scene / "scan_alignment.mlp", ETH3D / "dense.ply")
+    assert "scan2.ply" in str(e.value) and str(scene / "scan_alignment.mlp") in str(e.value)
+    assert str(e.value) == cli_error("eth3d", "--gt", scene / "scan_alignment.mlp", "--recon",
+                                     ETH3D / "dense.ply")
+    # a reconstruction that is not a PLY
+    bad = tmp_path / "bad.ply"
+    bad.write_text("not a ply\n")
+    with pytest.raises(sfmeval.InputError) as e:
+        sfmeval.eth3d(ETH3D_MLP, bad)
+    assert str(bad) in str(e.value)
+    assert str(e.value) == cli_error("eth3d", "--gt", ETH3D_MLP, "--recon", bad)
+    with pytest.raises(sfmeval.InputError, match="toleranc"):
+        sfmeval.eth3d(ETH3D_MLP, ETH3D / "dense.ply", tolerances=[-0.1])
+    with pytest.raises(TypeError):
+        sfmeval.eth3d(ETH3D_MLP, ETH3D / "dense.ply", out=3)  # type: ignore[arg-type]
 
 
 # ---- table --------------------------------------------------------------------------------

@@ -137,8 +137,14 @@ const fn metric(
 
 const M: Option<&str> = Some("m");
 const MM: Option<&str> = Some("mm");
+const PCT: Option<&str> = Some("%");
 const LOWER: Option<Best> = Some(Best::Lower);
 const HIGHER: Option<Best> = Some(Best::Higher);
+
+/// The ETH3D numbers of tolerance `k` of a row.
+fn eth3d_at(r: &Row, k: usize) -> Option<&crate::row::Eth3dTolerance> {
+    r.eth3d.as_ref().and_then(|e| e.tolerances.get(k))
+}
 
 fn registered_of_total(r: &Row) -> String {
     format!("{}/{}", r.images_registered, r.images_total)
@@ -511,6 +517,346 @@ pub const CATALOGUE: &[Metric] = &[
         Some(3),
         Source::Number(|r, _| r.dtu.as_ref().and_then(|d| d.overall)),
     ),
+    metric(
+        "run.poses.colmap.auc_percent[0]",
+        "colmap_auc0",
+        "COLMAP AUC@0.5°",
+        PCT,
+        "COLMAP benchmark: pose AUC up to 0.5° (%)",
+        HIGHER,
+        Some(2),
+        Source::Number(|r, _| {
+            r.poses
+                .as_ref()
+                .and_then(|p| p.colmap.auc_percent.first().copied())
+        }),
+    ),
+    metric(
+        "run.poses.colmap.auc_percent[1]",
+        "colmap_auc1",
+        "COLMAP AUC@1°",
+        PCT,
+        "COLMAP benchmark: pose AUC up to 1° (%)",
+        HIGHER,
+        Some(2),
+        Source::Number(|r, _| {
+            r.poses
+                .as_ref()
+                .and_then(|p| p.colmap.auc_percent.get(1).copied())
+        }),
+    ),
+    metric(
+        "run.poses.colmap.auc_percent[2]",
+        "colmap_auc2",
+        "COLMAP AUC@5°",
+        PCT,
+        "COLMAP benchmark: pose AUC up to 5° (%)",
+        HIGHER,
+        Some(2),
+        Source::Number(|r, _| {
+            r.poses
+                .as_ref()
+                .and_then(|p| p.colmap.auc_percent.get(2).copied())
+        }),
+    ),
+    metric(
+        "run.poses.colmap.auc_percent[3]",
+        "colmap_auc3",
+        "COLMAP AUC@10°",
+        PCT,
+        "COLMAP benchmark: pose AUC up to 10° (%)",
+        HIGHER,
+        Some(2),
+        Source::Number(|r, _| {
+            r.poses
+                .as_ref()
+                .and_then(|p| p.colmap.auc_percent.get(3).copied())
+        }),
+    ),
+    metric(
+        "run.poses.imc.maa_10",
+        "imc_maa",
+        "IMC mAA@10°",
+        None,
+        "Image Matching Challenge: pose mAA up to 10°",
+        HIGHER,
+        Some(3),
+        Source::Number(|r, _| r.poses.as_ref().map(|p| p.imc.maa_10)),
+    ),
+    metric(
+        "run.poses.co3d.rra_percent[0]",
+        "co3d_rra0",
+        "CO3D RRA@5°",
+        PCT,
+        "CO3D: relative rotation accuracy at 5° (%)",
+        HIGHER,
+        Some(2),
+        Source::Number(|r, _| {
+            r.poses
+                .as_ref()
+                .and_then(|p| p.co3d.rra_percent.first().copied())
+        }),
+    ),
+    metric(
+        "run.poses.co3d.rra_percent[1]",
+        "co3d_rra1",
+        "CO3D RRA@15°",
+        PCT,
+        "CO3D: relative rotation accuracy at 15° (%)",
+        HIGHER,
+        Some(2),
+        Source::Number(|r, _| {
+            r.poses
+                .as_ref()
+                .and_then(|p| p.co3d.rra_percent.get(1).copied())
+        }),
+    ),
+    metric(
+        "run.poses.co3d.rra_percent[2]",
+        "co3d_rra2",
+        "CO3D RRA@30°",
+        PCT,
+        "CO3D: relative rotation accuracy at 30° (%)",
+        HIGHER,
+        Some(2),
+        Source::Number(|r, _| {
+            r.poses
+                .as_ref()
+                .and_then(|p| p.co3d.rra_percent.get(2).copied())
+        }),
+    ),
+    metric(
+        "run.poses.co3d.rta_percent[0]",
+        "co3d_rta0",
+        "CO3D RTA@5°",
+        PCT,
+        "CO3D: relative translation accuracy at 5° (%)",
+        HIGHER,
+        Some(2),
+        Source::Number(|r, _| {
+            r.poses
+                .as_ref()
+                .and_then(|p| p.co3d.rta_percent.first().copied())
+        }),
+    ),
+    metric(
+        "run.poses.co3d.rta_percent[1]",
+        "co3d_rta1",
+        "CO3D RTA@15°",
+        PCT,
+        "CO3D: relative translation accuracy at 15° (%)",
+        HIGHER,
+        Some(2),
+        Source::Number(|r, _| {
+            r.poses
+                .as_ref()
+                .and_then(|p| p.co3d.rta_percent.get(1).copied())
+        }),
+    ),
+    metric(
+        "run.poses.co3d.rta_percent[2]",
+        "co3d_rta2",
+        "CO3D RTA@30°",
+        PCT,
+        "CO3D: relative translation accuracy at 30° (%)",
+        HIGHER,
+        Some(2),
+        Source::Number(|r, _| {
+            r.poses
+                .as_ref()
+                .and_then(|p| p.co3d.rta_percent.get(2).copied())
+        }),
+    ),
+    metric(
+        "run.poses.co3d.auc_percent",
+        "co3d_auc",
+        "CO3D AUC@30°",
+        PCT,
+        "CO3D: pose AUC up to 30° (%)",
+        HIGHER,
+        Some(2),
+        Source::Number(|r, _| r.poses.as_ref().map(|p| p.co3d.auc_percent)),
+    ),
+    metric(
+        "report.tolerances[0].accuracy",
+        "eth3d_acc0",
+        "ETH3D accuracy@0.01m",
+        None,
+        "ETH3D: accuracy (share of the reconstruction within 0.01 m)",
+        HIGHER,
+        Some(3),
+        Source::Number(|r, _| eth3d_at(r, 0).map(|t| t.accuracy)),
+    ),
+    metric(
+        "report.tolerances[0].completeness",
+        "eth3d_comp0",
+        "ETH3D completeness@0.01m",
+        None,
+        "ETH3D: completeness (share of the scans within 0.01 m)",
+        HIGHER,
+        Some(3),
+        Source::Number(|r, _| eth3d_at(r, 0).map(|t| t.completeness)),
+    ),
+    metric(
+        "report.tolerances[0].f1",
+        "eth3d_f10",
+        "ETH3D F1@0.01m",
+        None,
+        "ETH3D: F1 score at 0.01 m",
+        HIGHER,
+        Some(3),
+        Source::Number(|r, _| eth3d_at(r, 0).map(|t| t.f1)),
+    ),
+    metric(
+        "report.tolerances[1].accuracy",
+        "eth3d_acc1",
+        "ETH3D accuracy@0.02m",
+        None,
+        "ETH3D: accuracy (share of the reconstruction within 0.02 m)",
+        HIGHER,
+        Some(3),
+        Source::Number(|r, _| eth3d_at(r, 1).map(|t| t.accuracy)),
+    ),
+    metric(
+        "report.tolerances[1].completeness",
+        "eth3d_comp1",
+        "ETH3D completeness@0.02m",
+        None,
+        "ETH3D: completeness (share of the scans within 0.02 m)",
+        HIGHER,
+        Some(3),
+        Source::Number(|r, _| eth3d_at(r, 1).map(|t| t.completeness)),
+    ),
+    metric(
+        "report.tolerances[1].f1",
+        "eth3d_f11",
+        "ETH3D F1@0.02m",
+        None,
+        "ETH3D: F1 score at 0.02 m",
+        HIGHER,
+        Some(3),
+        Source::Number(|r, _| eth3d_at(r, 1).map(|t| t.f1)),
+    ),
+    metric(
+        "report.tolerances[2].accuracy",
+        "eth3d_acc2",
+        "ETH3D accuracy@0.05m",
+        None,
+        "ETH3D: accuracy (share of the reconstruction within 0.05 m)",
+        HIGHER,
+        Some(3),
+        Source::Number(|r, _| eth3d_at(r, 2).map(|t| t.accuracy)),
+    ),
+    metric(
+        "report.tolerances[2].completeness",
+        "eth3d_comp2",
+        "ETH3D completeness@0.05m",
+        None,
+        "ETH3D: completeness (share of the scans within 0.05 m)",
+        HIGHER,
+        Some(3),
+        Source::Number(|r, _| eth3d_at(r, 2).map(|t| t.completeness)),
+    ),
+    metric(
+        "report.tolerances[2].f1",
+        "eth3d_f12",
+        "ETH3D F1@0.05m",
+        None,
+        "ETH3D: F1 score at 0.05 m",
+        HIGHER,
+        Some(3),
+        Source::Number(|r, _| eth3d_at(r, 2).map(|t| t.f1)),
+    ),
+    metric(
+        "report.tolerances[3].accuracy",
+        "eth3d_acc3",
+        "ETH3D accuracy@0.1m",
+        None,
+        "ETH3D: accuracy (share of the reconstruction within 0.1 m)",
+        HIGHER,
+        Some(3),
+        Source::Number(|r, _| eth3d_at(r, 3).map(|t| t.accuracy)),
+    ),
+    metric(
+        "report.tolerances[3].completeness",
+        "eth3d_comp3",
+        "ETH3D completeness@0.1m",
+        None,
+        "ETH3D: completeness (share of the scans within 0.1 m)",
+        HIGHER,
+        Some(3),
+        Source::Number(|r, _| eth3d_at(r, 3).map(|t| t.completeness)),
+    ),
+    metric(
+        "report.tolerances[3].f1",
+        "eth3d_f13",
+        "ETH3D F1@0.1m",
+        None,
+        "ETH3D: F1 score at 0.1 m",
+        HIGHER,
+        Some(3),
+        Source::Number(|r, _| eth3d_at(r, 3).map(|t| t.f1)),
+    ),
+    metric(
+        "report.tolerances[4].accuracy",
+        "eth3d_acc4",
+        "ETH3D accuracy@0.2m",
+        None,
+        "ETH3D: accuracy (share of the reconstruction within 0.2 m)",
+        HIGHER,
+        Some(3),
+        Source::Number(|r, _| eth3d_at(r, 4).map(|t| t.accuracy)),
+    ),
+    metric(
+        "report.tolerances[4].completeness",
+        "eth3d_comp4",
+        "ETH3D completeness@0.2m",
+        None,
+        "ETH3D: completeness (share of the scans within 0.2 m)",
+        HIGHER,
+        Some(3),
+        Source::Number(|r, _| eth3d_at(r, 4).map(|t| t.completeness)),
+    ),
+    metric(
+        "report.tolerances[4].f1",
+        "eth3d_f14",
+        "ETH3D F1@0.2m",
+        None,
+        "ETH3D: F1 score at 0.2 m",
+        HIGHER,
+        Some(3),
+        Source::Number(|r, _| eth3d_at(r, 4).map(|t| t.f1)),
+    ),
+    metric(
+        "report.tolerances[5].accuracy",
+        "eth3d_acc5",
+        "ETH3D accuracy@0.5m",
+        None,
+        "ETH3D: accuracy (share of the reconstruction within 0.5 m)",
+        HIGHER,
+        Some(3),
+        Source::Number(|r, _| eth3d_at(r, 5).map(|t| t.accuracy)),
+    ),
+    metric(
+        "report.tolerances[5].completeness",
+        "eth3d_comp5",
+        "ETH3D completeness@0.5m",
+        None,
+        "ETH3D: completeness (share of the scans within 0.5 m)",
+        HIGHER,
+        Some(3),
+        Source::Number(|r, _| eth3d_at(r, 5).map(|t| t.completeness)),
+    ),
+    metric(
+        "report.tolerances[5].f1",
+        "eth3d_f15",
+        "ETH3D F1@0.5m",
+        None,
+        "ETH3D: F1 score at 0.5 m",
+        HIGHER,
+        Some(3),
+        Source::Number(|r, _| eth3d_at(r, 5).map(|t| t.f1)),
+    ),
 ];
 
 /// The wide table's columns (`runs.csv`, `table.md`, the runner's page), in order; [`WIDE_DTU`]
@@ -544,6 +890,48 @@ pub const WIDE_DTU: &[&str] = &[
     "report.mean_accuracy",
     "report.mean_completeness",
     "report.overall",
+];
+
+/// ETH3D's columns of the wide table (`sfmeval.eth3d/1` keys: accuracy, completeness and F1 at
+/// each of the benchmark's tolerances, 0.01 … 0.5 m, the runner's), shown when some row was
+/// evaluated on an ETH3D scene.
+pub const WIDE_ETH3D: &[&str] = &[
+    "report.tolerances[0].accuracy",
+    "report.tolerances[0].completeness",
+    "report.tolerances[0].f1",
+    "report.tolerances[1].accuracy",
+    "report.tolerances[1].completeness",
+    "report.tolerances[1].f1",
+    "report.tolerances[2].accuracy",
+    "report.tolerances[2].completeness",
+    "report.tolerances[2].f1",
+    "report.tolerances[3].accuracy",
+    "report.tolerances[3].completeness",
+    "report.tolerances[3].f1",
+    "report.tolerances[4].accuracy",
+    "report.tolerances[4].completeness",
+    "report.tolerances[4].f1",
+    "report.tolerances[5].accuracy",
+    "report.tolerances[5].completeness",
+    "report.tolerances[5].f1",
+];
+
+/// The pose protocols' columns of the wide table (`sfmeval poses` with its default options:
+/// COLMAP's AUC at 0.5, 1, 5 and 10°, IMC's mAA up to 10°, CO3D's RRA / RTA at 5, 15 and 30° and
+/// AUC@30), shown after the camera columns when some row has them (and in the page's Compare).
+pub const WIDE_POSES: &[&str] = &[
+    "run.poses.colmap.auc_percent[0]",
+    "run.poses.colmap.auc_percent[1]",
+    "run.poses.colmap.auc_percent[2]",
+    "run.poses.colmap.auc_percent[3]",
+    "run.poses.imc.maa_10",
+    "run.poses.co3d.rra_percent[0]",
+    "run.poses.co3d.rra_percent[1]",
+    "run.poses.co3d.rra_percent[2]",
+    "run.poses.co3d.rta_percent[0]",
+    "run.poses.co3d.rta_percent[1]",
+    "run.poses.co3d.rta_percent[2]",
+    "run.poses.co3d.auc_percent",
 ];
 
 /// The page's Compare table's columns, in order (per-threshold ones grouped by threshold).
@@ -625,7 +1013,15 @@ mod tests {
 
     #[test]
     fn every_list_names_catalogue_metrics_once() {
-        for list in [WIDE, WIDE_DTU, COMPARE, SWEEP, SWEEP_VISIBILITY] {
+        for list in [
+            WIDE,
+            WIDE_DTU,
+            WIDE_ETH3D,
+            WIDE_POSES,
+            COMPARE,
+            SWEEP,
+            SWEEP_VISIBILITY,
+        ] {
             assert_eq!(metrics_of(list).len(), list.len(), "{list:?}");
         }
         for (i, m) in CATALOGUE.iter().enumerate() {
@@ -638,6 +1034,50 @@ mod tests {
             );
             assert_eq!(m.is_text(), m.best.is_none(), "{}", m.key);
             assert_eq!(m.is_text(), m.digits.is_none(), "{}", m.key);
+        }
+    }
+
+    #[test]
+    fn pose_headers_name_the_default_thresholds_of_sfmeval_poses() {
+        let o = sfmeval::pose::ProtocolOptions::default();
+        let header = |k: &str| find(k).unwrap().header;
+        for (k, t) in o.colmap_thresholds_deg.iter().enumerate() {
+            assert_eq!(
+                header(&format!("run.poses.colmap.auc_percent[{k}]")),
+                format!("COLMAP AUC@{t}°")
+            );
+        }
+        for (k, t) in o.co3d_thresholds_deg.iter().enumerate() {
+            for (field, what) in [("rra_percent", "RRA"), ("rta_percent", "RTA")] {
+                assert_eq!(
+                    header(&format!("run.poses.co3d.{field}[{k}]")),
+                    format!("CO3D {what}@{t}°")
+                );
+            }
+        }
+        assert_eq!(
+            header("run.poses.co3d.auc_percent"),
+            format!("CO3D AUC@{}°", o.co3d_auc_max_deg)
+        );
+        assert_eq!(
+            WIDE_POSES.len(),
+            o.colmap_thresholds_deg.len() + 1 + 2 * o.co3d_thresholds_deg.len() + 1
+        );
+    }
+
+    #[test]
+    fn eth3d_headers_name_the_benchmark_tolerances() {
+        let tolerances = sfmeval_eth3d::DEFAULT_TOLERANCES;
+        assert_eq!(WIDE_ETH3D.len(), 3 * tolerances.len());
+        for (k, t) in tolerances.iter().enumerate() {
+            for (field, what) in [
+                ("accuracy", "accuracy"),
+                ("completeness", "completeness"),
+                ("f1", "F1"),
+            ] {
+                let m = find(&format!("report.tolerances[{k}].{field}")).unwrap();
+                assert_eq!(m.header, format!("ETH3D {what}@{t}m"));
+            }
         }
     }
 

@@ -1,7 +1,7 @@
 //! What the table cells say: Table I's `mean (points)` or the failure, and the wide table's
 //! columns and values (shared by Markdown, CSV and HTML).
 
-use crate::catalogue::{Metric, Source, WIDE, WIDE_DTU, metrics_of, short};
+use crate::catalogue::{Metric, Source, WIDE, WIDE_DTU, WIDE_ETH3D, WIDE_POSES, metrics_of, short};
 use crate::order::find;
 use crate::row::Row;
 
@@ -9,10 +9,17 @@ use crate::row::Row;
 pub fn table1_cell(r: Option<&Row>) -> String {
     match r {
         None => "—".into(),
-        Some(r) => match (r.mean, r.dtu.as_ref().and_then(|d| d.overall)) {
-            (Some(m), _) => format!("{m:.6} ({})", r.points),
-            (None, Some(overall)) => format!("{overall:.3} mm DTU overall ({})", r.points),
-            (None, None) => {
+        Some(r) => match (
+            r.mean,
+            r.dtu.as_ref().and_then(|d| d.overall),
+            eth3d_headline(r),
+        ) {
+            (Some(m), _, _) => format!("{m:.6} ({})", r.points),
+            (None, Some(overall), _) => format!("{overall:.3} mm DTU overall ({})", r.points),
+            (None, None, Some((tolerance, f1))) => {
+                format!("{f1:.3} ETH3D F1 at {tolerance} m ({})", r.points)
+            }
+            (None, None, None) => {
                 let reason = short(r.reason.as_deref().unwrap_or(""));
                 if reason.starts_with(&r.status) {
                     reason
@@ -22,6 +29,20 @@ pub fn table1_cell(r: Option<&Row>) -> String {
             }
         },
     }
+}
+
+/// The tolerance of Table I's ETH3D cell: the benchmark's headline 2 cm (its leaderboard's
+/// default), else the row's first.
+pub const ETH3D_TABLE1_TOLERANCE: f64 = 0.02;
+
+/// The `(tolerance, F1)` Table I shows for an ETH3D row.
+pub fn eth3d_headline(r: &Row) -> Option<(f64, f64)> {
+    let t = &r.eth3d.as_ref()?.tolerances;
+    let pick = t
+        .iter()
+        .find(|t| t.tolerance == ETH3D_TABLE1_TOLERANCE)
+        .or(t.first())?;
+    Some((pick.tolerance, pick.f1))
 }
 
 /// A number with `digits` decimals, empty for none.
@@ -35,13 +56,17 @@ pub fn csv_num(v: Option<f64>) -> String {
 }
 
 /// What the wide table's columns depend on: the number of thresholds (the most any row has)
-/// and whether some row has DTU numbers.
+/// and whether some row has DTU numbers or pose-protocol numbers.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct WideShape {
     /// Thresholds of the per-threshold columns.
     pub n_tau: usize,
     /// Whether the DTU columns ([`WIDE_DTU`]) are shown.
     pub dtu: bool,
+    /// Whether the pose protocols' columns ([`WIDE_POSES`]) are shown.
+    pub poses: bool,
+    /// Whether ETH3D's columns ([`WIDE_ETH3D`]) are shown.
+    pub eth3d: bool,
 }
 
 /// The wide table's shape for `rows`.
@@ -49,19 +74,36 @@ pub fn wide_shape(rows: &[Row]) -> WideShape {
     WideShape {
         n_tau: n_tau(rows),
         dtu: rows.iter().any(|r| r.dtu.is_some()),
+        poses: rows.iter().any(|r| r.poses.is_some()),
+        eth3d: rows.iter().any(|r| r.eth3d.is_some()),
     }
 }
 
-/// The wide table's metrics ([`WIDE`] of the catalogue, with [`WIDE_DTU`] after the
-/// per-threshold ones when `dtu`).
-fn wide_metrics(dtu: bool) -> Vec<&'static Metric> {
+/// The wide table's metrics ([`WIDE`] of the catalogue, with [`WIDE_POSES`] after the camera
+/// columns, [`WIDE_DTU`] after the per-threshold ones and [`WIDE_ETH3D`] after those when the
+/// shape has them).
+pub(crate) fn wide_metrics(shape: WideShape) -> Vec<&'static Metric> {
     let mut keys: Vec<&str> = WIDE.to_vec();
-    if dtu {
+    if shape.poses {
+        let after = keys
+            .iter()
+            .rposition(|k| k.starts_with("report.cameras."))
+            .map_or(keys.len(), |i| i + 1);
+        keys.splice(after..after, WIDE_POSES.iter().copied());
+    }
+    if shape.dtu {
         let after = keys
             .iter()
             .rposition(|k| k.contains("[*]"))
             .map_or(keys.len(), |i| i + 1);
         keys.splice(after..after, WIDE_DTU.iter().copied());
+    }
+    if shape.eth3d {
+        let after = keys
+            .iter()
+            .rposition(|k| k.contains("[*]") || WIDE_DTU.contains(k))
+            .map_or(keys.len(), |i| i + 1);
+        keys.splice(after..after, WIDE_ETH3D.iter().copied());
     }
     metrics_of(&keys)
 }
@@ -85,7 +127,7 @@ fn threshold_percents(rows: &[Row]) -> Vec<f64> {
 pub fn wide_columns(rows: &[Row]) -> Vec<String> {
     let pcts = threshold_percents(rows);
     let mut cols = Vec::new();
-    for_columns(&wide_metrics(wide_shape(rows).dtu), pcts.len(), |m, k| {
+    for_columns(&wide_metrics(wide_shape(rows)), pcts.len(), |m, k| {
         cols.push(m.header_with_unit(k.map(|k| pcts[k])));
     });
     cols
@@ -121,7 +163,7 @@ pub(crate) fn for_columns(
 /// decimals), in full for CSV (`csv`), in the table's `shape`.
 pub fn wide_values(r: &Row, shape: WideShape, csv: bool) -> Vec<String> {
     let mut v = Vec::new();
-    for_columns(&wide_metrics(shape.dtu), shape.n_tau, |m, k| {
+    for_columns(&wide_metrics(shape), shape.n_tau, |m, k| {
         v.push(cell_text(m, r, k.unwrap_or(0), csv));
     });
     v

@@ -6,7 +6,7 @@
 use serde::{Deserialize, Serialize};
 use serde_json::Value as Json;
 
-use crate::catalogue::{Best, COMPARE, Metric, metrics_of};
+use crate::catalogue::{Best, COMPARE, Metric, WIDE_POSES, metrics_of};
 use crate::cells::for_columns;
 use crate::number::compact;
 use crate::row::Row;
@@ -60,7 +60,8 @@ pub struct CompareTable {
 }
 
 /// The Compare table of `entries`: per-threshold columns for the most thresholds an entry has,
-/// named by the first report's thresholds.
+/// named by the first report's thresholds; the pose protocols' columns ([`WIDE_POSES`], as in
+/// the wide table) before the status when some entry's row has them.
 pub fn compare_table(entries: &[Entry]) -> CompareTable {
     let n_tau = entries
         .iter()
@@ -90,7 +91,12 @@ pub fn compare_table(entries: &[Entry]) -> CompareTable {
         .collect();
     let mut columns = Vec::new();
     let mut cells: Vec<Vec<Cell>> = vec![Vec::new(); entries.len()];
-    for_columns(&metrics_of(COMPARE), n_tau, |m, k| {
+    let mut keys = COMPARE.to_vec();
+    if entries.iter().any(|e| e.row.poses.is_some()) {
+        let at = keys.len().saturating_sub(1);
+        keys.splice(at..at, WIDE_POSES.iter().copied());
+    }
+    for_columns(&metrics_of(&keys), n_tau, |m, k| {
         let kk = k.unwrap_or(0);
         columns.push(Column {
             id: m.id_at(kk),
@@ -236,5 +242,42 @@ mod tests {
         // equal values are both best; a column without two values has none
         assert!(t.rows[0][col("ate")].best && t.rows[1][col("ate")].best);
         assert!(!t.rows.iter().any(|r| r[col("median")].best));
+    }
+
+    #[test]
+    fn pose_columns_join_before_the_status_when_a_row_has_them() {
+        let plain = compare_table(&[entry("a", Some(0.25), 30)]);
+        assert!(
+            !plain
+                .columns
+                .iter()
+                .any(|c| c.key.starts_with("run.poses."))
+        );
+        let mut with = entry("b", Some(0.125), 36);
+        with.row.poses = Some(
+            serde_json::from_value(json!({
+                "colmap": {"thresholds_deg": [0.5, 1.0, 5.0, 10.0],
+                    "auc_percent": [10.0, 20.0, 30.0, 40.0], "recall_percent": [1.0, 2.0, 3.0, 4.0],
+                    "position_accuracy": 0.0, "pairs": 2, "pairs_unregistered": 0,
+                    "pairs_outside_gt": 0, "median_error_deg": 0.5},
+                "imc": {"thresholds_deg": [1.0], "accuracy": [0.5], "maa_5": 0.25, "maa_10": 0.75,
+                    "pairs": 1, "pairs_unregistered": 0, "model_valid": true},
+                "co3d": {"thresholds_deg": [5.0, 15.0, 30.0], "rra_percent": [50.0, 60.0, 70.0],
+                    "rta_percent": [5.0, 6.0, 7.0], "auc_max_deg": 30.0, "auc_percent": 42.5,
+                    "pairs": 1, "pairs_unregistered": 0}
+            }))
+            .unwrap(),
+        );
+        let t = compare_table(&[entry("a", Some(0.25), 30), with]);
+        let col = |id: &str| t.columns.iter().position(|c| c.id == id).unwrap();
+        assert_eq!(col("colmap_auc0"), col("ate") + 1);
+        assert_eq!(col("co3d_auc") + 1, col("status"));
+        assert_eq!(t.columns[col("colmap_auc3")].header, "COLMAP AUC@10°");
+        assert_eq!(t.columns[col("colmap_auc3")].unit.as_deref(), Some("%"));
+        assert_eq!(t.rows[1][col("colmap_auc3")].value, Some(40.0));
+        assert_eq!(t.rows[1][col("imc_maa")].value, Some(0.75));
+        assert_eq!(t.rows[1][col("co3d_rta2")].value, Some(7.0));
+        assert_eq!(t.rows[1][col("co3d_auc")].value, Some(42.5));
+        assert_eq!(t.rows[0][col("co3d_auc")].value, None);
     }
 }

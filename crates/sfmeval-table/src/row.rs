@@ -3,6 +3,8 @@
 
 use serde::{Deserialize, Serialize};
 
+pub use crate::poses::RowPoses;
+
 /// One threshold's precision / recall / F.
 #[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
 pub struct Prf {
@@ -29,6 +31,27 @@ pub struct DtuNumbers {
     pub mean_completeness: Option<f64>,
     /// The mean of the two, mm.
     pub overall: Option<f64>,
+}
+
+/// One tolerance's numbers of ETH3D's evaluation (`sfmeval.eth3d/1`'s `tolerances[k]`, each
+/// `float` as the report writes it).
+#[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
+pub struct Eth3dTolerance {
+    /// The tolerance, m.
+    pub tolerance: f64,
+    /// Accuracy (share of the reconstruction's cells within the tolerance), 0..1.
+    pub accuracy: f64,
+    /// Completeness (share of the scans' cells within the tolerance), 0..1.
+    pub completeness: f64,
+    /// F1 of the two.
+    pub f1: f64,
+}
+
+/// ETH3D's numbers of a run on an ETH3D scene, tolerances ascending.
+#[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
+pub struct Eth3dNumbers {
+    /// Per tolerance.
+    pub tolerances: Vec<Eth3dTolerance>,
 }
 
 /// One run in the comparison.
@@ -89,4 +112,11 @@ pub struct Row {
     /// none: the protocol's report has no per-point distances in metres).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub dtu: Option<DtuNumbers>,
+    /// The pose protocols' numbers (`sfmeval poses`), for a run whose dataset has ground-truth
+    /// cameras and whose reconstruction has cameras.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub poses: Option<RowPoses>,
+    /// ETH3D's numbers, for a run on an ETH3D scene (its other distance fields are then none).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub eth3d: Option<Eth3dNumbers>,
 }

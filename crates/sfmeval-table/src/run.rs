@@ -5,7 +5,7 @@
 use serde::{Deserialize, Serialize};
 use sfmeval::report::Report;
 
-use crate::row::{DtuNumbers, Prf, Row};
+use crate::row::{DtuNumbers, Eth3dNumbers, Prf, Row};
 
 /// Schema id of run.json.
 pub const RUN_SCHEMA: &str = "sfmeval.run/1";
@@ -153,6 +153,8 @@ pub fn base_row(rec: &RunFacts) -> Row {
         report: None,
         alignment: None,
         dtu: None,
+        poses: None,
+        eth3d: None,
     }
 }
 
@@ -255,6 +257,17 @@ pub fn dtu_row(rec: &RunFacts, numbers: DtuNumbers, points: u64, alignment: &str
     row.alignment = Some(alignment.to_string());
     row.points = points;
     row.dtu = Some(numbers);
+    row.report = Some(report_path(&rec.dataset, &rec.pipeline));
+    row
+}
+
+/// The row of a run evaluated with ETH3D's protocol (`sfmeval.eth3d/1` numbers, `points` the
+/// reconstruction's points) after the camera alignment its files name.
+pub fn eth3d_row(rec: &RunFacts, numbers: Eth3dNumbers, points: u64, alignment: &str) -> Row {
+    let mut row = base_row(rec);
+    row.alignment = Some(alignment.to_string());
+    row.points = points;
+    row.eth3d = Some(numbers);
     row.report = Some(report_path(&rec.dataset, &rec.pipeline));
     row
 }

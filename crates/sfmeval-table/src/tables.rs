@@ -40,11 +40,18 @@ pub fn tables(rows: &[Row]) -> Tables {
         }
         t1.push('\n');
     }
-    let dtu_note = if rows.iter().any(|r| r.dtu.is_some()) {
+    let mut dtu_note = if rows.iter().any(|r| r.dtu.is_some()) {
         " On a DTU scan the cell is the DTU protocol's overall in mm (the mean of its accuracy and completeness)."
     } else {
         ""
-    };
+    }
+    .to_string();
+    if rows.iter().any(|r| r.eth3d.is_some()) {
+        dtu_note += &format!(
+            " On an ETH3D scene the cell is ETH3D's F1 score at {} m (else at its first tolerance).",
+            crate::cells::ETH3D_TABLE1_TOLERANCE
+        );
+    }
     let t1_md = format!(
         "# Table I: mean distance to the ground truth (m) and number of points\n\nEach cell: mean reconstruction → ground-truth distance in metres (after {}), and in parentheses the number of points; failed runs show why.{dtu_note}\n\n{t1}",
         alignment_caption(rows)

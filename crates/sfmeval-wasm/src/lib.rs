@@ -532,6 +532,9 @@ pub fn align_modes() -> Result<JsValue, JsError> {
 #[wasm_bindgen]
 pub struct Evaluation {
     inner: sfmeval::evaluate::Evaluation,
+    /// The pose protocols' numbers (`sfmeval poses`) when the ground truth and the
+    /// reconstruction both have cameras, for the run's row (`runRow`).
+    poses: Option<sfmeval_table::RowPoses>,
 }
 
 #[wasm_bindgen]
@@ -685,7 +688,14 @@ pub fn evaluate(
             js_err(&format!("evaluating '{}'", recon.input.name), e)
         }
     })?;
-    Ok(Evaluation { inner })
+    // as the runner's report: every protocol with its defaults, none when one cannot score
+    let poses = match (gt.dataset.cameras(), &recon.input.model) {
+        (Some(g), Some(e)) => sfmeval_table::PoseReports::evaluate(g, e)
+            .ok()
+            .and_then(|p| p.row_poses()),
+        _ => None,
+    };
+    Ok(Evaluation { inner, poses })
 }
 
 /// Parses and validates a crop file (`sfmeval.crop/1`) and returns it as a plain object.

@@ -25,7 +25,8 @@ pub fn run_row(run_json: &str) -> Result<String, JsError> {
 #[wasm_bindgen]
 impl Evaluation {
     /// This evaluation's row of the comparison tables, for the run whose `run.json` text is
-    /// given (as JSON): what `sfmeval-runner report` puts in `summary.json`.
+    /// given (as JSON): what `sfmeval-runner report` puts in `summary.json`, with the pose
+    /// protocols' numbers when both sides have cameras.
     #[wasm_bindgen(js_name = runRow)]
     pub fn run_row(&self, run_json: &str) -> Result<String, JsError> {
         let kept: Vec<f64> = self
@@ -36,7 +37,9 @@ impl Evaluation {
             .filter(|(_, s)| matches!(s, PointStatus::Kept))
             .map(|(d, _)| *d)
             .collect();
-        let row = sfmeval_table::run::evaluated_row(&facts(run_json)?, &self.inner.report, &kept);
+        let mut row =
+            sfmeval_table::run::evaluated_row(&facts(run_json)?, &self.inner.report, &kept);
+        row.poses.clone_from(&self.poses);
         row_json(&row)
     }
 }

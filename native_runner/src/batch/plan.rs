@@ -246,7 +246,7 @@ impl Plan {
     }
 
     /// `table1`: one dataset per preset, rendered, then the `--scene` folders (Tanks and
-    /// Temples scenes, DTU scans) as they are.
+    /// Temples scenes, DTU scans, ETH3D scenes) as they are.
     pub fn table1(a: &Table1Args) -> Result<Plan> {
         a.exec.check()?;
         let mut datasets: Vec<DatasetPlan> = Vec::new();
@@ -262,11 +262,13 @@ impl Plan {
             let ds = Dataset::open(scene)?;
             if !crate::tnt::is_scene(&ds.dir, &ds.name)
                 && crate::dtu::scan_number(&ds.dir).is_none()
+                && !crate::eth3d::is_scene(&ds.dir)
             {
                 bail!(
-                    "--scene {}: neither a Tanks and Temples scene (no {name}_trans.txt and {name}_COLMAP_SfM.log in it, folder named after the scene) nor a DTU scan (no Points/stl/stlNNN_total.ply with ObsMask/ObsMaskN_10.mat and ObsMask/PlaneN.mat)",
+                    "--scene {}: neither a Tanks and Temples scene (no {name}_trans.txt and {name}_COLMAP_SfM.log in it, folder named after the scene), a DTU scan (no Points/stl/stlNNN_total.ply with ObsMask/ObsMaskN_10.mat and ObsMask/PlaneN.mat) nor an ETH3D scene (no {mlp})",
                     scene.display(),
-                    name = ds.name
+                    name = ds.name,
+                    mlp = crate::eth3d::MLP
                 );
             }
             datasets.push(DatasetPlan {

@@ -3,7 +3,8 @@
 The Python face of the sfmeval core (Rust): ``evaluate`` reads the files as the ``sfmeval``
 CLI reads them (arrays as the PLY file of the same numbers) and runs the core's evaluation, so
 ``Report.to_json()`` is byte for byte the report ``sfmeval eval --report`` writes for the same
-inputs; ``align``, ``cameras``, ``tnt``, ``dtu`` and ``table`` are the CLI's verbs of those names and
+inputs; ``align``, ``cameras``, ``poses``, ``tnt``, ``dtu``, ``eth3d`` and ``table`` are the CLI's verbs
+of those names and
 ``read`` gives a file's geometry as numpy arrays. Nothing here computes a number: the results
 give attribute access to the core's JSON and numpy views of the per-point arrays.
 """
@@ -19,14 +20,14 @@ from typing import (
 import numpy as np
 
 from ._sfmeval import (
-    InputError, _align, _cameras, _dtu, _evaluate, _poses, _read, _table, _tnt, align_modes,
+    InputError, _align, _cameras, _dtu, _eth3d, _evaluate, _poses, _read, _table, _tnt, align_modes,
     version,
 )
 
 __all__ = [
-    "Alignment", "CamerasReport", "DtuReport", "InputError", "Mesh", "Model", "Note", "PathLike",
+    "Alignment", "CamerasReport", "DtuReport", "Eth3dReport", "InputError", "Mesh", "Model", "Note", "PathLike",
     "PointCloud", "PosesReport", "Progress", "Report", "Section", "Tables", "TntReport", "align",
-    "align_modes", "cameras", "dtu", "evaluate", "poses", "read", "table", "tnt", "version",
+    "align_modes", "cameras", "dtu", "eth3d", "evaluate", "poses", "read", "table", "tnt", "version",
 ]
 __version__: str = version()
 
@@ -292,6 +293,18 @@ class DtuReport(_JsonResult):
 
     def to_json(self) -> str:
         """The report of ``sfmeval dtu``, byte for byte."""
+        return self._json
+
+
+class Eth3dReport(_JsonResult):
+    """A ``sfmeval.eth3d/1`` report (``tolerances``: per tolerance in m its ``accuracy``,
+    ``completeness`` and ``f1`` with the point counts; ``scans``, ``options``).
+    ``to_json()`` is what ``sfmeval eth3d --json`` prints and ``--out`` writes as eth3d.json."""
+
+    __slots__ = ()
+
+    def to_json(self) -> str:
+        """The report of ``sfmeval eth3d``, byte for byte."""
         return self._json
 
 
@@ -830,6 +843,46 @@ def dtu(
     ))
 
 
+def eth3d(
+    gt: PathLike,
+    recon: PathLike,
+    *,
+    tolerances: Optional[Sequence[float]] = None,
+    voxel_size: Optional[float] = None,
+    beam_start_radius: Optional[float] = None,
+    beam_divergence_halfangle_deg: Optional[float] = None,
+    out: Optional[PathLike] = None,
+    threads: Optional[int] = None,
+) -> Eth3dReport:
+    """ETH3D's multi-view evaluation (``sfmeval eth3d``) of a reconstruction on a scene's laser
+    scans, as the benchmark's official tool computes it: accuracy, completeness and F1 per
+    tolerance. ``to_json()`` is the report ``sfmeval eth3d --json`` prints.
+
+    gt
+        The scene's MeshLab project (dslr_scan_eval/scan_alignment.mlp), its scan PLYs beside
+        it. Its path as given is its name in the report.
+    recon
+        The reconstruction PLY (its vertices), in the scene's frame and in metres. Its path as
+        given is its name in the report.
+    tolerances
+        The tolerances in m (default: the benchmark's 0.01, 0.02, 0.05, 0.1, 0.2, 0.5).
+    voxel_size, beam_start_radius, beam_divergence_halfangle_deg
+        The tool's options (default: the CLI's, 0.01 m, 0.001125 m and 0.011 degrees).
+    out
+        Write the report (eth3d.json) and the tool's coloured clouds
+        (accuracy.tolerance_T.ply, completeness.tolerance_T.ply) here.
+    threads
+        As ``evaluate``'s.
+    """
+    return Eth3dReport(_eth3d(
+        os.fspath(gt), os.fspath(recon),
+        tolerances=None if tolerances is None else [float(t) for t in tolerances],
+        voxel_size=voxel_size, beam_start_radius=beam_start_radius,
+        beam_divergence_halfangle_deg=beam_divergence_halfangle_deg, out=_path(out, "out"),
+        threads=threads,
+    ))
+
+
 def table(
     reports: Union[PathLike, Sequence[PathLike], Mapping[str, PathLike]],
     *,
@@ -843,7 +896,9 @@ def table(
         A folder of runs: every ``PIPELINE/report.json`` directly inside it, by name (what
         ``sfmeval table FOLDER/*/report.json`` reads); or report paths, each
         ``PIPELINE=REPORT.json`` or a path whose parent folder names the pipeline; or a dict
-        ``{pipeline: report path}``.
+        ``{pipeline: report path}``. The pose protocols' reports beside a report
+        (``REPORT.poses-colmap.json``, ``-imc``, ``-co3d``, as the runner writes them) add its
+        pose columns.
     dataset
         The dataset's name in the tables (default: the ground truth's file name, without its
         extension, of the first report).

@@ -97,6 +97,17 @@ def _dtu(
     threads: Optional[int] = ...,
     progress: Optional[Callable[[str, float], Any]] = ...,
 ) -> str: ...
+def _eth3d(
+    gt: str,
+    recon: str,
+    *,
+    tolerances: Optional[List[float]] = ...,
+    voxel_size: Optional[float] = ...,
+    beam_start_radius: Optional[float] = ...,
+    beam_divergence_halfangle_deg: Optional[float] = ...,
+    out: Optional[str] = ...,
+    threads: Optional[int] = ...,
+) -> str: ...
 def _table(reports: List[str], dataset: Optional[str] = ..., failed: List[str] = ...) -> Dict[str, str]: ...
 def version() -> str: ...
 def align_modes() -> List[str]: ...
