@@ -137,4 +137,77 @@ impl Eth3dReport {
         s.push('\n');
         s
     }
+
+    /// The summary's first line: points, scans, voxel size.
+    pub fn headline(&self) -> String {
+        let scan_points: usize = self.scans.iter().map(|s| s.points).sum();
+        format!(
+            "ETH3D multi-view evaluation: {} reconstruction points, {} scan points in {} scan(s), voxel {} m",
+            self.reconstruction_points,
+            scan_points,
+            self.scans.len(),
+            self.options.voxel_size
+        )
+    }
+
+    /// The per-tolerance table as the page shows it: its column headers and, per tolerance
+    /// (smallest first), the cells' texts (numbers as the summary prints them).
+    pub fn table(&self) -> Eth3dTable {
+        Eth3dTable {
+            columns: [
+                "tolerance",
+                "accuracy",
+                "completeness",
+                "F1",
+                "accurate",
+                "inaccurate",
+                "unobserved",
+            ]
+            .map(String::from)
+            .to_vec(),
+            rows: self
+                .tolerances
+                .iter()
+                .map(|t| {
+                    vec![
+                        format!("{} m", t.tolerance),
+                        format!("{:.6}", t.accuracy),
+                        format!("{:.6}", t.completeness),
+                        format!("{:.6}", t.f1),
+                        t.accurate_points.to_string(),
+                        t.inaccurate_points.to_string(),
+                        t.unobserved_points.to_string(),
+                    ]
+                })
+                .collect(),
+        }
+    }
+
+    /// The summary `sfmeval eth3d` prints: [`Self::headline`], then one line per tolerance.
+    pub fn summary(&self) -> String {
+        let mut s = self.headline();
+        s += "\n  tolerance     accuracy  completeness        F1   reconstruction points accurate / inaccurate / unobserved\n";
+        for t in &self.tolerances {
+            s += &format!(
+                "  {:<10}  {:>10.6}  {:>12.6}  {:>8.6}   {} / {} / {}\n",
+                format!("{} m", t.tolerance),
+                t.accuracy,
+                t.completeness,
+                t.f1,
+                t.accurate_points,
+                t.inaccurate_points,
+                t.unobserved_points
+            );
+        }
+        s
+    }
+}
+
+/// The per-tolerance table of [`Eth3dReport::table`]: headers and cell texts.
+#[derive(Debug, Clone, PartialEq, Eq, Serialize)]
+pub struct Eth3dTable {
+    /// Column headers.
+    pub columns: Vec<String>,
+    /// One row per tolerance.
+    pub rows: Vec<Vec<String>>,
 }

@@ -275,3 +275,64 @@ pub struct CurvesSection {
     /// Cumulative share of ground-truth points below each edge after the first.
     pub recall: Vec<f64>,
 }
+
+impl TntReport {
+    /// The summary `sfmeval tnt` prints (without its last line, where the files went): the
+    /// scene and τ, the trajectory alignment, each refinement, precision / recall / F-score and
+    /// the notes, one line each.
+    pub fn summary_lines(&self) -> Vec<String> {
+        let r = self;
+        let mut lines = vec![format!(
+            "Tanks and Temples protocol, scene {} (τ = {} from the {})",
+            r.protocol.scene, r.protocol.tau, r.protocol.tau_source
+        )];
+        if let Some(a) = &r.registration.trajectory_alignment {
+            lines.push(format!(
+                "trajectory alignment: {:.1} % of the cameras within {} (RMSE {:.4}), {} samples",
+                100.0 * a.fitness,
+                r.protocol
+                    .trajectory_alignment
+                    .as_ref()
+                    .map_or(0.0, |t| t.max_correspondence_distance),
+                a.inlier_rmse,
+                a.iterations
+            ));
+        }
+        for (i, st) in r.registration.refinement.iter().enumerate() {
+            lines.push(format!(
+                "refinement {}: {} → {} points, {} iteration(s), fitness {:.4}, RMSE {:.6}",
+                i + 1,
+                st.source_points,
+                st.target_points,
+                st.iterations,
+                st.fitness,
+                st.inlier_rmse
+            ));
+        }
+        if r.registration.mode == "given" {
+            lines.push("registration: the given transform".into());
+        }
+        lines.push(format!(
+            "precision {:.4}  recall {:.4}  F-score {:.4}  ({} reconstruction / {} ground-truth points measured)",
+            r.precision.value, r.recall.value, r.f_score, r.precision.points, r.recall.points
+        ));
+        for n in &r.notes {
+            lines.push(format!("{}: {}", n.level.as_str(), n.message));
+        }
+        lines
+    }
+
+    /// [`Self::summary_lines`] as `sfmeval tnt` prints them: the first flush left, the others
+    /// indented by two spaces.
+    pub fn summary(&self) -> String {
+        let mut s = String::new();
+        for (k, line) in self.summary_lines().iter().enumerate() {
+            if k > 0 {
+                s += "  ";
+            }
+            s += line;
+            s.push('\n');
+        }
+        s
+    }
+}
