@@ -8,6 +8,7 @@ import * as rawBindings from './sfmeval_wasm.js';
 import type { Report, Volume } from './report.js';
 import type { DtuReport } from './dtu-report.js';
 import type { PosesReport, SummaryRow } from './poses-report.js';
+import type { Eth3dReport } from './eth3d-report.js';
 
 /** The report's types (`Report`, its sections, `Note`, the note `Code`s, ...), generated from the
  * core's Rust types (`report.d.ts`, `scripts/gen-report-types.sh`). */
@@ -18,6 +19,9 @@ export * from './dtu-report.js';
 /** The poses report's types (`PosesReport`, `ProtocolResult`, `Convention`, ...), generated likewise
  * (`poses-report.d.ts`; its `Note` is the report's). */
 export * from './poses-report.js';
+/** The ETH3D report's types (`Eth3dReport`, `Eth3dTolerance`, ...), generated likewise
+ * (`eth3d-report.d.ts`). */
+export * from './eth3d-report.js';
 
 /** File contents by (relative) file name. */
 export type Files = Record<string, Uint8Array | ArrayBuffer | ArrayBufferView | string>;
@@ -411,7 +415,7 @@ export interface Eth3dResult {
   /** The `sfmeval.eth3d/1` JSON, byte for byte what `sfmeval eth3d --json` prints. */
   readonly reportJson: string;
   /** The parsed report. */
-  readonly report: any;
+  readonly report: Eth3dReport;
   /** The summary `sfmeval eth3d` prints. */
   readonly summary: string;
   /** Its first line (points, scans, voxel size). */

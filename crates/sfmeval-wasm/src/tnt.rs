@@ -4,10 +4,12 @@
 //! the CLI writes beside it (the coloured clouds, the toolbox's texts, the precision/recall plot
 //! as SVG; no PNG here).
 
+use std::cell::RefCell;
 use std::collections::BTreeMap;
 
 use js_sys::{Object, Uint8Array};
 use serde::Deserialize;
+use sfmeval::files::FileSource;
 use sfmeval::pipeline;
 use sfmeval_tnt::{
     self as tnt, IcpCriteria, Registration, Scene, TntEvaluation, TntRequest,
@@ -16,6 +18,24 @@ use sfmeval_tnt::{
 use wasm_bindgen::prelude::*;
 
 use crate::{files_of, js_err};
+
+/// The scene's files, each handed over (moved, not copied) the one time the scene's reader asks
+/// for it: a ground truth of millions of points is in memory as bytes once.
+struct TakeOnRead(RefCell<BTreeMap<String, Vec<u8>>>);
+
+impl FileSource for TakeOnRead {
+    fn read(&self, path: &str) -> sfmeval::Result<Option<Vec<u8>>> {
+        Ok(self.0.borrow_mut().remove(path))
+    }
+
+    fn list(&self, dir: &str) -> sfmeval::Result<Vec<String>> {
+        self.0.borrow().list(dir)
+    }
+
+    fn is_dir(&self, path: &str) -> bool {
+        self.0.borrow().is_dir(path)
+    }
+}
 
 /// The options of [`evaluate_tnt`], as `sfmeval tnt`'s flags.
 #[derive(Debug, Deserialize)]
@@ -159,8 +179,8 @@ pub fn evaluate_tnt(files: &Object, options: JsValue) -> Result<TntResult, JsErr
             scene_files.insert(format!("{scene_name}/{base}"), bytes);
         }
     }
-    let scene = Scene::read(&scene_files, &scene_name, None).map_err(|e| js_err("", e))?;
-    drop(scene_files);
+    let scene = Scene::read(&TakeOnRead(RefCell::new(scene_files)), &scene_name, None)
+        .map_err(|e| js_err("", e))?;
     let trajectory = tnt::read_log(files.get(&log).map(Vec::as_slice).unwrap_or_default())
         .map_err(|e| js_err(&format!("trajectory '{log}'"), e))?;
     let recon_base = recon
