@@ -9,6 +9,7 @@ import type { Report, Volume } from './report.js';
 import type { DtuReport } from './dtu-report.js';
 import type { PosesReport, SummaryRow } from './poses-report.js';
 import type { Eth3dReport } from './eth3d-report.js';
+import type { TntReport } from './tnt-report.js';
 
 /** The report's types (`Report`, its sections, `Note`, the note `Code`s, ...), generated from the
  * core's Rust types (`report.d.ts`, `scripts/gen-report-types.sh`). */
@@ -22,6 +23,9 @@ export * from './poses-report.js';
 /** The ETH3D report's types (`Eth3dReport`, `Eth3dTolerance`, ...), generated likewise
  * (`eth3d-report.d.ts`). */
 export * from './eth3d-report.js';
+/** The Tanks and Temples report's types (`TntReport`, its sections), generated likewise
+ * (`tnt-report.d.ts`; its `Tool` and `Note` are the report's). */
+export * from './tnt-report.js';
 
 /** File contents by (relative) file name. */
 export type Files = Record<string, Uint8Array | ArrayBuffer | ArrayBufferView | string>;
@@ -472,7 +476,7 @@ export interface TntResult {
   /** The `sfmeval.tanksandtemples/2` JSON, byte for byte what `sfmeval tnt --json` prints. */
   readonly reportJson: string;
   /** The parsed report. */
-  readonly report: any;
+  readonly report: TntReport;
   /** The summary `sfmeval tnt` prints (without where the files went). */
   readonly summary: string;
   /** Its lines. */
