@@ -80,7 +80,7 @@ fi
 
 # npm package
 rm -rf "$OUT/npm" && mkdir -p "$OUT/npm"
-cp crates/sfmeval-wasm/js/{package.json,index.js,index.d.ts,report.d.ts,dtu-report.d.ts,README.md} "$OUT/npm/"
+cp crates/sfmeval-wasm/js/{package.json,index.js,index.d.ts,report.d.ts,dtu-report.d.ts,poses-report.d.ts,eth3d-report.d.ts,tnt-report.d.ts,README.md} "$OUT/npm/"
 cp "$OUT"/pkg/sfmeval_wasm{.js,.d.ts,_bg.wasm,_bg.wasm.d.ts} "$OUT/npm/"
 rm -f "$OUT"/sfmeval-*.tgz
 (cd "$OUT/npm" && npm pack --silent --pack-destination "$OUT" >/dev/null)

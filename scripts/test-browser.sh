@@ -10,7 +10,8 @@
 # a dense PLY streamed into the page, a too-large one refused; tests/browser/ux.mjs:
 # layout at 1366×768 and 1920×1080, errors in view, keyboard, axe-core, cancel; tests/browser/compare.mjs:
 # a runner runs folder compared in the page equals `sfmeval-runner report`'s table and reports;
-# tests/browser/dtu.mjs: the DTU evaluation in npm and in the page equals `sfmeval dtu`).
+# tests/browser/dtu.mjs: the DTU evaluation in npm and in the page equals `sfmeval dtu`; likewise
+# tests/browser/poses.mjs, eth3d.mjs and tnt.mjs for `sfmeval poses`, `sfmeval eth3d` and `sfmeval tnt`).
 # SFMEVAL_BENCH=1 also runs the speed benchmarks (bench/data; not tests): whole eval in the page
 # with threads off and on against native with 1 and 2 threads (tests/browser/bench.mjs), and per
 # operation in Node (tests/browser/bench-ops.mjs).
@@ -172,6 +173,47 @@ else
   fail "dtu: making the scan" "$log/dtu-scene.log"
 fi
 echo "dtu: $((SECONDS - t)) s (screenshots dtu-*.png in $out)"
+
+# The pose protocols: real SfM models (tests/fixtures/models, tests/fixtures/global) evaluated by the
+# npm package in Node and by the page's section 7 in Chromium: report, summary and pairs CSV equal
+# `sfmeval poses`'s (tests/browser/poses.mjs)
+t=$SECONDS
+node tests/browser/poses.mjs --npm target/web/npm --cli target/release/sfmeval --out "$out" \
+  --url "http://127.0.0.1:$port/" >"$log/poses.log" 2>&1
+count poses "$log/poses.log" $?
+echo "poses: $((SECONDS - t)) s (screenshots poses-*.png in $out)"
+
+# ETH3D: a scene in ETH3D's layout (tests/python/eth3d_scene.py, small), evaluated by the npm package
+# and by the page's section 8: report, summary and coloured clouds equal `sfmeval eth3d`'s
+# (tests/browser/eth3d.mjs)
+t=$SECONDS
+rm -rf "$out/eth3d-scene"
+if .venv/bin/python -c "import sys, pathlib; sys.path.insert(0, 'tests/python'); import eth3d_scene; eth3d_scene.build(pathlib.Path(sys.argv[1]), sys.argv[2], scan_points=30000, dense_points=20000)" \
+  "$out/eth3d-scene" "$ROOT/target/release/sfmeval" >"$log/eth3d-scene.log" 2>&1; then
+  node tests/browser/eth3d.mjs --npm target/web/npm --cli target/release/sfmeval --scene "$out/eth3d-scene" --out "$out" \
+    --url "http://127.0.0.1:$port/" >"$log/eth3d.log" 2>&1
+  count eth3d "$log/eth3d.log" $?
+else
+  fail "eth3d: making the scene" "$log/eth3d-scene.log"
+fi
+echo "eth3d: $((SECONDS - t)) s (screenshots eth3d-*.png in $out)"
+
+# Tanks and Temples: a scene in the benchmark's layout (tests/python/tnt_scene.py, small) with the
+# trajectory `sfmeval log` writes from the demo's model, evaluated by the npm package and by the
+# page's section 9: report, summary and every output file equal `sfmeval tnt`'s (tests/browser/tnt.mjs)
+t=$SECONDS
+rm -rf "$out/tnt-scene"
+if .venv/bin/python -c "import sys, pathlib; sys.path.insert(0, 'tests/python'); import tnt_scene; pathlib.Path(sys.argv[2]).write_text(str(tnt_scene.build(sys.argv[1], 30000, 20000)['tau']))" \
+    "$out/tnt-scene" "$out/tnt-tau.txt" >"$log/tnt-scene.log" 2>&1 &&
+  ./target/release/sfmeval log --model data/demo/sparse --images "$out/tnt-scene/recon/images.txt" \
+    --out "$out/tnt-scene/recon/traj.log" >>"$log/tnt-scene.log" 2>&1; then
+  node tests/browser/tnt.mjs --npm target/web/npm --cli target/release/sfmeval --scene "$out/tnt-scene" --tau "$(cat "$out/tnt-tau.txt")" \
+    --out "$out" --url "http://127.0.0.1:$port/" >"$log/tnt.log" 2>&1
+  count tnt "$log/tnt.log" $?
+else
+  fail "tnt: making the scene" "$log/tnt-scene.log"
+fi
+echo "tnt: $((SECONDS - t)) s (screenshots tnt-*.png in $out)"
 
 if [ "${SFMEVAL_BENCH:-0}" = 1 ]; then
   node tests/browser/bench.mjs --url "http://127.0.0.1:$port/" --cli target/release/sfmeval 2>&1 | tee "$log/bench.log"

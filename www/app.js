@@ -2,7 +2,7 @@
 // options and the start-up. Modules by concern: core.js (the worker and its named messages),
 // state.js, ui.js (banner, run line, progress, out of date), inputs.js (section 1 and the demo),
 // points.js (section 2 and the shown points), crop.js (section 3), results.js, notes.js,
-// compare.js (section 5), util.js.
+// compare.js (section 5), dtu.js (section 6), poses.js (section 7), eth3d.js (section 8), tnt.js (section 9), util.js.
 import { $, numList, download, matrixText, alignedTransform } from './util.js';
 import { call, MSG, Cancelled, initCore, onWorkerEvents, pollSharedProgress, restartWorker } from './core.js';
 import { state, viewer } from './state.js';
@@ -14,6 +14,9 @@ import { showResults, showCameraScale, prAt } from './results.js';
 import { reportNotes } from './notes.js';
 import { setupCompare, drawCameras } from './compare.js';
 import { setupDtu } from './dtu.js';
+import { setupPoses } from './poses.js';
+import { setupEth3d } from './eth3d.js';
+import { setupTnt } from './tnt.js';
 
 onWorkerEvents({
   onProgress: (m) => {
@@ -151,5 +154,8 @@ const compare = setupCompare({
   },
 });
 const dtu = setupDtu({ call, showError, download, setRunning });
+const poses = setupPoses({ call, showError, download, setRunning });
+const eth3d = setupEth3d({ call, showError, download, setRunning });
+const tnt = setupTnt({ call, showError, download, setRunning });
 // for tests and scripting
-window.sfmeval = { compare, dtu, state, call, currentCrop, cropText, prAt, reportNotes, matrixText, alignedTransform };
+window.sfmeval = { compare, dtu, poses, eth3d, tnt, state, call, currentCrop, cropText, prAt, reportNotes, matrixText, alignedTransform };

@@ -6,7 +6,7 @@
 let api = null;
 let version, loadGroundTruth, loadReconstruction, loadReconstructionFile, loadCameras, raw, cropFile, parseCrop,
   parseTransform, parsePointPairs, errorColors, POSE_STRIDE, comparisonTables, compareTable, runReconstructionFiles, runRow,
-  isModelFile, dtuFiles, evaluateDtu;
+  isModelFile, dtuFiles, evaluateDtu, evaluatePoses, eth3dFiles, evaluateEth3d, tntFiles, evaluateTnt;
 
 // (module (func (result v128) i32.const 0 i8x16.splat i8x16.popcnt)): valid only with SIMD128
 const SIMD_PROBE = new Uint8Array([0, 97, 115, 109, 1, 0, 0, 0, 1, 5, 1, 96, 0, 1, 123, 3, 2, 1, 0,
@@ -51,6 +51,8 @@ let recon = null;
 let cameraFiles = null; // attached to each new ground truth
 let depthFiles = null; // attached after the cameras
 let last = null; // the last raw Evaluation
+let lastTnt = null; // the last Tanks and Temples evaluation (its files are made on demand)
+let lastEth3d = null; // the last ETH3D evaluation (its clouds are made on demand)
 
 /**
  * Camera poses (`POSE_STRIDE` numbers each, reconstruction frame) mapped into the ground-truth
@@ -112,7 +114,7 @@ const handlers = {
       ({
         version, loadGroundTruth, loadReconstruction, loadReconstructionFile, loadCameras, raw, cropFile, parseCrop,
         parseTransform, parsePointPairs, errorColors, POSE_STRIDE, comparisonTables, compareTable, runReconstructionFiles, runRow,
-        isModelFile, dtuFiles, evaluateDtu,
+        isModelFile, dtuFiles, evaluateDtu, evaluatePoses, eth3dFiles, evaluateEth3d, tntFiles, evaluateTnt,
       } = core);
     }
     // threads: the pool's size (1: the single-thread build); threadsOff: why threads are off;
@@ -298,6 +300,66 @@ const handlers = {
         transfer: [d2s.buffer, s2d.buffer],
       };
     } finally { r.free(); }
+  },
+  /**
+   * One pose protocol on the dropped ground-truth cameras and estimated model (`{name:
+   * ArrayBuffer}` each), as `sfmeval poses`: the `sfmeval.poses/1` report, the summary's rows
+   * and the pairs CSV, all from the core.
+   */
+  poses({ gtFiles, reconFiles, options }) {
+    const bytes = (files) => Object.fromEntries(Object.entries(files).map(([n, b]) => [n, new Uint8Array(b)]));
+    const t0 = performance.now();
+    const r = evaluatePoses({ gtCameras: bytes(gtFiles), recon: bytes(reconFiles) }, options);
+    return { reportJson: r.reportJson, rows: r.summaryRows, pairsCsv: r.pairsCsv, ms: performance.now() - t0 };
+  },
+  /** What the ETH3D evaluation makes of these file names (and the project's bytes, once known). */
+  eth3dFiles({ names, project }) {
+    return { found: eth3dFiles(names, project ? new Uint8Array(project) : undefined) };
+  },
+  /**
+   * ETH3D's evaluation of the dropped scene files (`{name: ArrayBuffer}`), as `sfmeval eth3d`:
+   * the `sfmeval.eth3d/1` report, the headline, the per-tolerance table and the tolerances; the
+   * result stays here for its coloured clouds (`eth3dCloud`), made when one is asked for.
+   */
+  eth3d({ files, options }) {
+    const bytes = {};
+    for (const [n, b] of Object.entries(files)) bytes[n] = new Uint8Array(b);
+    const t0 = performance.now();
+    const r = evaluateEth3d(bytes, options);
+    if (lastEth3d) lastEth3d.free();
+    lastEth3d = r;
+    return { reportJson: r.reportJson, headline: r.headline, table: r.table, tolerances: r.tolerances, ms: performance.now() - t0 };
+  },
+  /** Tolerance `t`'s coloured cloud of the last ETH3D evaluation (`kind`: accuracy or completeness), as the tool writes it. */
+  eth3dCloud({ t, kind }) {
+    if (!lastEth3d) throw new Error('no ETH3D evaluation yet');
+    const [accName, compName] = lastEth3d.cloudNames(t);
+    const bytes = kind === 'accuracy' ? lastEth3d.accuracyPly(t) : lastEth3d.completenessPly(t);
+    return { reply: { name: kind === 'accuracy' ? accName : compName, bytes }, transfer: [bytes.buffer] };
+  },
+  /** What the Tanks and Temples evaluation makes of these file names (the core's recognition). */
+  tntFiles({ names }) {
+    return { found: tntFiles(names) };
+  },
+  /**
+   * The Tanks and Temples protocol on the dropped files (`{name: ArrayBuffer}`), as `sfmeval tnt`:
+   * the report, the summary's lines, the plot's SVG and the output files' names; the result
+   * stays here for those files (`tntFile`), made when one is asked for.
+   */
+  tnt({ files, options }) {
+    const bytes = {};
+    for (const [n, b] of Object.entries(files)) bytes[n] = new Uint8Array(b);
+    const t0 = performance.now();
+    const r = evaluateTnt(bytes, options);
+    if (lastTnt) lastTnt.free();
+    lastTnt = r;
+    return { reportJson: r.reportJson, lines: r.summaryLines, svg: r.plotSvg, fileNames: r.fileNames, ms: performance.now() - t0 };
+  },
+  /** One output file of the last Tanks and Temples evaluation, by name. */
+  tntFile({ name }) {
+    if (!lastTnt) throw new Error('no Tanks and Temples evaluation yet');
+    const bytes = lastTnt.file(name);
+    return { reply: { name, bytes }, transfer: [bytes.buffer] };
   },
   /** The row of a run that did not end ok, from its run.json text. */
   runRowOnly({ runJson }) {

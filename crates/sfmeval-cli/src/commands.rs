@@ -720,8 +720,7 @@ fn poses_cmd(
             gt_cameras.display()
         )
     })?;
-    let mut s = serde_json::to_string_pretty(&poses)?;
-    s.push('\n');
+    let s = poses.to_json();
     if let Some(p) = report {
         write_atomic(p, s.as_bytes())?;
     }
@@ -731,7 +730,7 @@ fn poses_cmd(
     if json {
         print!("{s}");
     } else {
-        print!("{}", summary::render_poses(&poses));
+        print!("{}", poses.summary());
     }
     Ok(())
 }

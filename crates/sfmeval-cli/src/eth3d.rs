@@ -87,27 +87,7 @@ pub fn eth3d_cmd(args: &Eth3dArgs) -> Result<()> {
 }
 
 fn summary(r: &Eth3dReport, out: Option<&Path>) -> String {
-    let scan_points: usize = r.scans.iter().map(|s| s.points).sum();
-    let mut s = format!(
-        "ETH3D multi-view evaluation: {} reconstruction points, {} scan points in {} scan(s), voxel {} m\n",
-        r.reconstruction_points,
-        scan_points,
-        r.scans.len(),
-        r.options.voxel_size
-    );
-    s += "  tolerance     accuracy  completeness        F1   reconstruction points accurate / inaccurate / unobserved\n";
-    for t in &r.tolerances {
-        s += &format!(
-            "  {:<10}  {:>10.6}  {:>12.6}  {:>8.6}   {} / {} / {}\n",
-            format!("{} m", t.tolerance),
-            t.accuracy,
-            t.completeness,
-            t.f1,
-            t.accurate_points,
-            t.inaccurate_points,
-            t.unobserved_points
-        );
-    }
+    let mut s = r.summary();
     if let Some(dir) = out {
         s += &format!(
             "  report and coloured clouds written to {}\n",

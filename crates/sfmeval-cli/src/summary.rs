@@ -2,7 +2,7 @@
 
 use std::fmt::Write as _;
 
-use sfmeval::pose::{CamerasReport, PairError, PosesReport, ProtocolResult, TranslationSign};
+use sfmeval::pose::CamerasReport;
 use sfmeval::report::Report;
 
 fn g(v: f64) -> String {
@@ -229,80 +229,6 @@ pub fn render_cameras(c: &CamerasReport, stage: &str, scale: f64) -> String {
         g(c.center_error_percent.mean)
     );
     for n in &c.notes {
-        let _ = writeln!(s, "{}: {}", n.level.as_str(), n.message);
-    }
-    s
-}
-
-/// The human summary of `sfmeval poses`: the protocol's headline numbers and its convention.
-pub fn render_poses(p: &PosesReport) -> String {
-    let mut s = String::new();
-    let _ = writeln!(
-        s,
-        "cameras         {} ground truth, {} registered, {} matched, {} model(s)",
-        p.ground_truth, p.registered, p.matched, p.models
-    );
-    let list = |v: &[f64]| v.iter().map(|x| g(*x)).collect::<Vec<_>>().join(" / ");
-    match &p.result {
-        ProtocolResult::Colmap(r) => {
-            let _ = writeln!(
-                s,
-                "protocol        colmap: {} ordered pairs ({} with an unregistered image, {} outside the ground truth)",
-                r.pairs, r.pairs_unregistered, r.pairs_outside_gt
-            );
-            let _ = writeln!(s, "thresholds      {} °", list(&r.thresholds_deg));
-            let _ = writeln!(s, "AUC             {} %", list(&r.auc_percent));
-            let _ = writeln!(s, "recall          {} %", list(&r.recall_percent));
-        }
-        ProtocolResult::Imc(r) => {
-            let _ = writeln!(
-                s,
-                "protocol        imc: {} pairs ({} with an unregistered image){}",
-                r.pairs,
-                r.pairs_unregistered,
-                if r.model_valid {
-                    ""
-                } else {
-                    ", model invalid (a non-finite pose)"
-                }
-            );
-            let _ = writeln!(s, "mAA@5           {}", g(r.maa_5));
-            let _ = writeln!(s, "mAA@10          {}", g(r.maa_10));
-        }
-        ProtocolResult::Co3d(r) => {
-            let _ = writeln!(
-                s,
-                "protocol        co3d: {} pairs ({} with an unregistered image)",
-                r.pairs, r.pairs_unregistered
-            );
-            let _ = writeln!(s, "thresholds      {} °", list(&r.thresholds_deg));
-            let _ = writeln!(s, "RRA             {} %", list(&r.rra_percent));
-            let _ = writeln!(s, "RTA             {} %", list(&r.rta_percent));
-            let _ = writeln!(
-                s,
-                "AUC@{}          {} %",
-                g(r.auc_max_deg),
-                g(r.auc_percent)
-            );
-        }
-    }
-    let c = &p.convention;
-    let pair_error = match c.pair_error {
-        PairError::Max => "max(rotation, translation)",
-        PairError::SeparateAccuraciesMaxAuc => {
-            "RRA/RTA each error alone, AUC max(rotation, translation)"
-        }
-    };
-    let sign = match c.translation_sign {
-        TranslationSign::Signed => "signed",
-        TranslationSign::Folded => "sign folded",
-    };
-    let _ = writeln!(
-        s,
-        "convention      {pair_error}; translation direction {sign}"
-    );
-    let _ = writeln!(s, "unregistered    {}", c.unregistered);
-    for n in &p.notes {
         let _ = writeln!(s, "{}: {}", n.level.as_str(), n.message);
     }
     s

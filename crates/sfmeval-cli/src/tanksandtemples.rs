@@ -142,45 +142,7 @@ pub fn tnt_cmd(args: &TntArgs) -> Result<()> {
 }
 
 fn summary(r: &tnt::TntReport, out: &Path) -> String {
-    let mut s = format!(
-        "Tanks and Temples protocol, scene {} (τ = {} from the {})\n",
-        r.protocol.scene, r.protocol.tau, r.protocol.tau_source
-    );
-    if let Some(a) = &r.registration.trajectory_alignment {
-        s += &format!(
-            "  trajectory alignment: {:.1} % of the cameras within {} (RMSE {:.4}), {} samples\n",
-            100.0 * a.fitness,
-            r.protocol
-                .trajectory_alignment
-                .as_ref()
-                .map_or(0.0, |t| t.max_correspondence_distance),
-            a.inlier_rmse,
-            a.iterations
-        );
-    }
-    for (i, st) in r.registration.refinement.iter().enumerate() {
-        s += &format!(
-            "  refinement {}: {} → {} points, {} iteration(s), fitness {:.4}, RMSE {:.6}\n",
-            i + 1,
-            st.source_points,
-            st.target_points,
-            st.iterations,
-            st.fitness,
-            st.inlier_rmse
-        );
-    }
-    if r.registration.mode == "given" {
-        s += "  registration: the given transform\n";
-    }
-    s += &format!(
-        "  precision {:.4}  recall {:.4}  F-score {:.4}  ({} reconstruction / {} ground-truth points measured)\n",
-        r.precision.value, r.recall.value, r.f_score, r.precision.points, r.recall.points
-    );
-    for n in &r.notes {
-        s += &format!("  {}: {}\n", n.level.as_str(), n.message);
-    }
-    s += &format!("  written to {}\n", out.display());
-    s
+    format!("{}  written to {}\n", r.summary(), out.display())
 }
 
 /// Runs `sfmeval log`.

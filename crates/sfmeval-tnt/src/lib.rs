@@ -3,7 +3,9 @@
 //! precision, recall and F-score compare with the benchmark's leaderboard: the scene's files
 //! ([`scene`]), the `.log` trajectories ([`trajectory`]), the trajectory alignment, the three
 //! ICP refinements, crop, voxel down-sampling, distances both ways, the scores and curves
-//! ([`curves`]), the coloured clouds and the precision/recall plot ([`pr_svg`]).
+//! ([`curves`]), the coloured clouds and the precision/recall plot ([`pr_svg`]), the summary
+//! ([`TntReport::summary`]), and the scene's files recognised among dropped ones ([`files`], for
+//! the page and the npm package).
 //!
 //! Where sfmeval can differ from the toolbox at all: the trajectory alignment is a RANSAC over
 //! random samples (seeded here, unseeded in the toolbox), so the final transform can differ
@@ -13,6 +15,7 @@
 
 mod colors;
 pub mod curves;
+pub mod files;
 mod icp;
 pub mod matrix;
 mod plot;
@@ -24,6 +27,7 @@ mod trajectory_alignment;
 mod voxel;
 
 pub use colors::hot_r;
+pub use files::{TntFiles, recognise};
 pub use icp::IcpCriteria;
 #[cfg(feature = "png")]
 pub use plot::svg_to_png;

@@ -15,8 +15,10 @@ pub const TNT_SCHEMA: &str = "sfmeval.tanksandtemples/2";
 
 /// The whole report.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "ts", derive(ts_rs::TS))]
 pub struct TntReport {
-    /// [`TNT_SCHEMA`].
+    /// `sfmeval.tanksandtemples/2` ([`TNT_SCHEMA`] in Rust).
+    #[cfg_attr(feature = "ts", ts(type = "\"sfmeval.tanksandtemples/2\""))]
     pub schema: String,
     /// The program that wrote it.
     pub tool: Tool,
@@ -41,6 +43,7 @@ pub struct TntReport {
 
 /// The protocol's parameters.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "ts", derive(ts_rs::TS))]
 pub struct ProtocolSection {
     /// `"tanksandtemples"`.
     pub name: String,
@@ -64,6 +67,7 @@ pub struct ProtocolSection {
 
 /// The crop of the scene.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "ts", derive(ts_rs::TS))]
 pub struct CropSection {
     /// The crop file.
     pub file: String,
@@ -81,6 +85,7 @@ pub struct CropSection {
 
 /// Trajectory-alignment parameters.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "ts", derive(ts_rs::TS))]
 pub struct TrajectoryParams {
     /// Correspondence distance in ground-truth units.
     pub max_correspondence_distance: f64,
@@ -108,6 +113,7 @@ impl From<&TrajectoryAlignmentOptions> for TrajectoryParams {
 
 /// One refinement stage's parameters.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "ts", derive(ts_rs::TS))]
 pub struct StageParams {
     /// `"voxel"` (both clouds cropped and voxel down-sampled) or `"uniform"` (cropped, every
     /// k-th point kept above `max_points`).
@@ -148,6 +154,7 @@ impl StageParams {
 
 /// The evaluation step's parameters.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "ts", derive(ts_rs::TS))]
 pub struct EvaluationParams {
     /// Both clouds are voxel down-sampled at this edge (τ/2) after the crop.
     pub voxel_size: f64,
@@ -165,6 +172,7 @@ pub struct EvaluationParams {
 
 /// The inputs.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "ts", derive(ts_rs::TS))]
 pub struct InputsSection {
     /// The reconstructed cloud.
     pub reconstruction: NamedCount,
@@ -180,6 +188,7 @@ pub struct InputsSection {
 
 /// A file and its point count.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "ts", derive(ts_rs::TS))]
 pub struct NamedCount {
     /// As the front end named it.
     pub name: String,
@@ -189,6 +198,7 @@ pub struct NamedCount {
 
 /// The reconstruction's trajectory.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "ts", derive(ts_rs::TS))]
 pub struct TrajectoryInput {
     /// As the front end named it.
     pub name: String,
@@ -202,6 +212,7 @@ pub struct TrajectoryInput {
 
 /// How the reconstruction reached the ground-truth frame.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "ts", derive(ts_rs::TS))]
 pub struct RegistrationSection {
     /// `"protocol"` (trajectory alignment + three ICP refinements) or `"given"`.
     pub mode: String,
@@ -215,6 +226,7 @@ pub struct RegistrationSection {
 
 /// One refinement's result.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "ts", derive(ts_rs::TS))]
 pub struct StageResult {
     /// Reconstruction points the ICP used (after crop and down-sampling).
     pub source_points: usize,
@@ -252,6 +264,7 @@ impl StageResult {
 
 /// One direction's result.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "ts", derive(ts_rs::TS))]
 pub struct SideSection {
     /// The share within τ.
     pub value: f64,
@@ -267,6 +280,7 @@ pub struct SideSection {
 
 /// The cumulative curves.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "ts", derive(ts_rs::TS))]
 pub struct CurvesSection {
     /// Bin edges.
     pub edges: Vec<f64>,
@@ -274,4 +288,172 @@ pub struct CurvesSection {
     pub precision: Vec<f64>,
     /// Cumulative share of ground-truth points below each edge after the first.
     pub recall: Vec<f64>,
+}
+
+impl TntReport {
+    /// The summary `sfmeval tnt` prints (without its last line, where the files went): the
+    /// scene and τ, the trajectory alignment, each refinement, precision / recall / F-score and
+    /// the notes, one line each.
+    pub fn summary_lines(&self) -> Vec<String> {
+        let r = self;
+        let mut lines = vec![format!(
+            "Tanks and Temples protocol, scene {} (τ = {} from the {})",
+            r.protocol.scene, r.protocol.tau, r.protocol.tau_source
+        )];
+        if let Some(a) = &r.registration.trajectory_alignment {
+            lines.push(format!(
+                "trajectory alignment: {:.1} % of the cameras within {} (RMSE {:.4}), {} samples",
+                100.0 * a.fitness,
+                r.protocol
+                    .trajectory_alignment
+                    .as_ref()
+                    .map_or(0.0, |t| t.max_correspondence_distance),
+                a.inlier_rmse,
+                a.iterations
+            ));
+        }
+        for (i, st) in r.registration.refinement.iter().enumerate() {
+            lines.push(format!(
+                "refinement {}: {} → {} points, {} iteration(s), fitness {:.4}, RMSE {:.6}",
+                i + 1,
+                st.source_points,
+                st.target_points,
+                st.iterations,
+                st.fitness,
+                st.inlier_rmse
+            ));
+        }
+        if r.registration.mode == "given" {
+            lines.push("registration: the given transform".into());
+        }
+        lines.push(format!(
+            "precision {:.4}  recall {:.4}  F-score {:.4}  ({} reconstruction / {} ground-truth points measured)",
+            r.precision.value, r.recall.value, r.f_score, r.precision.points, r.recall.points
+        ));
+        for n in &r.notes {
+            lines.push(format!("{}: {}", n.level.as_str(), n.message));
+        }
+        lines
+    }
+
+    /// [`Self::summary_lines`] as `sfmeval tnt` prints them: the first flush left, the others
+    /// indented by two spaces.
+    pub fn summary(&self) -> String {
+        let mut s = String::new();
+        for (k, line) in self.summary_lines().iter().enumerate() {
+            if k > 0 {
+                s += "  ";
+            }
+            s += line;
+            s.push('\n');
+        }
+        s
+    }
+}
+
+/// The TypeScript declarations of [`TntReport`] and the types it holds but those the
+/// `sfmeval.report/3` declarations hold (`Tool`, `Note` and its parts, imported from there),
+/// generated by ts-rs, and the check that the npm package ships them
+/// (`crates/sfmeval-wasm/js/tnt-report.d.ts`). `scripts/gen-report-types.sh` rewrites the file
+/// (`SFMEVAL_WRITE_REPORT_TYPES=1`); without that variable the test fails when it is stale.
+#[cfg(all(test, feature = "ts"))]
+mod typescript {
+    use std::collections::{BTreeMap, BTreeSet};
+
+    use sfmeval::note::Note;
+    use sfmeval::report::Tool;
+    use ts_rs::{Config, TS, TypeVisitor};
+
+    use super::TntReport;
+
+    /// The package file, from this crate's folder.
+    const FILE: &str = "../sfmeval-wasm/js/tnt-report.d.ts";
+
+    /// Every declarable type reachable from the visited ones, by name.
+    struct Names {
+        by_name: BTreeMap<String, String>,
+        cfg: Config,
+    }
+
+    impl TypeVisitor for Names {
+        fn visit<T: TS + 'static + ?Sized>(&mut self) {
+            if T::output_path().is_none() {
+                return;
+            }
+            let name = T::ident(&self.cfg);
+            if self.by_name.contains_key(&name) {
+                return;
+            }
+            let mut text = String::from("\n");
+            if let Some(docs) = T::docs() {
+                text.push_str(&docs);
+            }
+            text.push_str("export ");
+            text.push_str(&T::decl(&self.cfg));
+            text.push('\n');
+            self.by_name.insert(name, text);
+            T::visit_dependencies(self);
+        }
+    }
+
+    fn declarations() -> String {
+        let cfg = || Config::new().with_large_int("number");
+        let mut core = Names {
+            cfg: cfg(),
+            by_name: BTreeMap::new(),
+        };
+        core.visit::<Note>();
+        core.visit::<Tool>();
+        let mut tnt = Names {
+            cfg: cfg(),
+            by_name: BTreeMap::new(),
+        };
+        tnt.visit::<TntReport>();
+        let shared: BTreeSet<String> = tnt
+            .by_name
+            .keys()
+            .filter(|n| core.by_name.contains_key(*n))
+            .cloned()
+            .collect();
+        let mut out = String::from(
+            "// The `sfmeval.tanksandtemples/2` report's types, generated from the Rust types of\n\
+             // crates/sfmeval-tnt (feature `ts`, ts-rs) by scripts/gen-report-types.sh: do not edit.\n",
+        );
+        if !shared.is_empty() {
+            let list: Vec<&str> = shared.iter().map(|s| s.as_str()).collect();
+            out.push_str(&format!(
+                "import type {{ {} }} from './report.js';\n",
+                list.join(", ")
+            ));
+        }
+        let first = tnt.by_name.remove("TntReport");
+        for text in first.into_iter().chain(
+            tnt.by_name
+                .iter()
+                .filter(|(n, _)| !shared.contains(n.as_str()))
+                .map(|(_, t)| t.clone()),
+        ) {
+            out.push_str(&text);
+        }
+        out.lines().map(|l| format!("{}\n", l.trim_end())).collect()
+    }
+
+    #[test]
+    fn tnt_report_types_are_the_committed_ones() {
+        let text = declarations();
+        assert!(
+            text.contains("schema: \"sfmeval.tanksandtemples/2\""),
+            "{text}"
+        );
+        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join(FILE);
+        if std::env::var_os("SFMEVAL_WRITE_REPORT_TYPES").is_some() {
+            std::fs::write(&path, &text).expect("write tnt-report.d.ts");
+        }
+        let committed = std::fs::read_to_string(&path).unwrap_or_default();
+        assert!(
+            committed == text,
+            "{} is not what the Tanks and Temples report types generate: run scripts/gen-report-types.sh",
+            path.display()
+        );
+    }
 }

@@ -51,6 +51,7 @@ impl Default for TrajectoryAlignmentOptions {
 
 /// The best sample's similarity and score.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "ts", derive(ts_rs::TS))]
 pub struct TrajectoryAlignment {
     /// `gt_from_recon` of the best sample.
     pub gt_from_recon: Matrix4,

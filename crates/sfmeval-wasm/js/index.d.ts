@@ -7,6 +7,9 @@ import type {
 import * as rawBindings from './sfmeval_wasm.js';
 import type { Report, Volume } from './report.js';
 import type { DtuReport } from './dtu-report.js';
+import type { PosesReport, SummaryRow } from './poses-report.js';
+import type { Eth3dReport } from './eth3d-report.js';
+import type { TntReport } from './tnt-report.js';
 
 /** The report's types (`Report`, its sections, `Note`, the note `Code`s, ...), generated from the
  * core's Rust types (`report.d.ts`, `scripts/gen-report-types.sh`). */
@@ -14,6 +17,15 @@ export * from './report.js';
 /** The DTU report's types (`DtuReport`, `DtuReportOptions`, `DtuCounts`), generated likewise
  * (`dtu-report.d.ts`). */
 export * from './dtu-report.js';
+/** The poses report's types (`PosesReport`, `ProtocolResult`, `Convention`, ...), generated likewise
+ * (`poses-report.d.ts`; its `Note` is the report's). */
+export * from './poses-report.js';
+/** The ETH3D report's types (`Eth3dReport`, `Eth3dTolerance`, ...), generated likewise
+ * (`eth3d-report.d.ts`). */
+export * from './eth3d-report.js';
+/** The Tanks and Temples report's types (`TntReport`, its sections), generated likewise
+ * (`tnt-report.d.ts`; its `Tool` and `Note` are the report's). */
+export * from './tnt-report.js';
 
 /** File contents by (relative) file name. */
 export type Files = Record<string, Uint8Array | ArrayBuffer | ArrayBufferView | string>;
@@ -360,6 +372,149 @@ export interface DtuResult {
 }
 /** The DTU MVS evaluation of a scan's files (STL points, ObsMask, Plane, reconstruction PLY). */
 export function evaluateDtu(files: Files, options?: DtuOptions): DtuResult;
+
+/** One scan of an ETH3D project and the file holding it. */
+export interface Eth3dScanFile {
+  /** The scan's `filename` in the project, as written (the report's name for it). */
+  filename: string;
+  /** The dropped file's name. */
+  file: string;
+}
+/** What the ETH3D evaluation makes of a set of file names (`eth3dFiles`). */
+export interface Eth3dFiles {
+  /** The MeshLab project (`.mlp`). */
+  project: string | null;
+  /** The project's scans found, in its order (empty until the project's bytes are given). */
+  scans: Eth3dScanFile[];
+  /** The one `.ply` that is no scan. */
+  reconstruction: string | null;
+  /** What is still needed, one sentence each. */
+  missing: string[];
+  /** What does not fit together, one sentence each. */
+  problems: string[];
+  /** Names that are none of the above. */
+  ignored: string[];
+}
+/** Sorts file names into an ETH3D scene's files; `project` the project's bytes once known. */
+export function eth3dFiles(names: string[], project?: Uint8Array | ArrayBuffer | string): Eth3dFiles;
+
+/** The options of `evaluateEth3d`, as `sfmeval eth3d`'s flags. */
+export interface Eth3dOptions {
+  /** Tolerances (m); the benchmark's 0.01 … 0.5 by default. */
+  tolerances?: number[];
+  /** Voxel size (m). */
+  voxel_size?: number;
+  /** Laser beam radius at the scanner (m). */
+  beam_start_radius?: number;
+  /** Laser beam divergence half-angle (degrees). */
+  beam_divergence_halfangle_deg?: number;
+}
+/** A table of cell texts made by the core. */
+export interface TextTable {
+  columns: string[];
+  rows: string[][];
+}
+/** One ETH3D evaluation. */
+export interface Eth3dResult {
+  /** The `sfmeval.eth3d/1` JSON, byte for byte what `sfmeval eth3d --json` prints. */
+  readonly reportJson: string;
+  /** The parsed report. */
+  readonly report: Eth3dReport;
+  /** The summary `sfmeval eth3d` prints. */
+  readonly summary: string;
+  /** Its first line (points, scans, voxel size). */
+  readonly headline: string;
+  /** The per-tolerance table: accuracy, completeness, F1 and the point counts. */
+  readonly table: TextTable;
+  /** The tolerances, smallest first (the index `t` below). */
+  readonly tolerances: number[];
+  /** Tolerance `t`'s clouds' names, `[accuracy.tolerance_T.ply, completeness.tolerance_T.ply]`. */
+  cloudNames(t: number): string[];
+  /** Tolerance `t`'s accuracy cloud (the reconstruction coloured as the tool colours it). */
+  accuracyPly(t: number): Uint8Array;
+  /** Tolerance `t`'s completeness cloud (the scan points coloured). */
+  completenessPly(t: number): Uint8Array;
+  /** Frees the wasm memory of this result. */
+  free(): void;
+}
+/** ETH3D's multi-view evaluation of a scene's files (MeshLab project, scan PLYs, reconstruction PLY). */
+export function evaluateEth3d(files: Files, options?: Eth3dOptions): Eth3dResult;
+
+/** What the Tanks and Temples evaluation makes of a set of file names (`tntFiles`). */
+export interface TntFiles {
+  /** The scene's name, from `SCENE_trans.txt`, `SCENE_COLMAP_SfM.log`, `SCENE_mapping_reference.txt`. */
+  scene: string | null;
+  ground_truth: string | null;
+  crop: string | null;
+  alignment: string | null;
+  reference_trajectory: string | null;
+  /** Video scenes only. */
+  mapping: string | null;
+  /** The reconstruction's camera trajectory (`.log`). */
+  trajectory: string | null;
+  /** The reconstruction (`.ply`). */
+  reconstruction: string | null;
+  /** What is still needed, one sentence each. */
+  missing: string[];
+  /** What does not fit together, one sentence each. */
+  problems: string[];
+  /** Names that are none of the above. */
+  ignored: string[];
+}
+/** Sorts file names into a Tanks and Temples scene's files. */
+export function tntFiles(names: string[]): TntFiles;
+
+/** The options of `evaluateTnt`, as `sfmeval tnt`'s flags. */
+export interface TntOptions {
+  /** τ in ground-truth units (default: the scene's, from the benchmark's table). */
+  tau?: number;
+  /** The trajectory alignment's RANSAC seed (default 0). */
+  seed?: number;
+}
+/** One Tanks and Temples evaluation. */
+export interface TntResult {
+  /** The `sfmeval.tanksandtemples/2` JSON, byte for byte what `sfmeval tnt --json` prints. */
+  readonly reportJson: string;
+  /** The parsed report. */
+  readonly report: TntReport;
+  /** The summary `sfmeval tnt` prints (without where the files went). */
+  readonly summary: string;
+  /** Its lines. */
+  readonly summaryLines: string[];
+  /** The precision/recall plot, SVG text. */
+  readonly plotSvg: string;
+  /** The files `sfmeval tnt` writes beside the report (no PNG). */
+  readonly fileNames: string[];
+  /** One of them, made when asked for. */
+  file(name: string): Uint8Array;
+  /** Frees the wasm memory of this result. */
+  free(): void;
+}
+/** The Tanks and Temples protocol on a scene's files, the reconstruction's trajectory and PLY. */
+export function evaluateTnt(files: Files, options?: TntOptions): TntResult;
+
+/** The options of `evaluatePoses`, as `sfmeval poses`' flags. */
+export interface PosesOptions {
+  /** The protocol (docs/poses.md). */
+  protocol: 'colmap' | 'imc' | 'co3d';
+  /** COLMAP: the ground truth's position accuracy (GT units; default 0, off). */
+  position_accuracy?: number;
+}
+/** One pose protocol's evaluation (plain values). */
+export interface PosesResult {
+  /** The `sfmeval.poses/1` JSON, byte for byte what `sfmeval poses --json` prints. */
+  readonly reportJson: string;
+  /** The parsed report. */
+  readonly report: PosesReport;
+  /** The summary `sfmeval poses` prints. */
+  readonly summary: string;
+  /** The summary's lines: counts, the protocol's numbers, the convention, the notes. */
+  readonly summaryRows: SummaryRow[];
+  /** Every scored ground-truth pair's errors (`sfmeval poses --pairs`). */
+  readonly pairsCsv: string;
+}
+/** One camera-pose protocol on the ground-truth cameras' and the estimated model's files. */
+export function evaluatePoses(files: { gtCameras: Files; recon: Files }, options: PosesOptions): PosesResult;
 
 /** Numbers per camera of `cameraPoses()`: centre (3), world_from_cam row-major (9), tangents of
  * the half field of view in x and y (0 when unknown). */

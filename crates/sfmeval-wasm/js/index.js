@@ -316,6 +316,98 @@ export function evaluateDtu(files, options) {
   };
 }
 
+/**
+ * What the ETH3D evaluation makes of these file names: `{project, scans: [{filename, file}],
+ * reconstruction, missing, problems, ignored}` (the one `.mlp` the project; given its bytes as
+ * `project`, the scans it names matched by file name and the one other `.ply` the
+ * reconstruction; `missing` and `problems` are sentences).
+ */
+export function eth3dFiles(names, project) {
+  return wasm.eth3dFiles(JSON.stringify(names), project === undefined ? undefined : toBytes(project, 'project'));
+}
+
+/**
+ * ETH3D's multi-view evaluation, as `sfmeval eth3d`: `files` maps the names of the MeshLab
+ * project (`.mlp`), the scan PLYs it names and the reconstruction PLY to their bytes (recognised
+ * by `eth3dFiles`); `options`: `{tolerances, voxel_size, beam_start_radius,
+ * beam_divergence_halfangle_deg}` as the CLI's flags. Returns `{reportJson, report, summary,
+ * headline, table, tolerances, cloudNames(t), accuracyPly(t), completenessPly(t), free()}`:
+ * `reportJson` byte for byte what `sfmeval eth3d --json` prints (the CLI run in the project's
+ * folder), `table` the per-tolerance `{columns, rows}` of cell texts.
+ */
+export function evaluateEth3d(files, options) {
+  const e = wasm.evaluateEth3d(fileMap(files), options ?? {});
+  return {
+    reportJson: e.reportJson,
+    get report() { return JSON.parse(this.reportJson); },
+    summary: e.summary,
+    headline: e.headline,
+    table: e.table,
+    tolerances: Array.from(e.tolerances),
+    cloudNames: (t) => e.cloudNames(t),
+    accuracyPly: (t) => e.accuracyPly(t),
+    completenessPly: (t) => e.completenessPly(t),
+    free: () => e.free(),
+  };
+}
+
+/**
+ * What the Tanks and Temples evaluation makes of these file names: `{scene, ground_truth, crop,
+ * alignment, reference_trajectory, mapping, trajectory, reconstruction, missing, problems,
+ * ignored}` (`SCENE.ply`, `SCENE.json`, `SCENE_trans.txt`, `SCENE_COLMAP_SfM.log`,
+ * `SCENE_mapping_reference.txt`; any other `.log` the reconstruction's trajectory, any other
+ * `.ply` the reconstruction; `missing` and `problems` are sentences).
+ */
+export function tntFiles(names) {
+  return wasm.tntFiles(JSON.stringify(names));
+}
+
+/**
+ * The Tanks and Temples protocol, as `sfmeval tnt --scene SCENE`: `files` maps the names of the
+ * scene's files, the reconstruction's trajectory and the reconstruction PLY to their bytes
+ * (recognised by `tntFiles`); `options`: `{tau, seed}` as the CLI's flags. Returns `{reportJson,
+ * report, summary, summaryLines, plotSvg, fileNames, file(name), free()}`: `reportJson` byte for
+ * byte what `sfmeval tnt --json` prints, `file(name)` the bytes of each file it writes beside the
+ * report (coloured clouds, curves, the plot's SVG).
+ */
+export function evaluateTnt(files, options) {
+  const e = wasm.evaluateTnt(fileMap(files), options ?? {});
+  return {
+    reportJson: e.reportJson,
+    get report() { return JSON.parse(this.reportJson); },
+    summary: e.summary,
+    summaryLines: e.summaryLines,
+    get plotSvg() { return e.plotSvg; },
+    fileNames: e.fileNames(),
+    file: (name) => e.file(name),
+    free: () => e.free(),
+  };
+}
+
+/**
+ * One camera-pose benchmark protocol, as `sfmeval poses`: `gtCameras` maps the ground-truth
+ * cameras' file names to bytes (a dataset's `cameras.json`, or any model the core reads),
+ * `recon` the estimated model's files (COLMAP `cameras/images/points3D` `.bin` or `.txt`, `.nvm`,
+ * Bundler `.out` + `list.txt`, `sfm_data.json`, `cameras.json`); `options`: `{protocol:
+ * 'colmap' | 'imc' | 'co3d', position_accuracy}` as the CLI's flags. Returns `{reportJson,
+ * report, summary, summaryRows, pairsCsv}` (plain values: nothing to free): `reportJson` byte
+ * for byte what `sfmeval poses --json` prints, `summaryRows` the summary's `{label, text}` lines.
+ */
+export function evaluatePoses({ gtCameras, recon } = {}, options) {
+  if (!gtCameras) throw new Error('evaluatePoses: give gtCameras, the ground-truth cameras\' files');
+  if (!recon) throw new Error('evaluatePoses: give recon, the estimated model\'s files');
+  const e = wasm.evaluatePoses(fileMap(gtCameras), fileMap(recon), options ?? {});
+  try {
+    return {
+      reportJson: e.reportJson,
+      get report() { return JSON.parse(this.reportJson); },
+      summary: e.summary,
+      summaryRows: e.summaryRows,
+      pairsCsv: e.pairsCsv,
+    };
+  } finally { e.free(); }
+}
+
 /** Numbers per camera in `GroundTruth.cameraPoses()` / `Reconstruction.cameraPoses()`:
  * centre (3), world_from_cam row-major (9), tan of the half field of view in x and y. */
 export const POSE_STRIDE = 14;

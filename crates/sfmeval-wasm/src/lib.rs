@@ -27,16 +27,22 @@ use sfmeval::transform::Similarity;
 use wasm_bindgen::prelude::*;
 
 mod dtu;
+mod eth3d;
+mod pose_protocols;
 mod poses;
 mod stream;
 mod table;
+mod tnt;
 
 pub use dtu::{DtuEvaluation, dtu_files, evaluate_dtu};
+pub use eth3d::{Eth3dResult, eth3d_files, evaluate_eth3d};
+pub use pose_protocols::{PosesEvaluation, evaluate_poses};
 pub use poses::error_colors;
 pub use stream::ReconstructionStream;
 pub use table::{
     compare_table, comparison_tables, metric_catalogue, run_reconstruction_files, run_row,
 };
+pub use tnt::{TntResult, evaluate_tnt, tnt_files};
 /// `initThreadPool(n)`: starts the pool of `n` Web Workers the threaded build's maps run on.
 #[cfg(feature = "threads")]
 pub use wasm_bindgen_rayon::init_thread_pool;

@@ -24,6 +24,7 @@ use super::protocol::{
 
 /// The CO3D numbers.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "ts", derive(ts_rs::TS))]
 pub struct Co3dResult {
     /// RRA / RTA thresholds, degrees.
     pub thresholds_deg: Vec<f64>,

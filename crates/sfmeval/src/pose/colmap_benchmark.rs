@@ -30,6 +30,7 @@ use crate::model::{mat_mul, rotation_angle_deg, transpose};
 
 /// COLMAP's benchmark numbers.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "ts", derive(ts_rs::TS))]
 pub struct ColmapResult {
     /// Thresholds in degrees.
     pub thresholds_deg: Vec<f64>,

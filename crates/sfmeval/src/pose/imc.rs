@@ -23,6 +23,7 @@ use super::protocol::{
 
 /// The IMC numbers.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "ts", derive(ts_rs::TS))]
 pub struct ImcResult {
     /// The thresholds of [`Self::accuracy`], degrees (1 … 10).
     pub thresholds_deg: Vec<f64>,

@@ -21,12 +21,14 @@ mod co3d;
 mod colmap_benchmark;
 mod imc;
 mod poses_report;
+mod poses_summary;
 mod protocol;
 
 pub use co3d::Co3dResult;
 pub use colmap_benchmark::ColmapResult;
 pub use imc::ImcResult;
 pub use poses_report::{POSES_SCHEMA, PosesReport, ProtocolResult, evaluate_protocol};
+pub use poses_summary::SummaryRow;
 pub use protocol::{
     Convention, PairError, PairRow, PairSet, Protocol, ProtocolOptions, ThresholdTest,
     TranslationSign,

@@ -84,6 +84,7 @@ impl Default for ProtocolOptions {
 /// Which image pairs a protocol scores.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
+#[cfg_attr(feature = "ts", derive(ts_rs::TS))]
 pub enum PairSet {
     /// Every ordered pair `(i, j)`, `i ≠ j`, of the ground-truth images, plus every ordered pair
     /// involving a registered image that is not in the ground truth.
@@ -95,6 +96,7 @@ pub enum PairSet {
 /// How a pair's rotation and translation errors make its score.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
+#[cfg_attr(feature = "ts", derive(ts_rs::TS))]
 pub enum PairError {
     /// `max(rotation error, translation error)` is compared with each threshold.
     Max,
@@ -105,6 +107,7 @@ pub enum PairError {
 /// How the translation-direction error treats the sign of the direction.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
+#[cfg_attr(feature = "ts", derive(ts_rs::TS))]
 pub enum TranslationSign {
     /// The angle between the directions, 0–180°.
     Signed,
@@ -115,6 +118,7 @@ pub enum TranslationSign {
 /// How a pair is compared with a threshold.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
+#[cfg_attr(feature = "ts", derive(ts_rs::TS))]
 pub enum ThresholdTest {
     /// `error <= threshold`.
     AtMost,
@@ -127,6 +131,7 @@ pub enum ThresholdTest {
 
 /// A protocol's convention, written into its report.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "ts", derive(ts_rs::TS))]
 pub struct Convention {
     /// The official code this protocol follows (repository, file, function).
     pub source: String,
