@@ -10,17 +10,20 @@
 //! build's own serial path: a range of more than a leaf whose centroids all coincide (stacked
 //! copies of a triangle, which the build drops).
 
-use crate::geometry::Point3;
 use crate::parallel;
+
+/// A triangle's centroid in `f32`, relative to the mesh's centre: it only chooses the splits
+/// (the answer of a search does not depend on the tree's shape), at 12 bytes a triangle.
+pub(crate) type Centroid = [f32; 3];
 
 /// Ranges at least this long split their halves on two threads.
 const PARALLEL_MIN: usize = 16_384;
 
 /// The longest axis of the centroids of `order` (the axis to split along; the last of equally
 /// long ones), and whether they all coincide.
-pub(crate) fn centroid_axis(order: &[u32], centroids: &[Point3]) -> (usize, bool) {
-    let mut lo = [f64::INFINITY; 3];
-    let mut hi = [f64::NEG_INFINITY; 3];
+pub(crate) fn centroid_axis(order: &[u32], centroids: &[Centroid]) -> (usize, bool) {
+    let mut lo = [f32::INFINITY; 3];
+    let mut hi = [f32::NEG_INFINITY; 3];
     for &i in order {
         let c = centroids[i as usize];
         for k in 0..3 {
@@ -35,7 +38,7 @@ pub(crate) fn centroid_axis(order: &[u32], centroids: &[Point3]) -> (usize, bool
 }
 
 /// Splits `order` at its median along `axis` (ties by triangle index); returns the middle.
-pub(crate) fn median_split(order: &mut [u32], centroids: &[Point3], axis: usize) -> usize {
+pub(crate) fn median_split(order: &mut [u32], centroids: &[Centroid], axis: usize) -> usize {
     let mid = order.len() / 2;
     order.select_nth_unstable_by(mid, |&a, &b| {
         centroids[a as usize][axis]
@@ -50,7 +53,7 @@ pub(crate) fn median_split(order: &mut [u32], centroids: &[Point3], axis: usize)
 /// split once, at its median along its own longest axis, whatever the grouping. Returns `false`
 /// (the order then partly split) when a range of more than a leaf has coinciding centroids: the
 /// build must then start over from its own order on its serial path.
-pub(crate) fn split_all(order: &mut [u32], centroids: &[Point3], leaf_size: usize) -> bool {
+pub(crate) fn split_all(order: &mut [u32], centroids: &[Centroid], leaf_size: usize) -> bool {
     if order.len() <= leaf_size {
         return true;
     }
