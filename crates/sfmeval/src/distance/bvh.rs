@@ -560,7 +560,7 @@ fn leaf_box(corners: &[[Point3; 3]], centre: Point3) -> ([f32; 3], [f32; 3]) {
 }
 
 /// The numbers of inner nodes and leaves the build makes over `n` triangles (fewer where it
-/// drops stacked copies), to size its vectors: the splits halve, so a level has at most two
+/// drops stacked copies), to size its vectors: the splits halve, so a level has a few
 /// range lengths, remembered.
 fn shape(n: usize) -> (usize, usize) {
     fn node(n: usize, memo: &mut Vec<(usize, (usize, usize))>) -> (usize, usize) {
@@ -569,11 +569,13 @@ fn shape(n: usize) -> (usize, usize) {
         }
         let mut total = (1, 0);
         let once = levels(n) % 2 == 1;
-        for half in [n / 2, n - n / 2] {
+        let mid = median_split::split_len(n, LEAF_SIZE);
+        for half in [mid, n - mid] {
             let parts = if once || half <= LEAF_SIZE {
                 vec![half]
             } else {
-                vec![half / 2, half - half / 2]
+                let m = median_split::split_len(half, LEAF_SIZE);
+                vec![m, half - m]
             };
             for part in parts {
                 let (a, b) = if part <= LEAF_SIZE {
@@ -594,11 +596,12 @@ fn shape(n: usize) -> (usize, usize) {
     }
 }
 
-/// Median halvings from `n` triangles down to leaves of at most [`LEAF_SIZE`].
+/// Splits from `n` triangles down to leaves of at most [`LEAF_SIZE`] ([`median_split::split_len`]
+/// halves the number of leaves, rounded up).
 fn levels(n: usize) -> u32 {
     let mut levels = 0;
-    let mut largest = n;
-    while largest > LEAF_SIZE {
+    let mut largest = n.div_ceil(LEAF_SIZE);
+    while largest > 1 {
         largest = largest.div_ceil(2);
         levels += 1;
     }
@@ -713,9 +716,15 @@ impl Builder<'_> {
     /// Median split of `order[start..end]` along `axis` (ties by input index); the middle.
     fn halve(&mut self, start: usize, end: usize, axis: usize) -> usize {
         if self.partitioned {
-            return start + (end - start) / 2;
+            return start + median_split::split_len(end - start, LEAF_SIZE);
         }
-        start + median_split::median_split(&mut self.order[start..end], self.centroids, axis)
+        start
+            + median_split::median_split(
+                &mut self.order[start..end],
+                self.centroids,
+                axis,
+                LEAF_SIZE,
+            )
     }
 
     /// Moves the distinct triangles of `order[start..end]` (same corners in the same cyclic
