@@ -16,8 +16,13 @@ Writes into OUT (default bench/data):
                                 sampled on it, each moved along a random direction by Gaussian
                                 noise of 0.15 % of the bbox diagonal clipped at 0.5 %: no point
                                 farther than 0.5 % of the diagonal from the surface, no outliers
-Usage: bench/generate.py [--out DIR] [--quick] [--dense 10m,100m] [--smooth]
-       (--quick: 50k mesh and 10k/100k clouds only; --dense, --smooth: only those files)
+  mesh_height_10m.ply, cloud_height_1m.ply
+                                with --big-mesh: a height field on a 2237 x 2237 vertex grid
+                                (5.0M vertices, 9,999,392 triangles, binary PLY of 190 MB) and
+                                1M points sampled on it with Gaussian noise of 0.2 % of the
+                                bbox diagonal (bench/big_mesh.py)
+Usage: bench/generate.py [--out DIR] [--quick] [--dense 10m,100m] [--smooth] [--big-mesh]
+       (--quick: 50k mesh and 10k/100k clouds only; --dense, --smooth, --big-mesh: only those files)
 """
 import argparse
 import json
@@ -161,15 +166,48 @@ def write_smooth(out):
           f"{0.005 * diag:.4g} (0.5 % of the diagonal {diag:.4g})")
 
 
+def height(x, y):
+    return 0.08 * np.sin(7 * x + 1.0) * np.cos(5 * y) + 0.03 * np.sin(23 * x * y + 0.5) + 0.05 * x * y
+
+
+def write_big_mesh(out, side=2237, n=1_000_000):
+    """mesh_height_10m.ply: a height field over [-1, 1]^2 on a side x side grid (two triangles a
+    cell), and cloud_height_1m.ply: n points on it, uniform in x, y, with Gaussian noise."""
+    rng = np.random.default_rng(20261206)
+    t = np.linspace(-1.0, 1.0, side)
+    x, y = np.meshgrid(t, t, indexing="ij")
+    v = np.stack([x.ravel(), y.ravel(), height(x, y).ravel()], -1)
+    i, j = np.meshgrid(np.arange(side - 1), np.arange(side - 1), indexing="ij")
+    a = (i * side + j).ravel()
+    b, c, d = a + side, a + 1, a + side + 1
+    f = np.empty((2 * len(a), 3), np.uint32)
+    f[0::2] = np.stack([a, b, d], -1)
+    f[1::2] = np.stack([a, d, c], -1)
+    del i, j, a, b, c, d
+    write_ply(out / "mesh_height_10m.ply", v, f)
+    lo, hi = v.min(0), v.max(0)
+    diag = float(np.linalg.norm(hi - lo))
+    del v, f
+    px, py = rng.uniform(-1.0, 1.0, n), rng.uniform(-1.0, 1.0, n)
+    pts = np.stack([px, py, height(px, py)], -1) + rng.normal(scale=0.002 * diag, size=(n, 3))
+    write_ply(out / "cloud_height_1m.ply", pts)
+    print(f"mesh_height_10m: {side * side} vertices, {2 * (side - 1) ** 2} triangles; "
+          f"cloud_height_1m: {n} points, noise {0.002 * diag:.4g}")
+
+
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--out", default=str(Path(__file__).resolve().parent / "data"))
     ap.add_argument("--quick", action="store_true")
     ap.add_argument("--dense", default="", help="only write these dense clouds: 10m, 100m (comma-separated)")
     ap.add_argument("--smooth", action="store_true", help="only write the smooth tube workload")
+    ap.add_argument("--big-mesh", action="store_true", help="only write the 10M-triangle height-field workload")
     args = ap.parse_args()
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
+    if args.big_mesh:
+        write_big_mesh(out)
+        return
     if args.smooth:
         write_smooth(out)
         return

@@ -41,7 +41,7 @@ use parry3d_f64::query::PointQueryWithLocation as _;
 use parry3d_f64::shape::Triangle;
 
 use super::leaf_bound::{self, LANES, LeafBound};
-use super::median_split;
+use super::median_split::{self, Centroid};
 use super::oriented::{self, OrientedLanes, OrientedQuery};
 use super::{down, up};
 use crate::geometry::{Point3, TriangleMesh, sub};
@@ -220,14 +220,6 @@ impl TriangleBvh {
 
     /// [`Self::new`]; `split_ahead` false takes the serial path (the tests' reference).
     fn build(mesh: &TriangleMesh, split_ahead: bool) -> Self {
-        let centroids: Vec<Point3> = parallel::map_range(mesh.triangles.len(), |i| {
-            let [a, b, c] = mesh.corners(&mesh.triangles[i]);
-            [
-                (a[0] + b[0] + c[0]) / 3.0,
-                (a[1] + b[1] + c[1]) / 3.0,
-                (a[2] + b[2] + c[2]) / 3.0,
-            ]
-        });
         let mut lo = [f64::INFINITY; 3];
         let mut hi = [f64::NEG_INFINITY; 3];
         for t in &mesh.triangles {
@@ -245,14 +237,20 @@ impl TriangleBvh {
         };
         let unbounded = (0..3).any(|k| !((hi[k] - lo[k]) / 2.0 < MAX_RELATIVE / 2.0));
         let unbounded = unbounded && !mesh.triangles.is_empty();
+        let centroids: Vec<Centroid> = parallel::map_range(mesh.triangles.len(), |i| {
+            let [a, b, c] = mesh.corners(&mesh.triangles[i]);
+            [0, 1, 2].map(|k| ((a[k] + b[k] + c[k]) / 3.0 - centre[k]) as f32)
+        });
         // The median splits ahead, in parallel; the serial path where copies are dropped.
         let mut order: Vec<u32> = (0..mesh.triangles.len() as u32).collect();
         let partitioned = split_ahead && median_split::split_all(&mut order, &centroids, LEAF_SIZE);
         if !partitioned {
             order = (0..mesh.triangles.len() as u32).collect();
         }
-        let mut nodes = Vec::with_capacity(mesh.triangles.len() / (2 * LEAF_SIZE) + 2);
-        let mut leaves = Vec::with_capacity(mesh.triangles.len() / (LEAF_SIZE - 1) + 1);
+        // Sized before they are filled (a grown vector peaks at up to twice its length).
+        let (node_count, leaf_count) = shape(mesh.triangles.len());
+        let mut nodes = Vec::with_capacity(node_count);
+        let mut leaves = Vec::with_capacity(leaf_count);
         let mut builder = Builder {
             mesh,
             centroids: &centroids,
@@ -270,23 +268,33 @@ impl TriangleBvh {
         let slots = leaves.len() * LEAF_SIZE;
         let mut tris = vec![[0u32; 3]; slots];
         let mut ids = vec![u32::MAX; slots];
-        for (leaf, &(start, end, _, _)) in leaves.iter().enumerate() {
-            for (k, &i) in order[start..end].iter().enumerate() {
+        for (leaf, &(start, end)) in leaves.iter().enumerate() {
+            for (k, &i) in order[start as usize..end as usize].iter().enumerate() {
                 tris[leaf * LEAF_SIZE + k] = mesh.triangles[i as usize];
                 ids[leaf * LEAF_SIZE + k] = i;
             }
         }
-        // The bound blocks, leaves in parallel.
-        let bounds = parallel::map_range(leaves.len(), |leaf| {
-            let (start, end, origin, extent) = leaves[leaf];
+        let leaf_count = leaves.len();
+        drop(leaves);
+        drop(order);
+        // The bound blocks, leaves in parallel, from the leaf-order triangles (each leaf's
+        // frame computed again as the build computed its box).
+        let bounds = parallel::map_range(leaf_count, |leaf| {
             if unbounded {
                 return LeafBound::default();
             }
+            let start = leaf * LEAF_SIZE;
+            let count = ids[start..start + LEAF_SIZE]
+                .iter()
+                .take_while(|&&id| id != u32::MAX)
+                .count();
             let mut corners = [[[0.0; 3]; 3]; LEAF_SIZE];
-            for (k, &i) in order[start..end].iter().enumerate() {
-                corners[k] = mesh.corners(&mesh.triangles[i as usize]);
+            for (k, t) in tris[start..start + count].iter().enumerate() {
+                corners[k] = mesh.corners(t);
             }
-            LeafBound::new(&corners[..end - start], origin, extent)
+            let (lo, hi) = leaf_box(&corners[..count], centre);
+            let (origin, extent) = frame(lo, hi, centre);
+            LeafBound::new(&corners[..count], origin, extent)
         });
         if !unbounded {
             oriented_boxes(&mut nodes, &tris, &ids, mesh, centre);
@@ -537,11 +545,63 @@ fn oriented_boxes(
     });
 }
 
-/// Median halvings from `n` triangles down to leaves of at most [`LEAF_SIZE`].
+/// A leaf's box relative to `centre`, rounded outwards to `f32`.
+fn leaf_box(corners: &[[Point3; 3]], centre: Point3) -> ([f32; 3], [f32; 3]) {
+    let mut lo = [f64::INFINITY; 3];
+    let mut hi = [f64::NEG_INFINITY; 3];
+    for v in corners.iter().flatten() {
+        for k in 0..3 {
+            let r = v[k] - centre[k];
+            lo[k] = lo[k].min(r);
+            hi[k] = hi[k].max(r);
+        }
+    }
+    (lo.map(down), hi.map(up))
+}
+
+/// The numbers of inner nodes and leaves the build makes over `n` triangles (fewer where it
+/// drops stacked copies), to size its vectors: the splits halve, so a level has a few
+/// range lengths, remembered.
+fn shape(n: usize) -> (usize, usize) {
+    fn node(n: usize, memo: &mut Vec<(usize, (usize, usize))>) -> (usize, usize) {
+        if let Some(&(_, found)) = memo.iter().find(|(m, _)| *m == n) {
+            return found;
+        }
+        let mut total = (1, 0);
+        let once = levels(n) % 2 == 1;
+        let mid = median_split::split_len(n, LEAF_SIZE);
+        for half in [mid, n - mid] {
+            let parts = if once || half <= LEAF_SIZE {
+                vec![half]
+            } else {
+                let m = median_split::split_len(half, LEAF_SIZE);
+                vec![m, half - m]
+            };
+            for part in parts {
+                let (a, b) = if part <= LEAF_SIZE {
+                    (0, 1)
+                } else {
+                    node(part, memo)
+                };
+                total = (total.0 + a, total.1 + b);
+            }
+        }
+        memo.push((n, total));
+        total
+    }
+    match n {
+        0 => (0, 0),
+        n if n <= LEAF_SIZE => (1, 1),
+        n => node(n, &mut Vec::new()),
+    }
+}
+
+/// Splits from `n` triangles down to leaves of at most [`LEAF_SIZE`] ([`median_split::split_len`]
+/// halves the number of leaves, rounded up).
 fn levels(n: usize) -> u32 {
     let mut levels = 0;
-    let mut largest = n;
-    while largest > LEAF_SIZE {
+    let mut largest = n.div_ceil(LEAF_SIZE);
+    while largest > 1 {
         largest = largest.div_ceil(2);
         levels += 1;
     }
@@ -550,12 +610,11 @@ fn levels(n: usize) -> u32 {
 
 struct Builder<'a> {
     mesh: &'a TriangleMesh,
-    centroids: &'a [Point3],
+    centroids: &'a [Centroid],
     order: &'a mut [u32],
     nodes: &'a mut Vec<Node>,
-    /// Per leaf, in slot order: its range of `order`, and its box's lower corner and extent
-    /// (as the search computes them from the parent's lane, [`Node::leaf_frame`]).
-    leaves: &'a mut Vec<(usize, usize, Point3, Point3)>,
+    /// Per leaf, in slot order: its range of `order`.
+    leaves: &'a mut Vec<(u32, u32)>,
     centre: Point3,
     unbounded: bool,
     /// The order is split already ([`median_split::split_all`]): only the nodes are placed.
@@ -610,21 +669,13 @@ impl Builder<'_> {
     /// if it fits one, else an inner node.
     fn child(&mut self, node: &mut Node, lane: usize, start: usize, end: usize, axis: usize) {
         let (lo, hi, code, count) = if end - start <= LEAF_SIZE {
-            let mut lo = [f64::INFINITY; 3];
-            let mut hi = [f64::NEG_INFINITY; 3];
-            for &i in &self.order[start..end] {
-                for v in self.mesh.corners(&self.mesh.triangles[i as usize]) {
-                    for k in 0..3 {
-                        let r = v[k] - self.centre[k];
-                        lo[k] = lo[k].min(r);
-                        hi[k] = hi[k].max(r);
-                    }
-                }
+            let mut corners = [[[0.0; 3]; 3]; LEAF_SIZE];
+            for (k, &i) in self.order[start..end].iter().enumerate() {
+                corners[k] = self.mesh.corners(&self.mesh.triangles[i as usize]);
             }
-            let (lo, hi) = (lo.map(down), hi.map(up));
+            let (lo, hi) = leaf_box(&corners[..end - start], self.centre);
             let leaf = self.leaves.len();
-            let (origin, extent) = frame(lo, hi, self.centre);
-            self.leaves.push((start, end, origin, extent));
+            self.leaves.push((start as u32, end as u32));
             (lo, hi, LEAF | leaf as u32, (end - start) as u8)
         } else {
             let c = self.node(start, end, axis);
@@ -665,9 +716,15 @@ impl Builder<'_> {
     /// Median split of `order[start..end]` along `axis` (ties by input index); the middle.
     fn halve(&mut self, start: usize, end: usize, axis: usize) -> usize {
         if self.partitioned {
-            return start + (end - start) / 2;
+            return start + median_split::split_len(end - start, LEAF_SIZE);
         }
-        start + median_split::median_split(&mut self.order[start..end], self.centroids, axis)
+        start
+            + median_split::median_split(
+                &mut self.order[start..end],
+                self.centroids,
+                axis,
+                LEAF_SIZE,
+            )
     }
 
     /// Moves the distinct triangles of `order[start..end]` (same corners in the same cyclic
@@ -801,6 +858,24 @@ mod tests {
                 spread > 1.0 || with * 4 < without,
                 "{offset:?} {spread}: {with} exact tests with the bounds, {without} without"
             );
+        }
+    }
+
+    /// The build's vectors are sized exactly: `shape` counts the nodes and leaves the build
+    /// makes, for odd and even numbers of halvings and a single leaf.
+    #[test]
+    fn shape_counts_the_nodes_and_leaves_built() {
+        for n in [1, 2, 3, 5, 9, 17, 40, 101] {
+            let mut mesh = blob(n);
+            for keep in [mesh.triangles.len(), 3, 4, 5, 33, 1000] {
+                mesh.triangles.truncate(keep);
+                let bvh = TriangleBvh::new(&mesh);
+                let (nodes, leaves) = shape(mesh.triangles.len());
+                assert_eq!(bvh.nodes.len(), nodes, "{} triangles", mesh.triangles.len());
+                assert_eq!(bvh.nodes.capacity(), nodes);
+                assert_eq!(bvh.bounds.len(), leaves);
+                assert_eq!(bvh.tris.len(), leaves * LEAF_SIZE);
+            }
         }
     }
 
