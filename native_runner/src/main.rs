@@ -1,5 +1,6 @@
 //! `sfmeval-runner`: runs SfM pipelines on sfmeval datasets, evaluates every run with the
-//! sfmeval core and writes the comparison table (the seed paper's Table I and more).
+//! sfmeval core and writes the comparison tables (Table I: mean distance and points per
+//! pipeline; and the wide table).
 //!
 //! ```text
 //! sfmeval-runner setup [--venv .venv]

@@ -7,7 +7,7 @@
 
 use crate::args::Table1Args;
 
-/// The seed paper's five datasets, as generator presets.
+/// The five datasets of Table I (statue, vase, bicycle, hydrant, vehicle), as generator presets.
 pub const PRESETS: [&str; 5] = ["statue", "vase", "bicycle", "hydrant", "vehicle"];
 
 /// Generator overrides of `--quick`: the `small` preset's camera, views and sampling.

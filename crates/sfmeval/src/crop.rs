@@ -1,5 +1,5 @@
 //! Cropping in the ground-truth frame: a volume (axis-aligned box, oriented box, sphere) and the
-//! seed paper's "discard points farther than D from the ground truth".
+//! cut-off that discards points farther than D from the ground truth.
 //!
 //! The crop file (`sfmeval.crop/1`, written by the browser page, read by the CLI):
 //! ```json
