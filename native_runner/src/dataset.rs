@@ -12,7 +12,7 @@ pub struct Dataset {
     pub name: String,
     /// The folder (absolute).
     pub dir: PathBuf,
-    /// Its `images/` folder.
+    /// Its images: `images/`, or the only subfolder of `images/` holding them (ETH3D).
     pub images: PathBuf,
     /// Number of images.
     pub image_count: usize,
@@ -26,25 +26,8 @@ impl Dataset {
     pub fn open(dir: &Path) -> Result<Dataset> {
         let dir = std::path::absolute(dir)
             .with_context(|| format!("dataset folder {}", dir.display()))?;
-        let images = dir.join("images");
-        if !images.is_dir() {
-            bail!("{} is not a dataset: no images/ folder", dir.display());
-        }
-        let image_count = std::fs::read_dir(&images)
-            .with_context(|| format!("reading {}", images.display()))?
-            .filter_map(|e| e.ok())
-            .filter(|e| {
-                e.path()
-                    .extension()
-                    .and_then(|x| x.to_str())
-                    .is_some_and(|x| {
-                        sfmeval_fs::IMAGE_EXTENSIONS.contains(&x.to_ascii_lowercase().as_str())
-                    })
-            })
-            .count();
-        if image_count == 0 {
-            bail!("{} holds no images", images.display());
-        }
+        let (images, image_count) = images_folder(&dir.join("images"))
+            .with_context(|| format!("{} is not a dataset", dir.display()))?;
         let name = dir
             .file_name()
             .map(|n| n.to_string_lossy().to_string())
@@ -70,5 +53,101 @@ impl Dataset {
             image_count,
             known,
         })
+    }
+}
+
+/// The number of image files directly in `dir`.
+fn count_images(dir: &Path) -> Result<usize> {
+    Ok(std::fs::read_dir(dir)
+        .with_context(|| format!("reading {}", dir.display()))?
+        .filter_map(|e| e.ok())
+        .filter(|e| {
+            e.path()
+                .extension()
+                .and_then(|x| x.to_str())
+                .is_some_and(|x| {
+                    sfmeval_fs::IMAGE_EXTENSIONS.contains(&x.to_ascii_lowercase().as_str())
+                })
+        })
+        .count())
+}
+
+/// The folder of a dataset's images and their number: `images/` itself, or its only subfolder
+/// when `images/` holds no images but one folder of them (ETH3D ships
+/// `images/dslr_images_undistorted/`; the tools then name the images without that folder,
+/// which the core's name matching ignores anyway).
+fn images_folder(images: &Path) -> Result<(PathBuf, usize)> {
+    if !images.is_dir() {
+        bail!("no images/ folder");
+    }
+    let direct = count_images(images)?;
+    if direct > 0 {
+        return Ok((images.to_path_buf(), direct));
+    }
+    let subfolders: Vec<PathBuf> = std::fs::read_dir(images)
+        .with_context(|| format!("reading {}", images.display()))?
+        .filter_map(|e| e.ok())
+        .map(|e| e.path())
+        .filter(|p| p.is_dir())
+        .collect();
+    if let [only] = subfolders.as_slice() {
+        let n = count_images(only)?;
+        if n > 0 {
+            return Ok((only.clone(), n));
+        }
+    }
+    bail!(
+        "{} holds no images (nor one subfolder of them)",
+        images.display()
+    )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn scratch(name: &str) -> PathBuf {
+        let d = std::env::temp_dir().join(format!("sfmeval-dataset-{}-{name}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&d);
+        std::fs::create_dir_all(d.join("images")).unwrap();
+        d
+    }
+
+    #[test]
+    fn images_directly_in_images_or_in_its_only_subfolder() {
+        let flat = scratch("flat");
+        std::fs::write(flat.join("images/0000.jpg"), b"x").unwrap();
+        std::fs::write(flat.join("images/notes.txt"), b"x").unwrap();
+        let d = Dataset::open(&flat).unwrap();
+        assert_eq!((d.image_count, d.images.ends_with("images")), (1, true));
+
+        // ETH3D's layout: images/dslr_images_undistorted/DSC_*.JPG.
+        let eth3d = scratch("eth3d");
+        let sub = eth3d.join("images/dslr_images_undistorted");
+        std::fs::create_dir_all(&sub).unwrap();
+        for k in 0..3 {
+            std::fs::write(sub.join(format!("DSC_{k:04}.JPG")), b"x").unwrap();
+        }
+        let d = Dataset::open(&eth3d).unwrap();
+        assert_eq!(
+            (d.image_count, d.images),
+            (3, std::path::absolute(&sub).unwrap())
+        );
+
+        // Two subfolders: which one is meant is not known.
+        std::fs::create_dir_all(eth3d.join("images/other")).unwrap();
+        std::fs::write(eth3d.join("images/other/a.png"), b"x").unwrap();
+        let e = format!("{:#}", Dataset::open(&eth3d).unwrap_err());
+        assert!(
+            e.contains("holds no images") && e.contains("not a dataset"),
+            "{e}"
+        );
+
+        let empty = scratch("empty");
+        let e = format!("{:#}", Dataset::open(&empty).unwrap_err());
+        assert!(e.contains("holds no images"), "{e}");
+        for d in [flat, eth3d, empty] {
+            let _ = std::fs::remove_dir_all(d);
+        }
     }
 }
