@@ -16,9 +16,9 @@ use sfmeval::geometry::{Aabb, GroundTruth};
 use sfmeval::io::{self, ReadLimits};
 use sfmeval::model;
 use sfmeval::pipeline::{self, EvalRequest, ReconInput, read_reconstruction};
-use sfmeval::pose::{PoseOptions, Protocol, ProtocolOptions, evaluate_protocol};
+use sfmeval::pose::{PoseOptions, Protocol, ProtocolOptions};
 use sfmeval_fs::{
-    Disk, name_of, path_str, read, read_input_files, read_point_pairs,
+    Disk, cameras_on_files, name_of, path_str, poses_on_files, read, read_point_pairs,
     read_reconstruction_with_cameras, read_transform, write_atomic,
 };
 
@@ -659,22 +659,9 @@ fn cameras_cmd(
     report: Option<&Path>,
     json: bool,
 ) -> Result<()> {
-    let gt = model::read_model_files(&read_input_files(gt_cameras)?)
-        .with_context(|| format!("ground-truth cameras '{}'", gt_cameras.display()))?;
-    let est = read_reconstruction(&name_of(recon), &read_input_files(recon)?)
-        .with_context(|| format!("reconstruction '{}'", recon.display()))?;
-    let est = est.model.ok_or_else(|| {
-        anyhow::anyhow!(
-            "reconstruction '{}' has no cameras (a bare point cloud)",
-            recon.display()
-        )
-    })?;
     let given = transform.map(read_transform).transpose()?;
-    let (_, alignment, cams) = pipeline::cameras_only(&gt, &est, given, 0, &PoseOptions::default())
-        .with_context(|| format!("cameras of '{}'", recon.display()))?;
-    let value = serde_json::json!({"alignment": alignment, "cameras": cams});
-    let mut s = serde_json::to_string_pretty(&value)?;
-    s.push('\n');
+    let outputs = cameras_on_files(gt_cameras, recon, given)?;
+    let s = outputs.to_json()?;
     if let Some(p) = report {
         write_atomic(p, s.as_bytes())?;
     }
@@ -683,7 +670,11 @@ fn cameras_cmd(
     } else {
         print!(
             "{}",
-            summary::render_cameras(&cams, &alignment.method, alignment.scale)
+            summary::render_cameras(
+                &outputs.cameras,
+                &outputs.alignment.method,
+                outputs.alignment.scale
+            )
         );
     }
     Ok(())
@@ -699,27 +690,11 @@ fn poses_cmd(
     json: bool,
 ) -> Result<()> {
     let protocol = Protocol::parse(protocol)?;
-    let gt = model::read_model_files(&read_input_files(gt_cameras)?)
-        .with_context(|| format!("ground-truth cameras '{}'", gt_cameras.display()))?;
-    let est = read_reconstruction(&name_of(recon), &read_input_files(recon)?)
-        .with_context(|| format!("reconstruction '{}'", recon.display()))?;
-    let est = est.model.ok_or_else(|| {
-        anyhow::anyhow!(
-            "reconstruction '{}' has no cameras (a bare point cloud)",
-            recon.display()
-        )
-    })?;
     let options = ProtocolOptions {
         colmap_position_accuracy: position_accuracy,
         ..ProtocolOptions::default()
     };
-    let poses = evaluate_protocol(&gt, &est, protocol, &options).with_context(|| {
-        format!(
-            "poses of '{}' against '{}'",
-            recon.display(),
-            gt_cameras.display()
-        )
-    })?;
+    let (gt, poses) = poses_on_files(gt_cameras, recon, protocol, &options)?;
     let s = poses.to_json();
     if let Some(p) = report {
         write_atomic(p, s.as_bytes())?;

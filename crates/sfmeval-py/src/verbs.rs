@@ -14,14 +14,14 @@ use sfmeval::geometry::{GroundTruth, Positions};
 use sfmeval::io::{LoadedCloud, ReadLimits};
 use sfmeval::model;
 use sfmeval::pipeline::{self, ReconInput};
-use sfmeval::pose::{PoseOptions, Protocol, ProtocolOptions, evaluate_protocol};
+use sfmeval::pose::{Protocol, ProtocolOptions};
 use sfmeval::report::Report;
 use sfmeval::transform::Similarity;
 use sfmeval_dtu::{DtuMode, DtuOptions, Shuffle};
 use sfmeval_eth3d::Eth3dOptions;
 use sfmeval_fs::{
-    Disk, DtuRun, Eth3dRun, name_of, named, path_str, pipeline_and_path, read, read_input_files,
-    read_transform, run_dtu, run_eth3d, write_atomic,
+    Disk, DtuRun, Eth3dRun, cameras_on_files, name_of, named, path_str, pipeline_and_path,
+    poses_on_files, read, read_transform, run_dtu, run_eth3d, write_atomic,
 };
 use sfmeval_table::{Row, failed_row, read_row_poses, report_row, summary_json, tables};
 use sfmeval_tnt::{self as tnt, IcpCriteria, Registration, Scene, TntRequest};
@@ -182,27 +182,13 @@ fn cameras_of(
     transform_path: Option<&Path>,
     transform_json: Option<&str>,
 ) -> Result<String, Failure> {
-    let gt = model::read_model_files(&read_input_files(existing(gt_cameras)?)?)
-        .with_context(|| format!("ground-truth cameras '{}'", gt_cameras.display()))?;
-    let est = pipeline::read_reconstruction(&name_of(recon), &read_input_files(existing(recon)?)?)
-        .with_context(|| format!("reconstruction '{}'", recon.display()))?;
-    let est = est.model.ok_or_else(|| {
-        anyhow!(
-            "reconstruction '{}' has no cameras (a bare point cloud)",
-            recon.display()
-        )
-    })?;
+    let (gt_cameras, recon) = (existing(gt_cameras)?, existing(recon)?);
     let given = match (transform_path, transform_json) {
         (Some(p), _) => Some(read_transform(existing(p)?)?),
         (None, Some(text)) => Some(Similarity::parse(text.as_bytes()).context("transform")?),
         (None, None) => None,
     };
-    let (_, alignment, cams) = pipeline::cameras_only(&gt, &est, given, 0, &PoseOptions::default())
-        .with_context(|| format!("cameras of '{}'", recon.display()))?;
-    let value = serde_json::json!({"alignment": alignment, "cameras": cams});
-    let mut s = serde_json::to_string_pretty(&value)?;
-    s.push('\n');
-    Ok(s)
+    Ok(cameras_on_files(gt_cameras, recon, given)?.to_json()?)
 }
 
 /// `_cameras(gt_cameras, recon, transform_path=None, transform_json=None)`: the JSON
@@ -235,30 +221,12 @@ fn poses_of(
     position_accuracy: f64,
 ) -> Result<String, Failure> {
     let protocol = Protocol::parse(protocol)?;
-    let gt = model::read_model_files(&read_input_files(existing(gt_cameras)?)?)
-        .with_context(|| format!("ground-truth cameras '{}'", gt_cameras.display()))?;
-    let est = pipeline::read_reconstruction(&name_of(recon), &read_input_files(existing(recon)?)?)
-        .with_context(|| format!("reconstruction '{}'", recon.display()))?;
-    let est = est.model.ok_or_else(|| {
-        anyhow!(
-            "reconstruction '{}' has no cameras (a bare point cloud)",
-            recon.display()
-        )
-    })?;
     let options = ProtocolOptions {
         colmap_position_accuracy: position_accuracy,
         ..ProtocolOptions::default()
     };
-    let poses = evaluate_protocol(&gt, &est, protocol, &options).with_context(|| {
-        format!(
-            "poses of '{}' against '{}'",
-            recon.display(),
-            gt_cameras.display()
-        )
-    })?;
-    let mut s = serde_json::to_string_pretty(&poses)?;
-    s.push('\n');
-    Ok(s)
+    let (_, poses) = poses_on_files(existing(gt_cameras)?, existing(recon)?, protocol, &options)?;
+    Ok(poses.to_json())
 }
 
 /// `_poses(gt_cameras, recon, protocol, position_accuracy=0.0)`: the JSON `sfmeval poses
