@@ -5,7 +5,7 @@
 // byte the CLI's `--json`) and the pairs CSV for download.
 import { $ } from './util.js';
 import { MSG } from './core.js';
-import { dropZone, entryFiles } from './files.js';
+import { onFiles, runButton } from './benchmark.js';
 
 /** The label and text cells of the core's summary rows, into `tbody`. */
 function fillRows(tbody, rows) {
@@ -39,14 +39,7 @@ export function setupPoses({ call, showError, download, setRunning }) {
       $('poses-status').textContent = '';
       ready();
     };
-    $(`file-poses-${kind}`).addEventListener('change', (e) => take(e.target.files));
-    dropZone($(`drop-poses-${kind}`), async (entries, dropped) => {
-      try {
-        const files = [];
-        for (const en of entries) files.push(...(await entryFiles(en)));
-        take(files.length ? files : dropped);
-      } catch (err) { showError(`poses: ${err.message}`, `file-poses-${kind}`); }
-    });
+    onFiles($(`file-poses-${kind}`), $(`drop-poses-${kind}`), take, (err) => showError(`poses: ${err.message}`, `file-poses-${kind}`));
   };
   zone('gt', 'gt');
   zone('est', 'est');
@@ -62,35 +55,24 @@ export function setupPoses({ call, showError, download, setRunning }) {
     return out;
   };
 
-  $('poses-run').onclick = async () => {
-    if (!state.gt || !state.est || $('poses-run').disabled) return;
-    if (!setRunning(true)) { showError('poses: wait for the evaluation under way to end (or cancel it)', 'poses-run'); return; }
-    $('poses-run').disabled = true;
-    showError('');
-    $('poses-status').textContent = 'evaluating…';
-    try {
+  runButton({
+    key: 'poses', label: 'poses', setRunning, showError, ready: () => Boolean(state.gt && state.est),
+    errorTarget: 'file-poses-est',
+    evaluate: async () => {
       const transfer = [];
       const gtFiles = await named(state.gt, transfer);
       const reconFiles = await named(state.est, transfer);
       const options = { protocol: $('poses-protocol').value, position_accuracy: Number($('poses-position-accuracy').value) || 0 };
       const r = await call(MSG.poses, { gtFiles, reconFiles, options }, transfer);
-      state.result = { ...r, protocol: options.protocol };
+      return { ...r, protocol: options.protocol };
+    },
+    show: (r) => {
+      state.result = r;
       fillRows($('poses-table').tBodies[0], r.rows);
       $('poses-result').hidden = false;
-      $('poses-status').textContent = `done in ${(r.ms / 1000).toFixed(1)} s`;
-      document.body.dataset.poses = String(Number(document.body.dataset.poses || 0) + 1);
-    } catch (err) {
-      if (err.name !== 'Cancelled') {
-        showError(`pose evaluation failed: ${err.message}`, 'file-poses-est');
-        $('poses-status').textContent = '✗ failed: see the message at the top';
-        $('poses-result').hidden = true;
-        state.result = null;
-      } else $('poses-status').textContent = 'cancelled';
-    } finally {
-      setRunning(false);
-      ready();
-    }
-  };
+    },
+    clear: () => { state.result = null; $('poses-result').hidden = true; },
+  });
   $('poses-dl-report').onclick = () => { if (state.result) download(`poses_${state.result.protocol}.json`, state.result.reportJson, 'application/json'); };
   $('poses-dl-pairs').onclick = () => { if (state.result) download(`poses_${state.result.protocol}_pairs.csv`, state.result.pairsCsv, 'text/csv'); };
   return state;

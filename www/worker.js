@@ -296,7 +296,7 @@ const handlers = {
     try {
       const d2s = r.d2sPly(), s2d = r.s2dPly();
       return {
-        reply: { reportJson: r.reportJson, summary: r.summary, lines: r.resultLines, visNames: r.visNames, d2s, s2d, ms: performance.now() - t0 },
+        reply: { reportJson: r.reportJson, summary: r.summary, counts: r.countsLine, lines: r.resultLines, visNames: r.visNames, d2s, s2d, ms: performance.now() - t0 },
         transfer: [d2s.buffer, s2d.buffer],
       };
     } finally { r.free(); }

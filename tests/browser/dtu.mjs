@@ -5,27 +5,13 @@
 // Usage: node dtu.mjs --npm NPM_PACKAGE_DIR --cli CLI_BINARY --scene SCENE_DIR --out OUT_DIR [--url PAGE_URL]
 // Prints one "ok NAME" / "FAILED NAME: why" line per check; exits 1 when one failed.
 import { execFileSync } from 'node:child_process';
-import { mkdirSync, readFileSync, writeFileSync } from 'node:fs';
-import { basename, dirname, join, resolve } from 'node:path';
-import { pathToFileURL } from 'node:url';
+import { readFileSync } from 'node:fs';
+import { basename, dirname, join } from 'node:path';
+import { args, argPaths, bytesEqual, check, download, dropAndCheckSummary, ensureDir, finish, firstDiff, loadNpm, withPage } from './driver.mjs';
 
-const args = Object.fromEntries(process.argv.slice(2).reduce((a, v, i, all) => (v.startsWith('--') ? [...a, [v.slice(2), all[i + 1]]] : a), []));
-const [npmDir, cli, sceneDir, out] = ['npm', 'cli', 'scene', 'out'].map((k) => resolve(args[k]));
-mkdirSync(out, { recursive: true });
-const sfmeval = await import(pathToFileURL(join(npmDir, 'index.js')).href);
-await sfmeval.init();
-
-let failed = 0;
-const check = (name, ok, why = '') => {
-  if (ok) console.log(`ok ${name}`);
-  else { failed++; console.log(`FAILED ${name}: ${why}`); }
-};
-const firstDiff = (a, b) => {
-  const x = a.split('\n'), y = b.split('\n');
-  const i = x.findIndex((l, k) => l !== y[k]);
-  return i < 0 ? (x.length === y.length ? 'equal' : 'lengths differ') : `line ${i + 1}: ${x[i]} vs ${y[i]}`;
-};
-const bytesEqual = (a, b) => a.length === b.length && Buffer.compare(Buffer.from(a), Buffer.from(b)) === 0;
+const [npmDir, cli, sceneDir, out] = argPaths('npm', 'cli', 'scene', 'out');
+ensureDir(out);
+const sfmeval = await loadNpm(npmDir);
 
 const scene = JSON.parse(readFileSync(join(sceneDir, 'scene.json'), 'utf8'));
 const scan = Number(scene.scan);
@@ -88,21 +74,10 @@ try {
 //    then the core's lines for mean accuracy, mean completeness and overall, and the report and
 //    clouds downloaded byte for byte the CLI's
 if (args.url && cliOut.sparse) {
-  const { chromium } = await import('playwright-core');
-  const browser = await chromium.launch({
-    executablePath: process.env.CHROMIUM || '/usr/bin/chromium',
-    args: ['--use-angle=swiftshader', '--enable-unsafe-swiftshader', '--no-sandbox', '--disable-gpu', '--disable-dev-shm-usage'],
-  });
-  try {
-    const page = await (await browser.newContext({ acceptDownloads: true, viewport: { width: 1366, height: 768 } })).newPage();
-    const errors = [];
-    page.on('pageerror', (e) => errors.push(String(e)));
-    await page.goto(args.url);
-    await page.waitForFunction(() => document.body.dataset.ready === '1', null, { timeout: 60000 });
-    await page.setInputFiles('#file-dtu', [gtPaths[0], gtPaths[1], scene.sparse]);
-    await page.waitForFunction(() => /still needed/.test(document.getElementById('info-dtu').textContent), null, { timeout: 10000 }).catch(() => {});
-    const missing = await page.evaluate(() => [document.getElementById('info-dtu').textContent, document.getElementById('dtu-run').disabled]);
-    check('dtu-page-says-what-is-missing', missing[1] && missing[0].includes(`Plane${scan}.mat`) && missing[0].includes('scan 1'), JSON.stringify(missing));
+  await withPage(args.url, 'dtu', async (page) => {
+    const dropped = [gtPaths[0], gtPaths[1], scene.sparse];
+    const missing = await dropAndCheckSummary(page, 'dtu', dropped, sfmeval.dtuFiles(dropped.map((p) => basename(p))), 'dtu-page-shows-the-cores-words-for-the-files');
+    check('dtu-page-says-what-is-missing', missing.disabled && missing.line.includes(`Plane${scan}.mat`) && missing.line.includes('scan 1'), JSON.stringify(missing));
     await page.setInputFiles('#file-dtu', [gtPaths[2]]);
     await page.waitForFunction(() => !document.getElementById('dtu-run').disabled, null, { timeout: 10000 });
     await page.locator('#drop-dtu').scrollIntoViewIfNeeded();
@@ -116,24 +91,14 @@ if (args.url && cliOut.sparse) {
     const want = cliOut.sparse.summary.split('\n').filter(Boolean);
     check('dtu-page-shows-the-cores-summary', !shown.error && shown.lines.length === 3 && shown.lines.every((l, i) => l === want[i + 1].trim()) && shown.counts === want[0],
       JSON.stringify({ shown, want }));
-    const download = async (sel) => {
-      const [dl] = await Promise.all([page.waitForEvent('download'), page.click(sel)]);
-      const p = join(out, `dtu-page-${dl.suggestedFilename()}`);
-      await dl.saveAs(p);
-      return readFileSync(p);
-    };
-    const rep = (await download('#dtu-dl-report')).toString();
+    const [, rep] = await download(page, '#dtu-dl-report', out, 'dtu');
     // the page names the reconstruction by its file name, as the CLI run in its folder does
-    check('dtu-page-report-equals-cli', rep === cliOut.sparse.json, firstDiff(rep, cliOut.sparse.json));
-    check('dtu-page-clouds-equal-cli', bytesEqual(await download('#dtu-dl-d2s'), cliOut.sparse.d2s) && bytesEqual(await download('#dtu-dl-s2d'), cliOut.sparse.s2d));
+    check('dtu-page-report-equals-cli', rep.toString() === cliOut.sparse.json, firstDiff(rep.toString(), cliOut.sparse.json));
+    const [, d2s] = await download(page, '#dtu-dl-d2s', out, 'dtu');
+    const [, s2d] = await download(page, '#dtu-dl-s2d', out, 'dtu');
+    check('dtu-page-clouds-equal-cli', bytesEqual(d2s, cliOut.sparse.d2s) && bytesEqual(s2d, cliOut.sparse.s2d));
     await page.locator('#drop-dtu').screenshot({ path: join(out, 'dtu-section.png') });
     await page.screenshot({ path: join(out, 'dtu-1366x768.png') });
-    check('dtu-page-no-errors', errors.length === 0, errors.join(' | '));
-  } catch (e) {
-    check('dtu-page', false, e.stack || String(e));
-  } finally {
-    await browser.close();
-  }
+  });
 }
-writeFileSync(join(out, 'dtu-done'), '');
-process.exit(failed ? 1 : 0);
+finish(out, 'dtu');

@@ -8,27 +8,13 @@
 // Usage: node eth3d.mjs --npm NPM_PACKAGE_DIR --cli CLI_BINARY --scene SCENE_DIR --out OUT_DIR [--url PAGE_URL]
 // Prints one "ok NAME" / "FAILED NAME: why" line per check; exits 1 when one failed.
 import { execFileSync } from 'node:child_process';
-import { copyFileSync, mkdirSync, readFileSync, writeFileSync } from 'node:fs';
-import { join, resolve } from 'node:path';
-import { pathToFileURL } from 'node:url';
+import { copyFileSync, readFileSync, writeFileSync } from 'node:fs';
+import { join } from 'node:path';
+import { args, argPaths, bytesEqual, check, download, dropAndCheckSummary, ensureDir, finish, firstDiff, loadNpm, withPage } from './driver.mjs';
 
-const args = Object.fromEntries(process.argv.slice(2).reduce((a, v, i, all) => (v.startsWith('--') ? [...a, [v.slice(2), all[i + 1]]] : a), []));
-const [npmDir, cli, sceneDir, out] = ['npm', 'cli', 'scene', 'out'].map((k) => resolve(args[k]));
-mkdirSync(out, { recursive: true });
-const sfmeval = await import(pathToFileURL(join(npmDir, 'index.js')).href);
-await sfmeval.init();
-
-let failed = 0;
-const check = (name, ok, why = '') => {
-  if (ok) console.log(`ok ${name}`);
-  else { failed++; console.log(`FAILED ${name}: ${why}`); }
-};
-const firstDiff = (a, b) => {
-  const x = a.split('\n'), y = b.split('\n');
-  const i = x.findIndex((l, k) => l !== y[k]);
-  return i < 0 ? (x.length === y.length ? 'equal' : 'lengths differ') : `line ${i + 1}: ${x[i]} vs ${y[i]}`;
-};
-const bytesEqual = (a, b) => a.length === b.length && Buffer.compare(Buffer.from(a), Buffer.from(b)) === 0;
+const [npmDir, cli, sceneDir, out] = argPaths('npm', 'cli', 'scene', 'out');
+ensureDir(out);
+const sfmeval = await loadNpm(npmDir);
 
 const gtDir = join(sceneDir, 'dslr_scan_eval');
 copyFileSync(join(sceneDir, 'dense.ply'), join(gtDir, 'dense.ply'));
@@ -82,21 +68,11 @@ try {
 //    the rest; the core's table shown, the report and a cloud downloaded byte for byte the CLI's;
 //    then a scan that is not a PLY: the core's message naming it
 if (args.url && want) {
-  const { chromium } = await import('playwright-core');
-  const browser = await chromium.launch({
-    executablePath: process.env.CHROMIUM || '/usr/bin/chromium',
-    args: ['--use-angle=swiftshader', '--enable-unsafe-swiftshader', '--no-sandbox', '--disable-gpu', '--disable-dev-shm-usage'],
-  });
-  try {
-    const page = await (await browser.newContext({ acceptDownloads: true, viewport: { width: 1366, height: 768 } })).newPage();
-    const errors = [];
-    page.on('pageerror', (e) => errors.push(String(e)));
-    await page.goto(args.url);
-    await page.waitForFunction(() => document.body.dataset.ready === '1', null, { timeout: 60000 });
-    await page.setInputFiles('#file-eth3d', [join(gtDir, 'scan_alignment.mlp'), join(gtDir, 'scan1.ply'), join(gtDir, 'dense.ply')]);
-    await page.waitForFunction(() => /still needed/.test(document.getElementById('info-eth3d').textContent), null, { timeout: 10000 }).catch(() => {});
-    const missing = await page.evaluate(() => [document.getElementById('info-eth3d').textContent, document.getElementById('eth3d-run').disabled]);
-    check('eth3d-page-says-what-is-missing', missing[1] && missing[0].includes('scan2.ply') && missing[0].includes('reconstruction: dense.ply'), JSON.stringify(missing));
+  await withPage(args.url, 'eth3d', async (page) => {
+    const dropped = ['scan_alignment.mlp', 'scan1.ply', 'dense.ply'];
+    const wantFound = sfmeval.eth3dFiles(dropped, files['scan_alignment.mlp']);
+    const missing = await dropAndCheckSummary(page, 'eth3d', dropped.map((n) => join(gtDir, n)), wantFound, 'eth3d-page-shows-the-cores-words-for-the-files');
+    check('eth3d-page-says-what-is-missing', missing.disabled && missing.line.includes('scan2.ply') && missing.line.includes('reconstruction: dense.ply'), JSON.stringify(missing));
     await page.setInputFiles('#file-eth3d', [join(gtDir, 'scan2.ply')]);
     await page.waitForFunction(() => !document.getElementById('eth3d-run').disabled, null, { timeout: 10000 });
     await page.locator('#drop-eth3d').scrollIntoViewIfNeeded();
@@ -113,16 +89,10 @@ if (args.url && want) {
       && shown.rows.length === wantRep.tolerances.length
       && shown.rows.every((r, k) => r[0] === `${wantRep.tolerances[k].tolerance} m` && want.summary.split('\n')[k + 2].includes(r[3])),
     JSON.stringify({ shown, summary: want.summary }));
-    const download = async (sel) => {
-      const [dl] = await Promise.all([page.waitForEvent('download'), page.click(sel)]);
-      const p = join(out, `eth3d-page-${dl.suggestedFilename()}`);
-      await dl.saveAs(p);
-      return [dl.suggestedFilename(), readFileSync(p)];
-    };
-    const [, rep] = await download('#eth3d-dl-report');
+    const [, rep] = await download(page, '#eth3d-dl-report', out, 'eth3d');
     check('eth3d-page-report-equals-cli', rep.toString() === want.json, firstDiff(rep.toString(), want.json));
     await page.selectOption('#eth3d-tolerance', '2');
-    const [name, cloud] = await download('#eth3d-dl-acc');
+    const [name, cloud] = await download(page, '#eth3d-dl-acc', out, 'eth3d');
     check('eth3d-page-cloud-equals-cli', name === 'accuracy.tolerance_0.05.ply' && bytesEqual(cloud, readFileSync(join(vis, name))), name);
     await page.locator('#eth3d-result').screenshot({ path: join(out, 'eth3d-section.png') });
     await page.screenshot({ path: join(out, 'eth3d-1366x768.png') });
@@ -135,12 +105,6 @@ if (args.url && want) {
     await page.waitForFunction(() => /failed/.test(document.getElementById('error').textContent), null, { timeout: 30000 }).catch(() => {});
     const err = await page.evaluate(() => document.getElementById('error').textContent);
     check('eth3d-page-wrong-file-named', err.includes('scan2.ply') && !/panic|unreachable/i.test(err), err);
-    check('eth3d-page-no-errors', errors.length === 0, errors.join(' | '));
-  } catch (e) {
-    check('eth3d-page', false, e.stack || String(e));
-  } finally {
-    await browser.close();
-  }
+  });
 }
-writeFileSync(join(out, 'eth3d-done'), '');
-process.exit(failed ? 1 : 0);
+finish(out, 'eth3d');

@@ -7,27 +7,15 @@
 // Usage: node poses.mjs --npm NPM_PACKAGE_DIR --cli CLI_BINARY --out OUT_DIR [--url PAGE_URL]
 // Prints one "ok NAME" / "FAILED NAME: why" line per check; exits 1 when one failed.
 import { execFileSync } from 'node:child_process';
-import { mkdirSync, readdirSync, readFileSync, writeFileSync } from 'node:fs';
+import { readdirSync, readFileSync } from 'node:fs';
 import { basename, dirname, join, resolve } from 'node:path';
-import { fileURLToPath, pathToFileURL } from 'node:url';
+import { fileURLToPath } from 'node:url';
+import { args, argPaths, check, download, ensureDir, finish, firstDiff, loadNpm, withPage } from './driver.mjs';
 
 const ROOT = resolve(dirname(fileURLToPath(import.meta.url)), '../..');
-const args = Object.fromEntries(process.argv.slice(2).reduce((a, v, i, all) => (v.startsWith('--') ? [...a, [v.slice(2), all[i + 1]]] : a), []));
-const [npmDir, cli, out] = ['npm', 'cli', 'out'].map((k) => resolve(args[k]));
-mkdirSync(out, { recursive: true });
-const sfmeval = await import(pathToFileURL(join(npmDir, 'index.js')).href);
-await sfmeval.init();
-
-let failed = 0;
-const check = (name, ok, why = '') => {
-  if (ok) console.log(`ok ${name}`);
-  else { failed++; console.log(`FAILED ${name}: ${why}`); }
-};
-const firstDiff = (a, b) => {
-  const x = a.split('\n'), y = b.split('\n');
-  const i = x.findIndex((l, k) => l !== y[k]);
-  return i < 0 ? (x.length === y.length ? 'equal' : 'lengths differ') : `line ${i + 1}: ${x[i]} vs ${y[i]}`;
-};
+const [npmDir, cli, out] = argPaths('npm', 'cli', 'out');
+ensureDir(out);
+const sfmeval = await loadNpm(npmDir);
 
 /** A model path (file or folder) as named bytes, as the page and npm get them. */
 const filesOf = (p) => {
@@ -97,18 +85,7 @@ try {
 //    core's summary rows shown, the report downloaded byte for byte the CLI's; a bare cloud as
 //    the estimate refused with the core's message naming the file
 if (args.url && cliOut['demo-co3d']) {
-  const { chromium } = await import('playwright-core');
-  const browser = await chromium.launch({
-    executablePath: process.env.CHROMIUM || '/usr/bin/chromium',
-    args: ['--use-angle=swiftshader', '--enable-unsafe-swiftshader', '--no-sandbox', '--disable-gpu', '--disable-dev-shm-usage'],
-  });
-  try {
-    const page = await (await browser.newContext({ acceptDownloads: true, viewport: { width: 1366, height: 768 } })).newPage();
-    const errors = [];
-    page.on('pageerror', (e) => errors.push(String(e)));
-    page.on('console', (m) => { if (m.type() === 'error') errors.push(m.text()); });
-    await page.goto(args.url);
-    await page.waitForFunction(() => document.body.dataset.ready === '1', null, { timeout: 60000 });
+  await withPage(args.url, 'poses', async (page) => {
     const before = await page.evaluate(() => document.getElementById('poses-run').disabled);
     await page.setInputFiles('#file-poses-gt', [cases[2][1]]);
     await page.setInputFiles('#file-poses-est', [cases[2][2]]);
@@ -126,11 +103,8 @@ if (args.url && cliOut['demo-co3d']) {
     const asLines = shown.rows.map(([l, t]) => (/^(info|warning|error)$/.test(l) ? `${l}: ${t}` : `${l.padEnd(15)} ${t}`));
     check('poses-page-shows-the-cores-summary', !shown.error && asLines.length === want.length && asLines.every((l, i) => l === want[i])
       && shown.rows.some(([l]) => l === 'RRA') && shown.rows.some(([l]) => l === 'convention'), JSON.stringify({ shown, want }));
-    const [dl] = await Promise.all([page.waitForEvent('download'), page.click('#poses-dl-report')]);
-    const p = join(out, `poses-page-${dl.suggestedFilename()}`);
-    await dl.saveAs(p);
-    const rep = readFileSync(p, 'utf8');
-    check('poses-page-report-equals-cli', rep === cliOut['demo-co3d'].json, firstDiff(rep, cliOut['demo-co3d'].json));
+    const [, rep] = await download(page, '#poses-dl-report', out, 'poses');
+    check('poses-page-report-equals-cli', rep.toString() === cliOut['demo-co3d'].json, firstDiff(rep.toString(), cliOut['demo-co3d'].json));
     await page.locator('#poses-result').screenshot({ path: join(out, 'poses-section.png') });
     await page.screenshot({ path: join(out, 'poses-1366x768.png') });
     // a point cloud dropped as the estimated model: the core's message, naming the file
@@ -140,12 +114,6 @@ if (args.url && cliOut['demo-co3d']) {
     await page.waitForFunction(() => /no cameras/.test(document.getElementById('error').textContent), null, { timeout: 30000 }).catch(() => {});
     const err = await page.evaluate(() => [document.getElementById('error').textContent, document.getElementById('poses-result').hidden]);
     check('poses-page-wrong-file-named', err[0].includes('pycolmap_points3D.ply') && /no cameras/.test(err[0]) && err[1], JSON.stringify(err));
-    check('poses-page-no-errors', errors.length === 0, errors.join(' | '));
-  } catch (e) {
-    check('poses-page', false, e.stack || String(e));
-  } finally {
-    await browser.close();
-  }
+  }, { consoleErrors: true });
 }
-writeFileSync(join(out, 'poses-done'), '');
-process.exit(failed ? 1 : 0);
+finish(out, 'poses');

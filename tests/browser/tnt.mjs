@@ -9,28 +9,14 @@
 // Usage: node tnt.mjs --npm NPM_PACKAGE_DIR --cli CLI_BINARY --scene OUT_OF_TNT_SCENE --tau T --out OUT_DIR [--url PAGE_URL]
 // Prints one "ok NAME" / "FAILED NAME: why" line per check; exits 1 when one failed.
 import { execFileSync } from 'node:child_process';
-import { mkdirSync, readFileSync, writeFileSync } from 'node:fs';
-import { join, resolve } from 'node:path';
-import { pathToFileURL } from 'node:url';
+import { readFileSync, writeFileSync } from 'node:fs';
+import { join } from 'node:path';
+import { args, bytesEqual, check, download, dropAndCheckSummary, ensureDir, finish, firstDiff, loadNpm, argPaths, withPage } from './driver.mjs';
 
-const args = Object.fromEntries(process.argv.slice(2).reduce((a, v, i, all) => (v.startsWith('--') ? [...a, [v.slice(2), all[i + 1]]] : a), []));
-const [npmDir, cli, root, out] = ['npm', 'cli', 'scene', 'out'].map((k) => resolve(args[k]));
+const [npmDir, cli, root, out] = argPaths('npm', 'cli', 'scene', 'out');
 const tau = Number(args.tau);
-mkdirSync(out, { recursive: true });
-const sfmeval = await import(pathToFileURL(join(npmDir, 'index.js')).href);
-await sfmeval.init();
-
-let failed = 0;
-const check = (name, ok, why = '') => {
-  if (ok) console.log(`ok ${name}`);
-  else { failed++; console.log(`FAILED ${name}: ${why}`); }
-};
-const firstDiff = (a, b) => {
-  const x = a.split('\n'), y = b.split('\n');
-  const i = x.findIndex((l, k) => l !== y[k]);
-  return i < 0 ? (x.length === y.length ? 'equal' : 'lengths differ') : `line ${i + 1}: ${x[i]} vs ${y[i]}`;
-};
-const bytesEqual = (a, b) => a.length === b.length && Buffer.compare(Buffer.from(a), Buffer.from(b)) === 0;
+ensureDir(out);
+const sfmeval = await loadNpm(npmDir);
 
 const S = 'Synth';
 const paths = {
@@ -83,21 +69,10 @@ try {
 //    lines and plot shown, the report and a cloud downloaded byte for byte the CLI's; then a
 //    trajectory that is not one: the core's message naming it
 if (args.url && want) {
-  const { chromium } = await import('playwright-core');
-  const browser = await chromium.launch({
-    executablePath: process.env.CHROMIUM || '/usr/bin/chromium',
-    args: ['--use-angle=swiftshader', '--enable-unsafe-swiftshader', '--no-sandbox', '--disable-gpu', '--disable-dev-shm-usage'],
-  });
-  try {
-    const page = await (await browser.newContext({ acceptDownloads: true, viewport: { width: 1366, height: 768 } })).newPage();
-    const errors = [];
-    page.on('pageerror', (e) => errors.push(String(e)));
-    await page.goto(args.url);
-    await page.waitForFunction(() => document.body.dataset.ready === '1', null, { timeout: 60000 });
-    await page.setInputFiles('#file-tnt', Object.entries(paths).filter(([n]) => n !== `${S}.json`).map(([, p]) => p));
-    await page.waitForFunction(() => /still needed/.test(document.getElementById('info-tnt').textContent), null, { timeout: 10000 }).catch(() => {});
-    const missing = await page.evaluate(() => [document.getElementById('info-tnt').textContent, document.getElementById('tnt-run').disabled]);
-    check('tnt-page-says-what-is-missing', missing[1] && missing[0].includes(`${S}.json`) && missing[0].includes(`scene ${S}`), JSON.stringify(missing));
+  await withPage(args.url, 'tnt', async (page) => {
+    const dropped = Object.keys(paths).filter((n) => n !== `${S}.json`);
+    const missing = await dropAndCheckSummary(page, 'tnt', dropped.map((n) => paths[n]), sfmeval.tntFiles(dropped), 'tnt-page-shows-the-cores-words-for-the-files');
+    check('tnt-page-says-what-is-missing', missing.disabled && missing.line.includes(`${S}.json`) && missing.line.includes(`scene ${S}`), JSON.stringify(missing));
     await page.setInputFiles('#file-tnt', [paths[`${S}.json`]]);
     await page.waitForFunction(() => !document.getElementById('tnt-run').disabled, null, { timeout: 10000 });
     await page.locator('#drop-tnt').scrollIntoViewIfNeeded();
@@ -113,16 +88,10 @@ if (args.url && want) {
     check('tnt-page-shows-the-cores-summary', !shown.error && shown.lines.length === wantLines.length && shown.lines.every((l, i) => l === wantLines[i])
       && shown.lines.some((l) => /^precision .* F-score/.test(l)), JSON.stringify({ shown, wantLines }));
     check('tnt-page-shows-the-plot', shown.plot > 0, `image width ${shown.plot}`);
-    const download = async (sel) => {
-      const [dl] = await Promise.all([page.waitForEvent('download'), page.click(sel)]);
-      const p = join(out, `tnt-page-${dl.suggestedFilename()}`);
-      await dl.saveAs(p);
-      return [dl.suggestedFilename(), readFileSync(p)];
-    };
-    const [, rep] = await download('#tnt-dl-report');
+    const [, rep] = await download(page, '#tnt-dl-report', out, 'tnt');
     check('tnt-page-report-equals-cli', rep.toString() === want.json, firstDiff(rep.toString(), want.json));
     await page.selectOption('#tnt-file', `${S}.precision.ply`);
-    const [name, cloud] = await download('#tnt-dl-file');
+    const [name, cloud] = await download(page, '#tnt-dl-file', out, 'tnt');
     check('tnt-page-cloud-equals-cli', name === `${S}.precision.ply` && bytesEqual(cloud, readFileSync(join(cliOut, name))), name);
     await page.locator('#tnt-result').screenshot({ path: join(out, 'tnt-section.png') });
     await page.screenshot({ path: join(out, 'tnt-1366x768.png') });
@@ -135,12 +104,6 @@ if (args.url && want) {
     await page.waitForFunction(() => /failed/.test(document.getElementById('error').textContent), null, { timeout: 30000 }).catch(() => {});
     const err = await page.evaluate(() => document.getElementById('error').textContent);
     check('tnt-page-wrong-file-named', err.includes('traj.log') && !/panic|unreachable/i.test(err), err);
-    check('tnt-page-no-errors', errors.length === 0, errors.join(' | '));
-  } catch (e) {
-    check('tnt-page', false, e.stack || String(e));
-  } finally {
-    await browser.close();
-  }
+  });
 }
-writeFileSync(join(out, 'tnt-done'), '');
-process.exit(failed ? 1 : 0);
+finish(out, 'tnt');

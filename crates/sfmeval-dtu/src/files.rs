@@ -5,6 +5,8 @@
 
 use serde::Serialize;
 use sfmeval::Result;
+use sfmeval::dropped::{self, FilesSummary};
+use sfmeval::files::base_name;
 
 use crate::DtuMode;
 use crate::protocol::DtuInput;
@@ -29,6 +31,10 @@ pub struct DtuFiles {
     pub problems: Vec<String>,
     /// Names that are none of the above.
     pub ignored: Vec<String>,
+    /// The files recognised that the evaluation reads, in the order STL points, observation mask, ground plane, reconstruction.
+    pub inputs: Vec<String>,
+    /// What a front end says of these files (worded by the core).
+    pub summary: FilesSummary,
 }
 
 impl DtuFiles {
@@ -36,11 +42,25 @@ impl DtuFiles {
     pub fn complete(&self) -> bool {
         self.missing.is_empty() && self.problems.is_empty()
     }
-}
 
-/// The base name of a path (`/` or `\` separated).
-fn base(path: &str) -> &str {
-    path.rsplit(['/', '\\']).next().unwrap_or(path)
+    /// Fills [`Self::inputs`] and [`Self::summary`] from the rest.
+    fn summarised(mut self) -> Self {
+        let named = [
+            ("STL points", &self.stl),
+            ("observation mask", &self.obs_mask),
+            ("ground plane", &self.plane),
+            ("reconstruction", &self.reconstruction),
+        ];
+        self.inputs = named.iter().filter_map(|(_, n)| (*n).clone()).collect();
+        let files: Vec<(&str, Option<&str>)> =
+            named.iter().map(|(k, n)| (*k, n.as_deref())).collect();
+        let found = [
+            self.scan.map_or_else(String::new, |n| format!("scan {n}")),
+            dropped::named_files(&files),
+        ];
+        self.summary = dropped::summarise(&found, &self.problems, &self.missing, &self.ignored);
+        self
+    }
 }
 
 /// The number between `prefix` and `suffix` in `name` (ASCII case-insensitive), if that is all.
@@ -62,7 +82,7 @@ pub fn recognise<S: AsRef<str>>(names: &[S]) -> DtuFiles {
     let mut recons: Vec<String> = Vec::new();
     for name in names {
         let name = name.as_ref();
-        let b = base(name);
+        let b = base_name(name);
         let lower = b.to_ascii_lowercase();
         let slot = if let Some(n) = number_in(b, "stl", "_total.ply") {
             Some((n, &mut f.stl))
@@ -132,7 +152,7 @@ pub fn recognise<S: AsRef<str>>(names: &[S]) -> DtuFiles {
             "the reconstruction: a PLY point cloud or mesh in the scan's frame, in mm".to_string(),
         );
     }
-    f
+    f.summarised()
 }
 
 /// Reads the reconstruction's PLY bytes as `mode` says; also returns whether it is a mesh.
@@ -161,6 +181,23 @@ mod tests {
         assert_eq!(f.plane.as_deref(), Some("ObsMask/Plane24.mat"));
         assert_eq!(f.reconstruction.as_deref(), Some("mvsnet024_l3.ply"));
         assert_eq!(f.ignored, ["notes.txt"]);
+        assert_eq!(
+            f.inputs,
+            [
+                "Points/stl/stl024_total.ply",
+                "ObsMask/ObsMask24_10.mat",
+                "ObsMask/Plane24.mat",
+                "mvsnet024_l3.ply"
+            ]
+        );
+        assert_eq!(
+            f.summary.line,
+            "scan 24 · STL points: Points/stl/stl024_total.ply, observation mask: \
+             ObsMask/ObsMask24_10.mat, ground plane: ObsMask/Plane24.mat, reconstruction: \
+             mvsnet024_l3.ply · not used: notes.txt"
+        );
+        assert_eq!(f.summary.status, "ready");
+        assert!(f.summary.complete && !f.summary.problem);
     }
 
     #[test]
@@ -171,6 +208,13 @@ mod tests {
         assert_eq!(f.missing.len(), 2, "{:?}", f.missing);
         assert!(f.missing[0].contains("ObsMask1_10.mat"), "{:?}", f.missing);
         assert!(f.missing[1].contains("reconstruction"), "{:?}", f.missing);
+        assert_eq!(f.summary.status, "2 files missing: see above");
+        assert!(
+            f.summary
+                .line
+                .contains("still needed: the observation mask")
+        );
+        assert!(!f.summary.complete);
         let f = recognise(&[
             "stl001_total.ply",
             "ObsMask2_10.mat",
@@ -187,6 +231,11 @@ mod tests {
             f.problems
         );
         assert!(f.missing.is_empty(), "{:?}", f.missing);
+        assert_eq!(
+            f.summary.status,
+            "these files do not fit together: see above"
+        );
+        assert!(f.summary.problem);
         let none: [&str; 0] = [];
         assert_eq!(recognise(&none).missing.len(), 4);
     }

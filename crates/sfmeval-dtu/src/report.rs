@@ -108,21 +108,27 @@ impl DtuReport {
     /// The summary `sfmeval dtu` prints (and the page shows): the scan and the counts, then mean
     /// accuracy, mean completeness and overall, one line each, in mm.
     pub fn summary(&self) -> String {
-        let c = &self.counts;
-        let o = &self.options;
         format!(
-            "DTU evaluation, scan {} ({}: {} points, {} after down-sampling to {} mm, {} in the bounding box, {} observed)\n\
-             {}\n{}\n{}\n",
+            "{}\n{}\n{}\n{}\n",
+            self.counts_line(),
+            self.accuracy_line(),
+            self.completeness_line(),
+            self.overall_line(),
+        )
+    }
+
+    /// The summary's first line: the scan, the input's kind and the point counts.
+    pub fn counts_line(&self) -> String {
+        let c = &self.counts;
+        format!(
+            "DTU evaluation, scan {} ({}: {} points, {} after down-sampling to {} mm, {} in the bounding box, {} observed)",
             self.scan,
             self.mode,
             c.points,
             c.downsampled,
-            o.downsample_density,
+            self.options.downsample_density,
             c.in_bounding_box,
             c.observed,
-            self.accuracy_line(),
-            self.completeness_line(),
-            self.overall_line(),
         )
     }
 
@@ -177,53 +183,19 @@ fn mm(v: Option<f64>) -> String {
 /// that variable the test fails when the file is stale.
 #[cfg(all(test, feature = "ts"))]
 mod typescript {
-    use ts_rs::{Config, TS};
+    use sfmeval::ts_declarations::{Declarations, check_committed};
 
-    use super::{DTU_SCHEMA, DtuCounts, DtuReport, DtuReportOptions};
-
-    /// The package file, from this crate's folder.
-    const FILE: &str = "../sfmeval-wasm/js/dtu-report.d.ts";
-
-    fn decl<T: TS>(cfg: &Config) -> String {
-        let mut text = String::from("\n");
-        if let Some(docs) = T::docs() {
-            text.push_str(&docs);
-        }
-        text.push_str("export ");
-        text.push_str(&T::decl(cfg));
-        text.push('\n');
-        text
-    }
-
-    fn declarations() -> String {
-        // counts and the seed are JSON numbers, which `JSON.parse` reads as `number`
-        let cfg = Config::new().with_large_int("number");
-        let mut out = format!(
-            "// The `{DTU_SCHEMA}` report's types, generated from the Rust types of\n\
-             // crates/sfmeval-dtu (feature `ts`, ts-rs) by scripts/gen-report-types.sh: do not edit.\n"
-        );
-        out.push_str(&decl::<DtuReport>(&cfg));
-        out.push_str(&decl::<DtuReportOptions>(&cfg));
-        out.push_str(&decl::<DtuCounts>(&cfg));
-        out.lines().map(|l| format!("{}\n", l.trim_end())).collect()
-    }
+    use super::{DTU_SCHEMA, DtuReport};
 
     #[test]
     fn dtu_report_types_are_the_committed_ones() {
-        let text = declarations();
-        assert!(
-            text.contains(&format!("schema: \"{DTU_SCHEMA}\"")),
-            "{text}"
+        let text = Declarations::new().add::<DtuReport>().file_text(
+            DTU_SCHEMA,
+            "crates/sfmeval-dtu",
+            "DtuReport",
+            None,
         );
-        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join(FILE);
-        if std::env::var_os("SFMEVAL_WRITE_REPORT_TYPES").is_some() {
-            std::fs::write(&path, &text).expect("write dtu-report.d.ts");
-        }
-        let committed = std::fs::read_to_string(&path).unwrap_or_default();
-        assert!(
-            committed == text,
-            "{} is not what the DTU report types generate: run scripts/gen-report-types.sh",
-            path.display()
-        );
+        let file = "../sfmeval-wasm/js/dtu-report.d.ts";
+        check_committed(env!("CARGO_MANIFEST_DIR"), file, DTU_SCHEMA, &text);
     }
 }

@@ -5,6 +5,8 @@
 //! reconstruction too.
 
 use serde::Serialize;
+use sfmeval::dropped::{self, FilesSummary};
+use sfmeval::files::base_name;
 
 use crate::mlp::read_mlp;
 
@@ -33,6 +35,10 @@ pub struct Eth3dFiles {
     pub problems: Vec<String>,
     /// Names that are none of the above.
     pub ignored: Vec<String>,
+    /// The files recognised that the evaluation reads, in the order project, scans, reconstruction.
+    pub inputs: Vec<String>,
+    /// What a front end says of these files (worded by the core).
+    pub summary: FilesSummary,
 }
 
 impl Eth3dFiles {
@@ -40,21 +46,44 @@ impl Eth3dFiles {
     pub fn complete(&self) -> bool {
         self.missing.is_empty() && self.problems.is_empty()
     }
-}
 
-/// The base name of a path (`/` or `\` separated).
-fn base(path: &str) -> &str {
-    path.rsplit(['/', '\\']).next().unwrap_or(path)
+    /// Fills [`Self::inputs`] and [`Self::summary`] from the rest.
+    fn summarised(mut self) -> Self {
+        let scans: Vec<&str> = self.scans.iter().map(|s| s.file.as_str()).collect();
+        self.inputs = self
+            .project
+            .iter()
+            .cloned()
+            .chain(scans.iter().map(|s| s.to_string()))
+            .chain(self.reconstruction.iter().cloned())
+            .collect();
+        let found = [
+            dropped::named_files(&[("project", self.project.as_deref())]),
+            if scans.is_empty() {
+                String::new()
+            } else {
+                format!("scans: {}", scans.join(", "))
+            },
+            dropped::named_files(&[("reconstruction", self.reconstruction.as_deref())]),
+        ];
+        self.summary = dropped::summarise(&found, &self.problems, &self.missing, &self.ignored);
+        self
+    }
 }
 
 fn has_ext(name: &str, ext: &str) -> bool {
-    base(name).to_ascii_lowercase().ends_with(ext)
+    base_name(name).to_ascii_lowercase().ends_with(ext)
 }
 
 /// Sorts `names` into the scene's files: the one `.mlp` is the project; given its bytes
 /// (`project`), each scan it names is the dropped `.ply` of that base name, and the one `.ply`
 /// left is the reconstruction. Says what is missing and what does not fit together.
 pub fn recognise<S: AsRef<str>>(names: &[S], project: Option<&[u8]>) -> Eth3dFiles {
+    sort_names(names, project).summarised()
+}
+
+/// [`recognise`] without the summary.
+fn sort_names<S: AsRef<str>>(names: &[S], project: Option<&[u8]>) -> Eth3dFiles {
     let mut f = Eth3dFiles::default();
     let mut projects = Vec::new();
     let mut plys: Vec<String> = Vec::new();
@@ -100,11 +129,11 @@ pub fn recognise<S: AsRef<str>>(names: &[S], project: Option<&[u8]>) -> Eth3dFil
         }
     };
     for entry in &entries {
-        let want = base(&entry.filename);
+        let want = base_name(&entry.filename);
         let found: Vec<usize> = plys
             .iter()
             .enumerate()
-            .filter(|(_, p)| base(p) == want)
+            .filter(|(_, p)| base_name(p) == want)
             .map(|(k, _)| k)
             .collect();
         match found.as_slice() {
@@ -198,6 +227,21 @@ mod tests {
         );
         assert_eq!(f.reconstruction.as_deref(), Some("dense.ply"));
         assert_eq!(f.ignored, ["a.txt"]);
+        assert_eq!(
+            f.inputs,
+            [
+                "scan_alignment.mlp",
+                "scan1.ply",
+                "x/scan2.ply",
+                "dense.ply"
+            ]
+        );
+        assert_eq!(
+            f.summary.line,
+            "project: scan_alignment.mlp · scans: scan1.ply, x/scan2.ply · reconstruction: \
+             dense.ply · not used: a.txt"
+        );
+        assert_eq!(f.summary.status, "ready");
     }
 
     #[test]
@@ -206,6 +250,12 @@ mod tests {
         assert!(f.missing[0].contains("scan_alignment.mlp"), "{f:?}");
         let f = recognise(&["p.mlp", "scan1.ply"], None);
         assert!(f.missing[0].contains("contents of the project 'p.mlp'"));
+        assert_eq!(f.summary.status, "1 file missing: see above");
+        assert!(
+            f.summary
+                .line
+                .starts_with("project: p.mlp · still needed: ")
+        );
         let f = recognise(&["p.mlp", "scan1.ply", "dense.ply"], Some(MLP.as_bytes()));
         assert_eq!(f.missing.len(), 1);
         assert!(f.missing[0].contains("'scans/scan2.ply'"), "{f:?}");

@@ -6,6 +6,8 @@
 //! the reconstruction's trajectory and any other `.ply` the reconstruction.
 
 use serde::Serialize;
+use sfmeval::dropped::{self, FilesSummary};
+use sfmeval::files::base_name;
 
 /// What the Tanks and Temples evaluation makes of a set of file names.
 #[derive(Debug, Clone, PartialEq, Eq, Default, Serialize)]
@@ -32,6 +34,10 @@ pub struct TntFiles {
     pub problems: Vec<String>,
     /// Names that are none of the above.
     pub ignored: Vec<String>,
+    /// The files recognised that the evaluation reads, in the order listed above.
+    pub inputs: Vec<String>,
+    /// What a front end says of these files (worded by the core).
+    pub summary: FilesSummary,
 }
 
 impl TntFiles {
@@ -39,11 +45,30 @@ impl TntFiles {
     pub fn complete(&self) -> bool {
         self.missing.is_empty() && self.problems.is_empty()
     }
-}
 
-/// The base name of a path (`/` or `\` separated).
-fn base(path: &str) -> &str {
-    path.rsplit(['/', '\\']).next().unwrap_or(path)
+    /// Fills [`Self::inputs`] and [`Self::summary`] from the rest.
+    fn summarised(mut self) -> Self {
+        let named = [
+            ("ground truth", &self.ground_truth),
+            ("crop", &self.crop),
+            ("alignment", &self.alignment),
+            ("reference trajectory", &self.reference_trajectory),
+            ("mapping", &self.mapping),
+            ("trajectory", &self.trajectory),
+            ("reconstruction", &self.reconstruction),
+        ];
+        self.inputs = named.iter().filter_map(|(_, n)| (*n).clone()).collect();
+        let files: Vec<(&str, Option<&str>)> =
+            named.iter().map(|(k, n)| (*k, n.as_deref())).collect();
+        let found = [
+            self.scene
+                .as_ref()
+                .map_or_else(String::new, |s| format!("scene {s}")),
+            dropped::named_files(&files),
+        ];
+        self.summary = dropped::summarise(&found, &self.problems, &self.missing, &self.ignored);
+        self
+    }
 }
 
 /// The scene files' suffixes that name the scene, and the slot each fills.
@@ -58,7 +83,7 @@ pub fn recognise<S: AsRef<str>>(names: &[S]) -> TntFiles {
     let mut scenes: Vec<(String, &str)> = Vec::new();
     for &n in &names {
         for suffix in NAMING {
-            if let Some(stem) = base(n).strip_suffix(suffix).filter(|s| !s.is_empty()) {
+            if let Some(stem) = base_name(n).strip_suffix(suffix).filter(|s| !s.is_empty()) {
                 scenes.push((stem.to_string(), n));
             }
         }
@@ -75,7 +100,7 @@ pub fn recognise<S: AsRef<str>>(names: &[S]) -> TntFiles {
     let mut logs = Vec::new();
     let mut plys = Vec::new();
     for &n in &names {
-        let b = base(n);
+        let b = base_name(n);
         let slot = f.scene.as_deref().and_then(|s| {
             if b == format!("{s}.ply") {
                 Some(&mut f.ground_truth)
@@ -150,7 +175,7 @@ pub fn recognise<S: AsRef<str>>(names: &[S]) -> TntFiles {
         f.reconstruction.is_some() || n_plys > 1,
         "the reconstruction: a PLY point cloud".into(),
     );
-    f
+    f.summarised()
 }
 
 #[cfg(test)]
@@ -175,6 +200,26 @@ mod tests {
         assert_eq!(f.trajectory.as_deref(), Some("traj.log"));
         assert_eq!(f.mapping, None);
         assert_eq!(f.ignored, ["readme.md"]);
+        assert_eq!(
+            f.inputs,
+            [
+                "Barn/Barn.ply",
+                "Barn.json",
+                "Barn_trans.txt",
+                "Barn_COLMAP_SfM.log",
+                "traj.log",
+                "dense.ply"
+            ]
+        );
+        assert!(
+            f.summary
+                .line
+                .starts_with("scene Barn · ground truth: Barn/Barn.ply, crop: Barn.json"),
+            "{}",
+            f.summary.line
+        );
+        assert!(f.summary.line.ends_with(" · not used: readme.md"));
+        assert_eq!(f.summary.status, "ready");
     }
 
     #[test]
@@ -183,6 +228,12 @@ mod tests {
         assert!(f.missing.iter().any(|m| m.contains("Barn.json")), "{f:?}");
         assert!(f.missing.iter().any(|m| m.contains("Barn_COLMAP_SfM.log")));
         assert!(f.missing.iter().any(|m| m.contains("trajectory: a .log")));
+        assert_eq!(f.summary.status, "3 files missing: see above");
+        assert!(
+            f.summary
+                .line
+                .contains(" · still needed: the crop, Barn.json; ")
+        );
         let f = recognise(&["Barn_trans.txt", "Truck_COLMAP_SfM.log"]);
         assert!(f.problems[0].contains("two scenes"), "{f:?}");
         let f = recognise(&["a.ply", "b.ply"]);

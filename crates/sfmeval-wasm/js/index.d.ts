@@ -317,6 +317,17 @@ export function errorColors(values: ArrayLike<number>, clip: number): Uint8Array
 /** Whether a file can be part of an SfM model or a cloud, by its extension (the core's rule). */
 export function isModelFile(path: string): boolean;
 
+/** What a front end says of a benchmark's dropped files, worded by the core. */
+export interface FilesSummary {
+  /** One line: what each file is, what does not fit together, what is still needed, what is not used (joined by ` · `). */
+  line: string;
+  /** `ready`, `N files missing: see above` or `these files do not fit together: see above`. */
+  status: string;
+  /** Whether the evaluation can run. */
+  complete: boolean;
+  /** Whether some files do not fit together (show the line as an error). */
+  problem: boolean;
+}
 /** What the DTU evaluation makes of a set of file names (`dtuFiles`). */
 export interface DtuFiles {
   /** The scan number the ground-truth files' names give, null when none or when they disagree. */
@@ -335,6 +346,10 @@ export interface DtuFiles {
   problems: string[];
   /** Names that are none of the above. */
   ignored: string[];
+  /** The files recognised that the evaluation reads, in the order of the fields above: the names to pass its evaluate function. */
+  inputs: string[];
+  /** What to show of these files. */
+  summary: FilesSummary;
 }
 /** Sorts file names into the DTU scan's files. */
 export function dtuFiles(names: string[]): DtuFiles;
@@ -359,6 +374,8 @@ export interface DtuResult {
   readonly report: DtuReport;
   /** The summary `sfmeval dtu` prints. */
   readonly summary: string;
+  /** Its first line: the scan, the input's kind and the point counts. */
+  readonly countsLine: string;
   /** Its mean accuracy, mean completeness and overall lines. */
   readonly resultLines: string[];
   /** The error clouds' names, `[vis_NNN_d2s.ply, vis_NNN_s2d.ply]`. */
@@ -394,6 +411,10 @@ export interface Eth3dFiles {
   problems: string[];
   /** Names that are none of the above. */
   ignored: string[];
+  /** The files recognised that the evaluation reads, in the order of the fields above: the names to pass its evaluate function. */
+  inputs: string[];
+  /** What to show of these files. */
+  summary: FilesSummary;
 }
 /** Sorts file names into an ETH3D scene's files; `project` the project's bytes once known. */
 export function eth3dFiles(names: string[], project?: Uint8Array | ArrayBuffer | string): Eth3dFiles;
@@ -460,6 +481,10 @@ export interface TntFiles {
   problems: string[];
   /** Names that are none of the above. */
   ignored: string[];
+  /** The files recognised that the evaluation reads, in the order of the fields above: the names to pass its evaluate function. */
+  inputs: string[];
+  /** What to show of these files. */
+  summary: FilesSummary;
 }
 /** Sorts file names into a Tanks and Temples scene's files. */
 export function tntFiles(names: string[]): TntFiles;

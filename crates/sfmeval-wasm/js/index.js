@@ -287,7 +287,7 @@ export function isModelFile(path) {
 
 /**
  * What the DTU evaluation makes of these file names: `{scan, stl, obs_mask, plane,
- * reconstruction, missing, problems, ignored}` (`stl{NNN}_total.ply`, `ObsMask{N}_10.mat`,
+ * reconstruction, missing, problems, ignored, inputs, summary: {line, status, complete, problem}}` (`stl{NNN}_total.ply`, `ObsMask{N}_10.mat`,
  * `Plane{N}.mat`, any other `.ply` the reconstruction; `missing` and `problems` are sentences).
  */
 export function dtuFiles(names) {
@@ -308,6 +308,7 @@ export function evaluateDtu(files, options) {
     reportJson: e.reportJson,
     get report() { return JSON.parse(this.reportJson); },
     summary: e.summary,
+    countsLine: e.countsLine,
     resultLines: e.resultLines,
     visNames: e.visNames(),
     d2sPly: () => e.d2sPly(),
@@ -318,7 +319,7 @@ export function evaluateDtu(files, options) {
 
 /**
  * What the ETH3D evaluation makes of these file names: `{project, scans: [{filename, file}],
- * reconstruction, missing, problems, ignored}` (the one `.mlp` the project; given its bytes as
+ * reconstruction, missing, problems, ignored, inputs, summary: {line, status, complete, problem}}` (the one `.mlp` the project; given its bytes as
  * `project`, the scans it names matched by file name and the one other `.ply` the
  * reconstruction; `missing` and `problems` are sentences).
  */
@@ -354,7 +355,7 @@ export function evaluateEth3d(files, options) {
 /**
  * What the Tanks and Temples evaluation makes of these file names: `{scene, ground_truth, crop,
  * alignment, reference_trajectory, mapping, trajectory, reconstruction, missing, problems,
- * ignored}` (`SCENE.ply`, `SCENE.json`, `SCENE_trans.txt`, `SCENE_COLMAP_SfM.log`,
+ * ignored, inputs, summary}` (`SCENE.ply`, `SCENE.json`, `SCENE_trans.txt`, `SCENE_COLMAP_SfM.log`,
  * `SCENE_mapping_reference.txt`; any other `.log` the reconstruction's trajectory, any other
  * `.ply` the reconstruction; `missing` and `problems` are sentences).
  */

@@ -33,7 +33,7 @@ struct DtuJsOptions {
 }
 
 /// Which of `names` (a JSON array of file names or paths) are the DTU scan's files: `{scan,
-/// stl, obs_mask, plane, reconstruction, missing: [sentence], problems: [sentence], ignored}`
+/// stl, obs_mask, plane, reconstruction, missing: [sentence], problems: [sentence], ignored, inputs, summary}`
 /// (`sfmeval_dtu::recognise`: `stl{NNN}_total.ply`, `ObsMask{N}_10.mat`, `Plane{N}.mat`, any
 /// other `.ply` the reconstruction).
 #[wasm_bindgen(js_name = dtuFiles)]
@@ -65,6 +65,12 @@ impl DtuEvaluation {
     #[wasm_bindgen(getter)]
     pub fn summary(&self) -> String {
         self.report.summary()
+    }
+
+    /// The summary's first line: the scan, the input's kind and the point counts.
+    #[wasm_bindgen(getter, js_name = countsLine)]
+    pub fn counts_line(&self) -> String {
+        self.report.counts_line()
     }
 
     /// The summary's lines for mean accuracy, mean completeness and overall, in that order.

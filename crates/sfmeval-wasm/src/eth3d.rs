@@ -29,7 +29,7 @@ struct Eth3dJsOptions {
 }
 
 /// Which of `names` (a JSON array of file names or paths) are the scene's files: `{project,
-/// scans: [{filename, file}], reconstruction, missing, problems, ignored}`
+/// scans: [{filename, file}], reconstruction, missing, problems, ignored, inputs, summary: {line, status, complete, problem}}`
 /// (`sfmeval_eth3d::recognise`); `project` the project's bytes once it is known (the scans are
 /// matched to the names it gives them).
 #[wasm_bindgen(js_name = eth3dFiles)]

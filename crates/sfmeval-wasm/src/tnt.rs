@@ -51,7 +51,7 @@ struct TntJsOptions {
 
 /// Which of `names` (a JSON array of file names or paths) are the scene's files: `{scene,
 /// ground_truth, crop, alignment, reference_trajectory, mapping, trajectory, reconstruction,
-/// missing, problems, ignored}` (`sfmeval_tnt::recognise`).
+/// missing, problems, ignored, inputs, summary}` (`sfmeval_tnt::recognise`).
 #[wasm_bindgen(js_name = tntFiles)]
 pub fn tnt_files(names_json: &str) -> Result<JsValue, JsError> {
     let names: Vec<String> =

@@ -41,6 +41,12 @@ pub fn file_name(path: &str) -> &str {
     trimmed.rfind('/').map_or(trimmed, |i| &trimmed[i + 1..])
 }
 
+/// The base name of a dropped file's name or path, `/` or `\\` separated (a browser's
+/// `webkitRelativePath`, a Windows path typed into a script).
+pub fn base_name(path: &str) -> &str {
+    path.rsplit(['/', '\\']).next().unwrap_or(path)
+}
+
 impl FileSource for BTreeMap<String, Vec<u8>> {
     fn read(&self, path: &str) -> Result<Option<Vec<u8>>> {
         Ok(self.get(path).cloned())

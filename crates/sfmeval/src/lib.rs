@@ -43,6 +43,7 @@ pub mod colormap;
 pub mod crop;
 pub mod dataset;
 pub mod distance;
+pub mod dropped;
 mod error;
 pub mod evaluate;
 pub mod export;
