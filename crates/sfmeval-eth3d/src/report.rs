@@ -223,54 +223,19 @@ pub struct Eth3dTable {
 /// that variable the test fails when the file is stale.
 #[cfg(all(test, feature = "ts"))]
 mod typescript {
-    use ts_rs::{Config, TS};
+    use sfmeval::ts_declarations::{Declarations, check_committed};
 
-    use super::{ETH3D_SCHEMA, Eth3dReport, Eth3dReportOptions, Eth3dReportScan, Eth3dTolerance};
-
-    /// The package file, from this crate's folder.
-    const FILE: &str = "../sfmeval-wasm/js/eth3d-report.d.ts";
-
-    fn decl<T: TS>(cfg: &Config) -> String {
-        let mut text = String::from("\n");
-        if let Some(docs) = T::docs() {
-            text.push_str(&docs);
-        }
-        text.push_str("export ");
-        text.push_str(&T::decl(cfg));
-        text.push('\n');
-        text
-    }
-
-    fn declarations() -> String {
-        // counts are JSON numbers, which `JSON.parse` reads as `number`
-        let cfg = Config::new().with_large_int("number");
-        let mut out = format!(
-            "// The `{ETH3D_SCHEMA}` report's types, generated from the Rust types of\n\
-             // crates/sfmeval-eth3d (feature `ts`, ts-rs) by scripts/gen-report-types.sh: do not edit.\n"
-        );
-        out.push_str(&decl::<Eth3dReport>(&cfg));
-        out.push_str(&decl::<Eth3dReportOptions>(&cfg));
-        out.push_str(&decl::<Eth3dReportScan>(&cfg));
-        out.push_str(&decl::<Eth3dTolerance>(&cfg));
-        out.lines().map(|l| format!("{}\n", l.trim_end())).collect()
-    }
+    use super::{ETH3D_SCHEMA, Eth3dReport};
 
     #[test]
     fn eth3d_report_types_are_the_committed_ones() {
-        let text = declarations();
-        assert!(
-            text.contains(&format!("schema: \"{ETH3D_SCHEMA}\"")),
-            "{text}"
+        let text = Declarations::new().add::<Eth3dReport>().file_text(
+            ETH3D_SCHEMA,
+            "crates/sfmeval-eth3d",
+            "Eth3dReport",
+            None,
         );
-        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join(FILE);
-        if std::env::var_os("SFMEVAL_WRITE_REPORT_TYPES").is_some() {
-            std::fs::write(&path, &text).expect("write eth3d-report.d.ts");
-        }
-        let committed = std::fs::read_to_string(&path).unwrap_or_default();
-        assert!(
-            committed == text,
-            "{} is not what the ETH3D report types generate: run scripts/gen-report-types.sh",
-            path.display()
-        );
+        let file = "../sfmeval-wasm/js/eth3d-report.d.ts";
+        check_committed(env!("CARGO_MANIFEST_DIR"), file, ETH3D_SCHEMA, &text);
     }
 }

@@ -358,102 +358,23 @@ impl TntReport {
 /// (`SFMEVAL_WRITE_REPORT_TYPES=1`); without that variable the test fails when it is stale.
 #[cfg(all(test, feature = "ts"))]
 mod typescript {
-    use std::collections::{BTreeMap, BTreeSet};
-
     use sfmeval::note::Note;
     use sfmeval::report::Tool;
-    use ts_rs::{Config, TS, TypeVisitor};
+    use sfmeval::ts_declarations::{Declarations, check_committed};
 
     use super::TntReport;
 
-    /// The package file, from this crate's folder.
-    const FILE: &str = "../sfmeval-wasm/js/tnt-report.d.ts";
-
-    /// Every declarable type reachable from the visited ones, by name.
-    struct Names {
-        by_name: BTreeMap<String, String>,
-        cfg: Config,
-    }
-
-    impl TypeVisitor for Names {
-        fn visit<T: TS + 'static + ?Sized>(&mut self) {
-            if T::output_path().is_none() {
-                return;
-            }
-            let name = T::ident(&self.cfg);
-            if self.by_name.contains_key(&name) {
-                return;
-            }
-            let mut text = String::from("\n");
-            if let Some(docs) = T::docs() {
-                text.push_str(&docs);
-            }
-            text.push_str("export ");
-            text.push_str(&T::decl(&self.cfg));
-            text.push('\n');
-            self.by_name.insert(name, text);
-            T::visit_dependencies(self);
-        }
-    }
-
-    fn declarations() -> String {
-        let cfg = || Config::new().with_large_int("number");
-        let mut core = Names {
-            cfg: cfg(),
-            by_name: BTreeMap::new(),
-        };
-        core.visit::<Note>();
-        core.visit::<Tool>();
-        let mut tnt = Names {
-            cfg: cfg(),
-            by_name: BTreeMap::new(),
-        };
-        tnt.visit::<TntReport>();
-        let shared: BTreeSet<String> = tnt
-            .by_name
-            .keys()
-            .filter(|n| core.by_name.contains_key(*n))
-            .cloned()
-            .collect();
-        let mut out = String::from(
-            "// The `sfmeval.tanksandtemples/2` report's types, generated from the Rust types of\n\
-             // crates/sfmeval-tnt (feature `ts`, ts-rs) by scripts/gen-report-types.sh: do not edit.\n",
-        );
-        if !shared.is_empty() {
-            let list: Vec<&str> = shared.iter().map(|s| s.as_str()).collect();
-            out.push_str(&format!(
-                "import type {{ {} }} from './report.js';\n",
-                list.join(", ")
-            ));
-        }
-        let first = tnt.by_name.remove("TntReport");
-        for text in first.into_iter().chain(
-            tnt.by_name
-                .iter()
-                .filter(|(n, _)| !shared.contains(n.as_str()))
-                .map(|(_, t)| t.clone()),
-        ) {
-            out.push_str(&text);
-        }
-        out.lines().map(|l| format!("{}\n", l.trim_end())).collect()
-    }
-
     #[test]
     fn tnt_report_types_are_the_committed_ones() {
-        let text = declarations();
-        assert!(
-            text.contains("schema: \"sfmeval.tanksandtemples/2\""),
-            "{text}"
+        let schema = "sfmeval.tanksandtemples/2";
+        let shared = Declarations::new().add::<Note>().add::<Tool>();
+        let text = Declarations::new().add::<TntReport>().file_text(
+            schema,
+            "crates/sfmeval-tnt",
+            "TntReport",
+            Some(&shared),
         );
-        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join(FILE);
-        if std::env::var_os("SFMEVAL_WRITE_REPORT_TYPES").is_some() {
-            std::fs::write(&path, &text).expect("write tnt-report.d.ts");
-        }
-        let committed = std::fs::read_to_string(&path).unwrap_or_default();
-        assert!(
-            committed == text,
-            "{} is not what the Tanks and Temples report types generate: run scripts/gen-report-types.sh",
-            path.display()
-        );
+        let file = "../sfmeval-wasm/js/tnt-report.d.ts";
+        check_committed(env!("CARGO_MANIFEST_DIR"), file, schema, &text);
     }
 }

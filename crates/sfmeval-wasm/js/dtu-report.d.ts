@@ -43,31 +43,6 @@ overall: number | null,
 counts: DtuCounts, };
 
 /**
- * The options of a report.
- */
-export type DtuReportOptions = {
-/**
- * Down-sampling density (mm).
- */
-downsample_density: number,
-/**
- * Patch size (mm).
- */
-patch_size: number,
-/**
- * Distance cap (mm).
- */
-max_dist: number,
-/**
- * Visualisation threshold (mm).
- */
-visualize_threshold: number,
-/**
- * The shuffle's seed; `null` when the input's order was kept.
- */
-shuffle_seed: number | null, };
-
-/**
  * The counts of a report.
  */
 export type DtuCounts = {
@@ -103,3 +78,28 @@ stl_above_plane: number,
  * Completeness distances below `max_dist` (averaged).
  */
 completeness_below_max_dist: number, };
+
+/**
+ * The options of a report.
+ */
+export type DtuReportOptions = {
+/**
+ * Down-sampling density (mm).
+ */
+downsample_density: number,
+/**
+ * Patch size (mm).
+ */
+patch_size: number,
+/**
+ * Distance cap (mm).
+ */
+max_dist: number,
+/**
+ * Visualisation threshold (mm).
+ */
+visualize_threshold: number,
+/**
+ * The shuffle's seed; `null` when the input's order was kept.
+ */
+shuffle_seed: number | null, };

@@ -65,6 +65,8 @@ mod spatial_order;
 pub mod stats;
 mod track_error;
 pub mod transform;
+#[cfg(feature = "ts")]
+pub mod ts_declarations;
 pub mod visibility;
 
 pub use error::{AlignInputProblem, Error, Result};

@@ -393,82 +393,18 @@ impl Report {
 /// that variable the test fails when the file is stale.
 #[cfg(all(test, feature = "ts"))]
 mod typescript {
-    use std::collections::BTreeMap;
-
-    use ts_rs::{Config, TS, TypeVisitor};
-
     use super::{REPORT_SCHEMA, Report};
-
-    /// The package file, from this crate's folder.
-    const FILE: &str = "../sfmeval-wasm/js/report.d.ts";
-
-    /// Every declarable type reachable from the visited ones, each once, by name: the file lists
-    /// them `Report` first, then by name, so that its text depends on the types alone (ts-rs
-    /// visits dependencies in an order that changes with the build, e.g. the checkout's path).
-    struct Declarations<'a> {
-        cfg: &'a Config,
-        /// The declaration text (doc comment, `export type ...`) by name.
-        by_name: BTreeMap<String, (String, String)>,
-    }
-
-    impl TypeVisitor for Declarations<'_> {
-        fn visit<T: TS + 'static + ?Sized>(&mut self) {
-            // primitives and containers have no declaration of their own
-            if T::output_path().is_none() {
-                return;
-            }
-            // one declaration a name (serde_json's `Value` and `Map` both declare `JsonValue`)
-            let decl = T::decl(self.cfg);
-            let name = T::ident(self.cfg);
-            if let Some((earlier, _)) = self.by_name.get(&name) {
-                assert_eq!(*earlier, decl, "two report types named {name}");
-                return;
-            }
-            let mut text = String::from("\n");
-            if let Some(docs) = T::docs() {
-                text.push_str(&docs);
-            }
-            text.push_str("export ");
-            text.push_str(&decl);
-            text.push('\n');
-            self.by_name.insert(name, (decl, text));
-            T::visit_dependencies(self);
-        }
-    }
-
-    fn declarations() -> String {
-        // u64 counts are JSON numbers, which `JSON.parse` reads as `number` (not `bigint`)
-        let cfg = Config::new().with_large_int("number");
-        let mut d = Declarations {
-            cfg: &cfg,
-            by_name: BTreeMap::new(),
-        };
-        d.visit::<Report>();
-        let mut out = format!(
-            "// The `{REPORT_SCHEMA}` report's types, generated from the Rust types of\n\
-             // crates/sfmeval (feature `ts`, ts-rs) by scripts/gen-report-types.sh: do not edit.\n"
-        );
-        let report = d.by_name.remove("Report");
-        for (_, text) in report.into_iter().chain(d.by_name.into_values()) {
-            out.push_str(&text);
-        }
-        // ts-rs leaves a space at the end of each field's line
-        out.lines().map(|l| format!("{}\n", l.trim_end())).collect()
-    }
+    use crate::ts_declarations::{Declarations, check_committed};
 
     #[test]
     fn report_types_are_the_committed_ones() {
-        let text = declarations();
-        assert!(text.contains(&format!("schema: \"{REPORT_SCHEMA}\"")));
-        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join(FILE);
-        if std::env::var_os("SFMEVAL_WRITE_REPORT_TYPES").is_some() {
-            std::fs::write(&path, &text).expect("write report.d.ts");
-        }
-        let committed = std::fs::read_to_string(&path).unwrap_or_default();
-        assert!(
-            committed == text,
-            "{} is not what the report types generate: run scripts/gen-report-types.sh",
-            path.display()
+        let text = Declarations::new().add::<Report>().file_text(
+            REPORT_SCHEMA,
+            "crates/sfmeval",
+            "Report",
+            None,
         );
+        let file = "../sfmeval-wasm/js/report.d.ts";
+        check_committed(env!("CARGO_MANIFEST_DIR"), file, REPORT_SCHEMA, &text);
     }
 }

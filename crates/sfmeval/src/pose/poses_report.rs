@@ -160,103 +160,19 @@ pub fn evaluate_protocol(
 /// (`SFMEVAL_WRITE_REPORT_TYPES=1`); without that variable the test fails when it is stale.
 #[cfg(all(test, feature = "ts"))]
 mod typescript {
-    use std::collections::{BTreeMap, BTreeSet};
-
-    use ts_rs::{Config, TS, TypeVisitor};
-
     use super::{POSES_SCHEMA, PosesReport};
     use crate::note::Note;
     use crate::pose::SummaryRow;
-
-    /// The package file, from this crate's folder.
-    const FILE: &str = "../sfmeval-wasm/js/poses-report.d.ts";
-
-    /// Every declarable type reachable from the visited ones, by name (as the report's).
-    struct Names {
-        by_name: BTreeMap<String, String>,
-        cfg: Config,
-    }
-
-    impl TypeVisitor for Names {
-        fn visit<T: TS + 'static + ?Sized>(&mut self) {
-            if T::output_path().is_none() {
-                return;
-            }
-            let name = T::ident(&self.cfg);
-            if self.by_name.contains_key(&name) {
-                return;
-            }
-            let mut text = String::from("\n");
-            if let Some(docs) = T::docs() {
-                text.push_str(&docs);
-            }
-            text.push_str("export ");
-            text.push_str(&T::decl(&self.cfg));
-            text.push('\n');
-            self.by_name.insert(name, text);
-            T::visit_dependencies(self);
-        }
-    }
-
-    fn declarations() -> String {
-        let cfg = || Config::new().with_large_int("number");
-        let mut report = Names {
-            cfg: cfg(),
-            by_name: BTreeMap::new(),
-        };
-        report.visit::<Note>();
-        let mut poses = Names {
-            cfg: cfg(),
-            by_name: BTreeMap::new(),
-        };
-        poses.visit::<PosesReport>();
-        poses.visit::<SummaryRow>();
-        let shared: BTreeSet<String> = poses
-            .by_name
-            .keys()
-            .filter(|n| report.by_name.contains_key(*n))
-            .cloned()
-            .collect();
-        let mut out = format!(
-            "// The `{POSES_SCHEMA}` report's types, generated from the Rust types of\n\
-             // crates/sfmeval (feature `ts`, ts-rs) by scripts/gen-report-types.sh: do not edit.\n"
-        );
-        if !shared.is_empty() {
-            let list: Vec<&str> = shared.iter().map(|s| s.as_str()).collect();
-            out.push_str(&format!(
-                "import type {{ {} }} from './report.js';\n",
-                list.join(", ")
-            ));
-        }
-        let first = poses.by_name.remove("PosesReport");
-        for text in first.into_iter().chain(
-            poses
-                .by_name
-                .iter()
-                .filter(|(n, _)| !shared.contains(n.as_str()))
-                .map(|(_, t)| t.clone()),
-        ) {
-            out.push_str(&text);
-        }
-        out.lines().map(|l| format!("{}\n", l.trim_end())).collect()
-    }
+    use crate::ts_declarations::{Declarations, check_committed};
 
     #[test]
     fn poses_report_types_are_the_committed_ones() {
-        let text = declarations();
-        assert!(
-            text.contains(&format!("schema: \"{POSES_SCHEMA}\"")),
-            "{text}"
-        );
-        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join(FILE);
-        if std::env::var_os("SFMEVAL_WRITE_REPORT_TYPES").is_some() {
-            std::fs::write(&path, &text).expect("write poses-report.d.ts");
-        }
-        let committed = std::fs::read_to_string(&path).unwrap_or_default();
-        assert!(
-            committed == text,
-            "{} is not what the poses report types generate: run scripts/gen-report-types.sh",
-            path.display()
-        );
+        let shared = Declarations::new().add::<Note>();
+        let text = Declarations::new()
+            .add::<PosesReport>()
+            .add::<SummaryRow>()
+            .file_text(POSES_SCHEMA, "crates/sfmeval", "PosesReport", Some(&shared));
+        let file = "../sfmeval-wasm/js/poses-report.d.ts";
+        check_committed(env!("CARGO_MANIFEST_DIR"), file, POSES_SCHEMA, &text);
     }
 }
