@@ -8,6 +8,7 @@
 pub mod files;
 pub mod mat;
 mod protocol;
+mod radius_filter;
 mod report;
 pub mod scan;
 pub mod vis;
@@ -15,8 +16,9 @@ pub mod vis;
 pub use files::{DtuFiles, read_reconstruction, recognise};
 pub use protocol::{
     DOWNSAMPLE_DENSITY, DtuEvaluation, DtuInput, DtuOptions, MAX_DIST, PATCH_SIZE, Shuffle,
-    VISUALIZE_THRESHOLD, evaluate, pairwise_sum, radius_filter, sample_mesh, shuffle,
+    VISUALIZE_THRESHOLD, evaluate, pairwise_sum, sample_mesh, shuffle,
 };
+pub use radius_filter::radius_filter;
 pub use report::{DTU_SCHEMA, DtuCounts, DtuReport, DtuReportOptions};
 pub use scan::{DtuScan, NamedBytes, ObsMask};
 

@@ -27,6 +27,7 @@ use sfmeval::geometry::Point3;
 use sfmeval::progress::{NoProgress, Progress, Stage};
 use sfmeval::{Error, Result, parallel};
 
+use crate::radius_filter::radius_filter;
 use crate::scan::DtuScan;
 
 /// The evaluator's defaults.
@@ -260,94 +261,6 @@ pub fn shuffle(points: &mut [Point3], order: Shuffle) {
     }
 }
 
-/// The port's down-sampling: visiting `points` in order, a point is kept when no point kept
-/// before it lies within `radius` (`d² ≤ r²`, scikit-learn's radius test); returns the mask of
-/// kept points. Kept points are hashed into cells of twice the radius, so a query reads at most
-/// eight cells' kept points.
-pub fn radius_filter(points: &[Point3], radius: f64) -> Vec<bool> {
-    let r2 = radius * radius;
-    let cell = 2.0 * radius;
-    let mut heads: std::collections::HashMap<u64, u32, CellHash> =
-        std::collections::HashMap::with_hasher(CellHash);
-    // next[i]: the kept point before i in i's cell (u32::MAX ends the list).
-    let mut next = vec![u32::MAX; points.len()];
-    let mut kept = vec![false; points.len()];
-    let coord = |v: f64| (v / cell).floor() as i64;
-    for (i, &p) in points.iter().enumerate() {
-        let lo = [
-            coord(p[0] - radius),
-            coord(p[1] - radius),
-            coord(p[2] - radius),
-        ];
-        let hi = [
-            coord(p[0] + radius),
-            coord(p[1] + radius),
-            coord(p[2] + radius),
-        ];
-        let mut near = false;
-        'cells: for x in lo[0]..=hi[0].min(lo[0] + 2) {
-            for y in lo[1]..=hi[1].min(lo[1] + 2) {
-                for z in lo[2]..=hi[2].min(lo[2] + 2) {
-                    let Some(&head) = heads.get(&cell_key(x, y, z)) else {
-                        continue;
-                    };
-                    let mut k = head;
-                    while k != u32::MAX {
-                        if sfmeval::distance::distance2(p, points[k as usize]) <= r2 {
-                            near = true;
-                            break 'cells;
-                        }
-                        k = next[k as usize];
-                    }
-                }
-            }
-        }
-        if !near {
-            kept[i] = true;
-            let own = cell_key(coord(p[0]), coord(p[1]), coord(p[2]));
-            let slot = heads.entry(own).or_insert(u32::MAX);
-            next[i] = *slot;
-            *slot = i as u32;
-        }
-    }
-    kept
-}
-
-/// A cell's key: 21 bits of each coordinate. Far cells can share a key; they only add
-/// candidates, each tested by its distance.
-fn cell_key(x: i64, y: i64, z: i64) -> u64 {
-    let m = (1u64 << 21) - 1;
-    (x as u64 & m) | ((y as u64 & m) << 21) | ((z as u64 & m) << 42)
-}
-
-#[derive(Clone, Copy, Default)]
-struct CellHash;
-
-impl std::hash::BuildHasher for CellHash {
-    type Hasher = CellHasher;
-    fn build_hasher(&self) -> CellHasher {
-        CellHasher(0)
-    }
-}
-
-struct CellHasher(u64);
-
-impl std::hash::Hasher for CellHasher {
-    fn finish(&self) -> u64 {
-        self.0
-    }
-    fn write(&mut self, bytes: &[u8]) {
-        for &b in bytes {
-            self.0 = (self.0.rotate_left(8) ^ u64::from(b)).wrapping_mul(0x9E37_79B9_7F4A_7C15);
-        }
-    }
-    fn write_u64(&mut self, k: u64) {
-        // A multiplicative hash with the high bits folded down (hashbrown reads both ends).
-        let h = (k ^ (k >> 29)).wrapping_mul(0x9E37_79B9_7F4A_7C15);
-        self.0 = h ^ (h >> 32);
-    }
-}
-
 /// numpy's pairwise sum (blocks of 8 partial sums up to 128 values, halves above), so means
 /// agree with `ndarray.mean` to the last bits in most cases.
 pub fn pairwise_sum(a: &[f64]) -> f64 {
@@ -576,42 +489,6 @@ impl Default for NearStart {
 #[allow(clippy::unwrap_used)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn radius_filter_is_the_greedy_rule() {
-        // Brute force on a random cloud: kept iff no earlier kept point within r.
-        let mut rng = ChaCha8Rng::seed_from_u64(7);
-        let pts: Vec<Point3> = (0..3000)
-            .map(|_| {
-                [
-                    rng.random_range(-2.0..2.0),
-                    rng.random_range(-2.0..2.0),
-                    rng.random_range(-0.5..0.5),
-                ]
-            })
-            .collect();
-        // Copies 2²¹ cells away share cell keys with the originals: only more candidates.
-        let mut pts = pts;
-        let far: Vec<Point3> = pts[..500]
-            .iter()
-            .map(|p| {
-                [
-                    p[0] + 0.4 * f64::from(1u32 << 21),
-                    p[1],
-                    p[2] - 0.4 * f64::from(1u32 << 21),
-                ]
-            })
-            .collect();
-        pts.extend(far);
-        let kept = radius_filter(&pts, 0.2);
-        let mut brute = vec![false; pts.len()];
-        for i in 0..pts.len() {
-            brute[i] =
-                (0..i).all(|j| !brute[j] || sfmeval::distance::distance2(pts[i], pts[j]) > 0.04);
-        }
-        assert_eq!(kept, brute);
-        assert!(kept.iter().filter(|&&k| k).count() > 100);
-    }
 
     #[test]
     fn triangle_count_matches_the_samples() {
