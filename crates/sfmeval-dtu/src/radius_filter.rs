@@ -176,7 +176,6 @@ fn filter_in_tasks(points: &[Point3], radius: f64, task_points: usize) -> Vec<bo
     let mut kept_bits = vec![0u64; n.div_ceil(64)];
     let mut head = vec![u32::MAX; run_keys.len()];
     let mut next = vec![u32::MAX; n];
-    let mut kept = vec![false; n];
     for i in 0..n {
         let at = record[i];
         let own = flat[at] as usize;
@@ -201,13 +200,14 @@ fn filter_in_tasks(points: &[Point3], radius: f64, task_points: usize) -> Vec<bo
                 })
         };
         if !near {
-            kept[i] = true;
             kept_bits[i / 64] |= 1 << (i % 64);
             next[i] = head[own];
             head[own] = i as u32;
         }
     }
-    kept
+    (0..n)
+        .map(|i| kept_bits[i / 64] >> (i % 64) & 1 == 1)
+        .collect()
 }
 
 /// The most earlier neighbours listed for a point: one with more is decided by its cells' kept
