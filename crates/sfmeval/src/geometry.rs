@@ -259,16 +259,6 @@ pub(crate) fn check_finite(
     what: &'static str,
     points: &[Point3],
 ) -> Result<()> {
-    // One parallel pass for the common case, every coordinate finite and in range (`abs() <=`
-    // fails for NaN and ±∞ as well); the passes that name the first bad point only otherwise.
-    let fine = crate::parallel::map_ranges(points.len(), |range| {
-        points[range].iter().fold(true, |ok, p| {
-            ok & p.iter().all(|v| v.abs() <= MAX_COORDINATE)
-        })
-    });
-    if fine.into_iter().all(|ok| ok) {
-        return Ok(());
-    }
     check_finite_with(format, what, points.len(), |i| points[i])
 }
 

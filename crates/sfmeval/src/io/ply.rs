@@ -19,7 +19,7 @@
 //! (any list types); polygons are fan-triangulated. Every other element and property is skipped.
 
 use crate::error::{Error, Result};
-use crate::geometry::Positions;
+use crate::geometry::{Point3, Positions};
 
 pub(super) const FMT: &str = "PLY";
 
@@ -402,7 +402,11 @@ pub(super) fn empty_data(header: &Header) -> Result<(PlyData, VertexLayout)> {
 /// The checks of a file read whole: finite vertices, face indices in range.
 pub(super) fn check_data(out: PlyData) -> Result<PlyData> {
     match &out.vertices {
-        Positions::F64(v) => crate::geometry::check_finite(FMT, "vertex", v)?,
+        // One parallel pass for the common case, every coordinate finite and in range
+        // (`abs() <=` fails for NaN and ±∞ as well); the passes that name the first bad point
+        // only otherwise.
+        Positions::F64(v) if !all_in_range(v) => crate::geometry::check_finite(FMT, "vertex", v)?,
+        Positions::F64(_) => {}
         Positions::F32(v) => crate::geometry::check_finite_f32(FMT, "vertex", v)?,
     }
     let n = out.vertices.len() as u64;
@@ -418,6 +422,19 @@ pub(super) fn check_data(out: PlyData) -> Result<PlyData> {
         ));
     }
     Ok(out)
+}
+
+/// Whether every coordinate of `points` is within ±[`crate::geometry::MAX_COORDINATE`] (so
+/// finite), in one parallel pass.
+fn all_in_range(points: &[Point3]) -> bool {
+    let max = crate::geometry::MAX_COORDINATE;
+    crate::parallel::map_ranges(points.len(), |range| {
+        points[range]
+            .iter()
+            .fold(true, |ok, p| ok & p.iter().all(|v| v.abs() <= max))
+    })
+    .into_iter()
+    .all(|ok| ok)
 }
 
 fn push_polygon(out: &mut PlyData, poly: &[u32]) {
