@@ -8,7 +8,7 @@ sparse SfM cloud too (the scene's recon/sparse.ply: the pycolmap run of data/dem
 against the same ground truth, where the fixed costs around the ICP dominate). The two tools'
 rounds alternate. Prints a markdown table with wall and CPU time and the ratios; exits 1 when the
 numbers disagree (fixed transform: 1e-4; whole protocol: 0.5 points on the dense cloud, 1 point
-on the sparse one, where the toolbox's own runs differ by up to 0.57 points) or a tool fails.
+on the sparse one (2 with --quick), where the toolbox's own runs differ by up to 0.57 points) or a tool fails.
 
   bench/tanksandtemples.py [--quick] [--rounds 3] [--gt-points 2000000] [--dense-points 1000000]
                            [--markdown out.md]
@@ -102,8 +102,11 @@ def main():
     rows, failures = [], []
     for what, tol, (mine_cmd, their_cmd) in [
         # The toolbox's own runs differ by up to 5.7e-3 in F on the sparse cloud (its trajectory
-        # RANSAC is not seeded, and 2.5k points leave its draws a trace): a wider bar there.
-        (f"whole protocol, sparse cloud ({sparse_points} points)", 0.01, protocol(sparse, "sparse")),
+        # RANSAC is not seeded, and 2.5k points leave its draws a trace): a wider bar there. On
+        # --quick's 100k-point ground truth its precision spread over 0.8970-0.9108 in four runs
+        # (1.4 points; sfmeval's is one value, 0.9112): twice that bar.
+        (f"whole protocol, sparse cloud ({sparse_points} points)", 0.02 if args.quick else 0.01,
+         protocol(sparse, "sparse")),
         (f"whole protocol, dense cloud ({args.dense_points + args.dense_points // 30} points)", 0.005,
          protocol(recon, "run")),
         ("evaluation, dense cloud, transform fixed", 1e-4,
