@@ -354,6 +354,9 @@ try {
   };
   const demoSparse = join(root, 'data/demo/sparse');
   await page.setInputFiles('#file-runs', ['cameras.txt', 'images.txt', 'points3D.txt'].map((f) => join(demoSparse, f)));
+  // The line is written once the dropped files are read: wait for it (the check fails if it
+  // never comes) rather than read the previous one.
+  await page.waitForFunction(() => document.getElementById('info-runs').textContent.startsWith('1 reconstruction: model'), null, { timeout: 20000 }).catch(() => {});
   check('compare-colmap-files-one-item', (await page.textContent('#info-runs')).startsWith('1 reconstruction: model'), await page.textContent('#info-runs'));
   await compareAgain();
   const colmapRows = await tableRows();
