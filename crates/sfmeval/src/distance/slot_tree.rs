@@ -88,6 +88,7 @@ fn key_bounds(keys: &[([f32; 3], u32)]) -> ([f32; 3], [f32; 3]) {
     let rest = chunks.remainder();
     for chunk in chunks {
         for ((e, lo), hi) in chunk.iter().zip(&mut los).zip(&mut his) {
+            // A fourth lane (z again) fills a 4-wide register; only the first three are read.
             let p = [e.0[0], e.0[1], e.0[2], e.0[2]];
             for k in 0..4 {
                 lo[k] = if p[k] < lo[k] { p[k] } else { lo[k] };
