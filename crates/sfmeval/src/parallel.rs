@@ -115,6 +115,30 @@ where
     }
 }
 
+/// [`map_range`] of a function giving pairs, collected straight into two vectors.
+pub(crate) fn map_range_unzip<A, B, F>(n: usize, f: F) -> (Vec<A>, Vec<B>)
+where
+    A: Send,
+    B: Send,
+    F: Fn(usize) -> (A, B) + Sync + Send,
+{
+    #[cfg(feature = "parallel")]
+    {
+        use rayon::prelude::*;
+        let (mut a, mut b) = (Vec::new(), Vec::new());
+        (0..n)
+            .into_par_iter()
+            .with_min_len(1024)
+            .map(f)
+            .unzip_into_vecs(&mut a, &mut b);
+        (a, b)
+    }
+    #[cfg(not(feature = "parallel"))]
+    {
+        (0..n).map(f).unzip()
+    }
+}
+
 /// `f` over `0..n` cut into one contiguous range per thread (a single range without threads),
 /// the results in range order: for reductions whose partial results are large (histograms,
 /// counters), where a range per work unit would multiply them.

@@ -41,8 +41,9 @@ use parry3d_f64::query::PointQueryWithLocation as _;
 use parry3d_f64::shape::Triangle;
 
 use super::leaf_bound::{self, LANES, LeafBound};
-use super::median_split::{self, Centroid};
+use super::median_split;
 use super::oriented::{self, OrientedLanes, OrientedQuery};
+use super::split_key::Keyed;
 use super::{down, up};
 use crate::geometry::{Point3, TriangleMesh, sub};
 use crate::parallel;
@@ -220,14 +221,27 @@ impl TriangleBvh {
 
     /// [`Self::new`]; `split_ahead` false takes the serial path (the tests' reference).
     fn build(mesh: &TriangleMesh, split_ahead: bool) -> Self {
+        // The bounds of the triangles' corners, ranges in parallel (minima and maxima are
+        // exact: the same whatever the cuts).
+        let parts = parallel::map_ranges(mesh.triangles.len(), |range| {
+            let mut lo = [f64::INFINITY; 3];
+            let mut hi = [f64::NEG_INFINITY; 3];
+            for t in &mesh.triangles[range] {
+                for v in mesh.corners(t) {
+                    for k in 0..3 {
+                        lo[k] = lo[k].min(v[k]);
+                        hi[k] = hi[k].max(v[k]);
+                    }
+                }
+            }
+            (lo, hi)
+        });
         let mut lo = [f64::INFINITY; 3];
         let mut hi = [f64::NEG_INFINITY; 3];
-        for t in &mesh.triangles {
-            for v in mesh.corners(t) {
-                for k in 0..3 {
-                    lo[k] = lo[k].min(v[k]);
-                    hi[k] = hi[k].max(v[k]);
-                }
+        for (l, h) in parts {
+            for k in 0..3 {
+                lo[k] = lo[k].min(l[k]);
+                hi[k] = hi[k].max(h[k]);
             }
         }
         let centre = if mesh.triangles.is_empty() {
@@ -237,15 +251,20 @@ impl TriangleBvh {
         };
         let unbounded = (0..3).any(|k| !((hi[k] - lo[k]) / 2.0 < MAX_RELATIVE / 2.0));
         let unbounded = unbounded && !mesh.triangles.is_empty();
-        let centroids: Vec<Centroid> = parallel::map_range(mesh.triangles.len(), |i| {
-            let [a, b, c] = mesh.corners(&mesh.triangles[i]);
-            [0, 1, 2].map(|k| ((a[k] + b[k] + c[k]) / 3.0 - centre[k]) as f32)
-        });
+        // The triangles in input order, each with its centroid in `f32` relative to the centre
+        // (it only chooses the splits: 16 bytes a triangle).
+        let input_order = || -> Vec<Keyed> {
+            parallel::map_range(mesh.triangles.len(), |i| {
+                let [a, b, c] = mesh.corners(&mesh.triangles[i]);
+                let centroid = [0, 1, 2].map(|k| ((a[k] + b[k] + c[k]) / 3.0 - centre[k]) as f32);
+                (centroid, i as u32)
+            })
+        };
+        let mut keyed = input_order();
         // The median splits ahead, in parallel; the serial path where copies are dropped.
-        let mut order: Vec<u32> = (0..mesh.triangles.len() as u32).collect();
-        let partitioned = split_ahead && median_split::split_all(&mut order, &centroids, LEAF_SIZE);
+        let partitioned = split_ahead && median_split::split_all(&mut keyed, LEAF_SIZE);
         if !partitioned {
-            order = (0..mesh.triangles.len() as u32).collect();
+            keyed = input_order();
         }
         // Sized before they are filled (a grown vector peaks at up to twice its length).
         let (node_count, leaf_count) = shape(mesh.triangles.len());
@@ -253,49 +272,56 @@ impl TriangleBvh {
         let mut leaves = Vec::with_capacity(leaf_count);
         let mut builder = Builder {
             mesh,
-            centroids: &centroids,
-            order: &mut order,
+            order: &mut keyed,
             nodes: &mut nodes,
             leaves: &mut leaves,
-            centre,
-            unbounded,
             partitioned,
         };
         if !mesh.triangles.is_empty() {
             builder.root(mesh.triangles.len());
         }
-        drop(centroids);
-        let slots = leaves.len() * LEAF_SIZE;
-        let mut tris = vec![[0u32; 3]; slots];
-        let mut ids = vec![u32::MAX; slots];
-        for (leaf, &(start, end)) in leaves.iter().enumerate() {
-            for (k, &i) in order[start as usize..end as usize].iter().enumerate() {
-                tris[leaf * LEAF_SIZE + k] = mesh.triangles[i as usize];
-                ids[leaf * LEAF_SIZE + k] = i;
-            }
-        }
+        // Only the triangles' indices from here (the centroids dropped before the leaf slots
+        // are filled: the build's peak stays that of the splits).
+        let order: Vec<u32> = keyed.iter().map(|&(_, i)| i).collect();
+        drop(keyed);
+        // The leaves' slots (input indices, then triangles), leaves in parallel.
         let leaf_count = leaves.len();
-        drop(leaves);
+        let ids: Vec<[u32; LEAF_SIZE]> = parallel::map_range(leaf_count, |leaf| {
+            let (start, end) = leaves[leaf];
+            let mut slot = [u32::MAX; LEAF_SIZE];
+            slot[..(end - start) as usize].copy_from_slice(&order[start as usize..end as usize]);
+            slot
+        });
         drop(order);
-        // The bound blocks, leaves in parallel, from the leaf-order triangles (each leaf's
-        // frame computed again as the build computed its box).
-        let bounds = parallel::map_range(leaf_count, |leaf| {
-            if unbounded {
-                return LeafBound::default();
-            }
-            let start = leaf * LEAF_SIZE;
-            let count = ids[start..start + LEAF_SIZE]
-                .iter()
-                .take_while(|&&id| id != u32::MAX)
-                .count();
+        drop(leaves);
+        let tris: Vec<[[u32; 3]; LEAF_SIZE]> = parallel::map_range(leaf_count, |leaf| {
+            ids[leaf].map(|id| {
+                if id == u32::MAX {
+                    [0; 3]
+                } else {
+                    mesh.triangles[id as usize]
+                }
+            })
+        });
+        // Each leaf's box and bound block, leaves in parallel.
+        let (bounds, leaf_boxes) = parallel::map_range_unzip(leaf_count, |leaf| {
+            let count = ids[leaf].iter().take_while(|&&id| id != u32::MAX).count();
             let mut corners = [[[0.0; 3]; 3]; LEAF_SIZE];
-            for (k, t) in tris[start..start + count].iter().enumerate() {
+            for (k, t) in tris[leaf][..count].iter().enumerate() {
                 corners[k] = mesh.corners(t);
             }
             let (lo, hi) = leaf_box(&corners[..count], centre);
-            let (origin, extent) = frame(lo, hi, centre);
-            LeafBound::new(&corners[..count], origin, extent)
+            let bound = if unbounded {
+                LeafBound::default()
+            } else {
+                let (origin, extent) = frame(lo, hi, centre);
+                LeafBound::new(&corners[..count], origin, extent)
+            };
+            (bound, (lo, hi))
         });
+        place_boxes(&mut nodes, &leaf_boxes, unbounded);
+        drop(leaf_boxes);
+        let (tris, ids) = (tris.into_flattened(), ids.into_flattened());
         if !unbounded {
             oriented_boxes(&mut nodes, &tris, &ids, mesh, centre);
         }
@@ -545,6 +571,34 @@ fn oriented_boxes(
     });
 }
 
+/// Each used lane's box: a leaf's from `leaf_boxes`, an inner node's the union of its
+/// children's (children come after their parent, so the deepest nodes are done first);
+/// unbounded, every lane's box is all of space.
+fn place_boxes(nodes: &mut [Node], leaf_boxes: &[([f32; 3], [f32; 3])], unbounded: bool) {
+    for i in (0..nodes.len()).rev() {
+        for lane in 0..WIDTH {
+            let code = nodes[i].child[lane];
+            let (lo, hi) = if code == EMPTY {
+                continue;
+            } else if unbounded {
+                ([f32::NEG_INFINITY; 3], [f32::INFINITY; 3])
+            } else if code & LEAF != 0 {
+                leaf_boxes[(code & !LEAF) as usize]
+            } else {
+                let n = &nodes[code as usize];
+                (
+                    [0, 1, 2].map(|k| n.min[k].iter().copied().fold(f32::INFINITY, f32::min)),
+                    [0, 1, 2].map(|k| n.max[k].iter().copied().fold(f32::NEG_INFINITY, f32::max)),
+                )
+            };
+            for k in 0..3 {
+                nodes[i].min[k][lane] = lo[k];
+                nodes[i].max[k][lane] = hi[k];
+            }
+        }
+    }
+}
+
 /// A leaf's box relative to `centre`, rounded outwards to `f32`.
 fn leaf_box(corners: &[[Point3; 3]], centre: Point3) -> ([f32; 3], [f32; 3]) {
     let mut lo = [f64::INFINITY; 3];
@@ -610,13 +664,10 @@ fn levels(n: usize) -> u32 {
 
 struct Builder<'a> {
     mesh: &'a TriangleMesh,
-    centroids: &'a [Centroid],
-    order: &'a mut [u32],
+    order: &'a mut [Keyed],
     nodes: &'a mut Vec<Node>,
     /// Per leaf, in slot order: its range of `order`.
     leaves: &'a mut Vec<(u32, u32)>,
-    centre: Point3,
-    unbounded: bool,
     /// The order is split already ([`median_split::split_all`]): only the nodes are placed.
     partitioned: bool,
 }
@@ -666,31 +717,15 @@ impl Builder<'_> {
     }
 
     /// Fills lane `lane` of `node` with the child over `order[start..end]` (prepared): a leaf
-    /// if it fits one, else an inner node.
+    /// if it fits one, else an inner node. The lane's box is placed later ([`place_boxes`]).
     fn child(&mut self, node: &mut Node, lane: usize, start: usize, end: usize, axis: usize) {
-        let (lo, hi, code, count) = if end - start <= LEAF_SIZE {
-            let mut corners = [[[0.0; 3]; 3]; LEAF_SIZE];
-            for (k, &i) in self.order[start..end].iter().enumerate() {
-                corners[k] = self.mesh.corners(&self.mesh.triangles[i as usize]);
-            }
-            let (lo, hi) = leaf_box(&corners[..end - start], self.centre);
+        let (code, count) = if end - start <= LEAF_SIZE {
             let leaf = self.leaves.len();
             self.leaves.push((start as u32, end as u32));
-            (lo, hi, LEAF | leaf as u32, (end - start) as u8)
+            (LEAF | leaf as u32, (end - start) as u8)
         } else {
-            let c = self.node(start, end, axis);
-            let n = &self.nodes[c as usize];
-            let lo = [0, 1, 2].map(|k| n.min[k].iter().copied().fold(f32::INFINITY, f32::min));
-            let hi = [0, 1, 2].map(|k| n.max[k].iter().copied().fold(f32::NEG_INFINITY, f32::max));
-            (lo, hi, c, 0)
+            (self.node(start, end, axis), 0)
         };
-        for k in 0..3 {
-            (node.min[k][lane], node.max[k][lane]) = if self.unbounded {
-                (f32::NEG_INFINITY, f32::INFINITY)
-            } else {
-                (lo[k], hi[k])
-            };
-        }
         node.child[lane] = code;
         node.count[lane] = count;
     }
@@ -701,7 +736,7 @@ impl Builder<'_> {
         if self.partitioned {
             return (end, 0);
         }
-        let (axis, same) = median_split::centroid_axis(&self.order[start..end], self.centroids);
+        let (axis, same) = median_split::centroid_axis(&self.order[start..end]);
         if end - start > LEAF_SIZE && same {
             // Every centroid in one place: copies of one triangle (a glTF node graph that
             // instances a mesh many times in the same place) would make every query visit
@@ -718,13 +753,7 @@ impl Builder<'_> {
         if self.partitioned {
             return start + median_split::split_len(end - start, LEAF_SIZE);
         }
-        start
-            + median_split::median_split(
-                &mut self.order[start..end],
-                self.centroids,
-                axis,
-                LEAF_SIZE,
-            )
+        start + median_split::median_split(&mut self.order[start..end], axis, LEAF_SIZE)
     }
 
     /// Moves the distinct triangles of `order[start..end]` (same corners in the same cyclic
@@ -758,7 +787,9 @@ impl Builder<'_> {
             })
         };
         let slice = &mut self.order[start..end];
-        let mut keyed: Vec<(u64, u32)> = slice.iter().map(|&i| (hash(&key(i)), i)).collect();
+        // (every centroid of the range is this one)
+        let centroid = slice[0].0;
+        let mut keyed: Vec<(u64, u32)> = slice.iter().map(|&(_, i)| (hash(&key(i)), i)).collect();
         keyed.sort_unstable();
         let mut unique = 0;
         let mut run_start = 0;
@@ -767,8 +798,8 @@ impl Builder<'_> {
                 run_start = unique;
             }
             let ki = key(i);
-            if !slice[run_start..unique].iter().any(|&u| key(u) == ki) {
-                slice[unique] = i;
+            if !slice[run_start..unique].iter().any(|&(_, u)| key(u) == ki) {
+                slice[unique] = (centroid, i);
                 unique += 1;
             }
         }

@@ -9,6 +9,7 @@ mod mesh;
 mod neighbour_list;
 mod oriented;
 pub(crate) mod slot_tree;
+mod split_key;
 
 pub use cloud::CloudIndex;
 pub use kd_cloud::{KdCloud, NO_POINT, distance2};

@@ -14,6 +14,7 @@
 //! monotone); pruning a node whose box distance is not below the best never drops a strictly
 //! nearer point.
 
+use super::split_key::{Keyed, key_bounds, longest_axis, select_at};
 use super::{down, up};
 use crate::geometry::Point3;
 
@@ -38,7 +39,7 @@ fn depth_for(n: usize) -> u32 {
 pub(crate) fn kd_order(n: usize, point: impl Fn(usize) -> Point3 + Sync) -> Vec<u32> {
     // The keys only choose the splits (boxes are computed from the exact points afterwards),
     // so `f32` keys are enough.
-    let mut keys: Vec<([f32; 3], u32)> =
+    let mut keys: Vec<Keyed> =
         crate::parallel::map_range(n, |i| (point(i).map(|v| v as f32), i as u32));
     split(&mut keys, depth_for(n));
     // Not `into_iter().collect()`: collecting in place would keep the keys' allocation,
@@ -46,84 +47,17 @@ pub(crate) fn kd_order(n: usize, point: impl Fn(usize) -> Point3 + Sync) -> Vec<
     keys.iter().map(|&(_, i)| i).collect()
 }
 
-fn split(keys: &mut [([f32; 3], u32)], levels: u32) {
+fn split(keys: &mut [Keyed], levels: u32) {
     if levels == 0 || keys.len() < 2 {
         return;
     }
     let (lo, hi) = key_bounds(keys);
-    let axis = (0..3)
-        .max_by(|&a, &b| (hi[a] - lo[a]).total_cmp(&(hi[b] - lo[b])))
-        .unwrap_or(0);
     let mid = keys.len() / 2;
-    // By coordinate (`total_cmp`'s order), ties by index: one `u64` comparison, the axis fixed
-    // in each closure. The same order as comparing the pairs, so the same arrangement.
-    match axis {
-        0 => keys.select_nth_unstable_by_key(mid, |e| split_key(e, 0)),
-        1 => keys.select_nth_unstable_by_key(mid, |e| split_key(e, 1)),
-        _ => keys.select_nth_unstable_by_key(mid, |e| split_key(e, 2)),
-    };
+    // By coordinate (`total_cmp`'s order), ties by index: the same order as comparing the
+    // pairs, so the same arrangement.
+    select_at(keys, mid, longest_axis(lo, hi));
     let (left, right) = keys.split_at_mut(mid);
     crate::parallel::join(|| split(left, levels - 1), || split(right, levels - 1));
-}
-
-/// `e`'s coordinate on `axis` and its index as one integer that orders as `total_cmp` on the
-/// coordinate, then the index.
-#[inline(always)]
-fn split_key(e: &([f32; 3], u32), axis: usize) -> u64 {
-    let bits = e.0[axis].to_bits();
-    // `total_cmp`'s flip of the negative values' magnitude bits, and the sign bit flipped so
-    // that unsigned order is signed order.
-    let ordered = (bits ^ ((((bits as i32) >> 31) as u32) >> 1)) ^ (1 << 31);
-    (u64::from(ordered) << 32) | u64::from(e.1)
-}
-
-/// The smallest and largest finite coordinate of `keys` on each axis (±∞ for none): one pass
-/// of comparisons the compiler vectorises (NaN fails them and counts for none), redone with
-/// the finiteness test in the rare case an infinite coordinate reached the bounds.
-fn key_bounds(keys: &[([f32; 3], u32)]) -> ([f32; 3], [f32; 3]) {
-    // Four running bounds, so that the comparisons do not wait on one another.
-    let mut los = [[f32::INFINITY; 4]; 4];
-    let mut his = [[f32::NEG_INFINITY; 4]; 4];
-    let chunks = keys.chunks_exact(4);
-    let rest = chunks.remainder();
-    for chunk in chunks {
-        for ((e, lo), hi) in chunk.iter().zip(&mut los).zip(&mut his) {
-            // A fourth lane (z again) fills a 4-wide register; only the first three are read.
-            let p = [e.0[0], e.0[1], e.0[2], e.0[2]];
-            for k in 0..4 {
-                lo[k] = if p[k] < lo[k] { p[k] } else { lo[k] };
-                hi[k] = if p[k] > hi[k] { p[k] } else { hi[k] };
-            }
-        }
-    }
-    for (e, (lo, hi)) in rest.iter().zip(los.iter_mut().zip(&mut his)) {
-        for k in 0..3 {
-            lo[k] = if e.0[k] < lo[k] { e.0[k] } else { lo[k] };
-            hi[k] = if e.0[k] > hi[k] { e.0[k] } else { hi[k] };
-        }
-    }
-    let mut lo = [f32::INFINITY; 3];
-    let mut hi = [f32::NEG_INFINITY; 3];
-    for (l, h) in los.iter().zip(&his) {
-        for k in 0..3 {
-            lo[k] = if l[k] < lo[k] { l[k] } else { lo[k] };
-            hi[k] = if h[k] > hi[k] { h[k] } else { hi[k] };
-        }
-    }
-    if lo.iter().chain(&hi).all(|v| v.is_finite()) {
-        return (lo, hi);
-    }
-    let mut lo = [f32::INFINITY; 3];
-    let mut hi = [f32::NEG_INFINITY; 3];
-    for (p, _) in keys {
-        for k in 0..3 {
-            if p[k].is_finite() {
-                lo[k] = lo[k].min(p[k]);
-                hi[k] = hi[k].max(p[k]);
-            }
-        }
-    }
-    (lo, hi)
 }
 
 /// An axis-aligned box in `f32`, rounded outwards; empty (`min > max`) when no live point.
@@ -500,26 +434,6 @@ mod tests {
             reference_split(&mut keys, depth_for(n));
             let want: Vec<u32> = keys.iter().map(|&(_, i)| i).collect();
             assert_eq!(got, want, "{n} points, {odd} kinds of special values");
-        }
-        // The key orders as `total_cmp`, then the index.
-        let values = [
-            f32::NEG_INFINITY,
-            -1.5,
-            -0.0,
-            0.0,
-            1e-40,
-            2.0,
-            f32::INFINITY,
-            f32::NAN,
-        ];
-        for a in values {
-            for b in values {
-                for (i, j) in [(1, 2), (2, 1), (3, 3)] {
-                    let (x, y) = (([a, 0.0, 0.0], i), ([b, 0.0, 0.0], j));
-                    let want = a.total_cmp(&b).then(i.cmp(&j));
-                    assert_eq!(split_key(&x, 0).cmp(&split_key(&y, 0)), want, "{a} {b}");
-                }
-            }
         }
     }
 
