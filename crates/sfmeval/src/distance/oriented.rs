@@ -150,13 +150,15 @@ impl OrientedLanes {
         d2.map(|x| x * SHRINK - TINY)
     }
 
-    /// Sets lane `lane` to the oriented box of `triangles` (their corners, absolute), for a
-    /// child whose axis-aligned box runs from `min` to `max` (relative to `centre`). A degenerate
-    /// patch (no net normal, a box of size 0, non-finite) stays unconstrained.
+    /// Sets lane `lane` to the oriented box of `triangles` (their corners, absolute; `normals`
+    /// their [`area_normal`]s), for a child whose axis-aligned box runs from `min` to `max`
+    /// (relative to `centre`). A degenerate patch (no net normal, a box of size 0, non-finite)
+    /// stays unconstrained.
     pub(crate) fn set(
         &mut self,
         lane: usize,
         triangles: &[[Point3; 3]],
+        normals: &[(Point3, f64)],
         min: [f32; 3],
         max: [f32; 3],
         centre: Point3,
@@ -166,7 +168,7 @@ impl OrientedLanes {
         if !(unit.is_finite() && unit > 0.0) {
             return;
         }
-        let Some(axes) = axes(triangles, extent) else {
+        let Some(axes) = axes(normals, extent) else {
             return;
         };
         // Components in units of 2⁻¹⁵ (1 itself rounds down to 32767: |aₖⱼ| ≤ 1 either way).
@@ -207,16 +209,24 @@ impl OrientedLanes {
     }
 }
 
-/// Orthonormal axes for a patch: its area-weighted unit normal, a tangent along the world axis
-/// of the box's longest extent that is not near the normal, and their cross product. `None`
-/// when the triangles' normals cancel out (a closed or folded patch) or are not finite.
-fn axes(triangles: &[[Point3; 3]], extent: [f64; 3]) -> Option<[Point3; 3]> {
+/// A triangle's normal scaled by twice its area, `(b − a) × (c − a)`, and that length: what
+/// a patch's axes sum over its triangles (computed once a triangle for all the levels of a
+/// tree).
+pub(crate) fn area_normal([a, b, c]: &[Point3; 3]) -> (Point3, f64) {
+    let m = cross(sub(*b, *a), sub(*c, *a));
+    (m, norm(m))
+}
+
+/// Orthonormal axes for a patch of triangles with these [`area_normal`]s: its area-weighted
+/// unit normal, a tangent along the world axis of the box's longest extent that is not near
+/// the normal, and their cross product. `None` when the triangles' normals cancel out (a
+/// closed or folded patch) or are not finite.
+fn axes(normals: &[(Point3, f64)], extent: [f64; 3]) -> Option<[Point3; 3]> {
     let mut n = [0.0; 3];
     let mut total = 0.0;
-    for [a, b, c] in triangles {
-        let m = cross(sub(*b, *a), sub(*c, *a));
+    for (m, length) in normals {
         n = [n[0] + m[0], n[1] + m[1], n[2] + m[2]];
-        total += norm(m);
+        total += length;
     }
     let length = norm(n);
     // Normals that mostly cancel: no useful orientation.
@@ -313,7 +323,8 @@ mod tests {
                         corners[k][lane] = c[k];
                         far_corners[k][lane] = f[k];
                     }
-                    lanes_of.set(lane, &t, c, f, centre);
+                    let normals: Vec<_> = t.iter().map(area_normal).collect();
+                    lanes_of.set(lane, &t, &normals, c, f, centre);
                     tris.push(t);
                 }
                 for _ in 0..20 {
@@ -351,8 +362,9 @@ mod tests {
     fn cancelling_normals_stay_unconstrained() {
         let t = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]];
         let flipped = [t[0], t[2], t[1]];
-        assert!(axes(&[t, flipped], [1.0, 1.0, 0.0]).is_none());
-        let a = axes(&[t], [1.0, 1.0, 0.0]).unwrap();
+        let normals = |ts: &[[Point3; 3]]| ts.iter().map(area_normal).collect::<Vec<_>>();
+        assert!(axes(&normals(&[t, flipped]), [1.0, 1.0, 0.0]).is_none());
+        let a = axes(&normals(&[t]), [1.0, 1.0, 0.0]).unwrap();
         assert_eq!(a[0], [0.0, 0.0, 1.0]);
         for (i, x) in a.iter().enumerate() {
             for (j, y) in a.iter().enumerate() {
