@@ -45,16 +45,23 @@ impl PreparedGroundTruth {
         progress.start(Stage::IndexGroundTruth, 1);
         let (index, pts, vertices, triangles, area) = match gt {
             GroundTruth::Mesh(m) => {
-                let idx = MeshIndex::new(m)?;
+                // The samples and the area are drawn while the BVH is built (its serial
+                // steps leave cores idle); the mesh is checked first, as both read it.
+                m.validate("mesh")?;
+                let (idx, sampled) = crate::parallel::join(
+                    || MeshIndex::new(m),
+                    || sample_surface(m, samples, seed).map(|s| (s, m.area())),
+                );
+                let idx = idx?;
                 progress.finish();
                 progress.start(Stage::Sampling, 1);
-                let s = sample_surface(m, samples, seed)?;
+                let (s, area) = sampled?;
                 (
                     GtIndex::Mesh(Box::new(idx)),
                     s,
                     m.vertices.len(),
                     m.triangles.len(),
-                    m.area(),
+                    area,
                 )
             }
             GroundTruth::Cloud(c) => (
