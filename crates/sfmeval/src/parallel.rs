@@ -344,7 +344,12 @@ where
     F: Fn(&Point3) -> R + Sync + Send,
 {
     let order = morton_order(points);
-    map_in_order(&order, progress, |i| f(&points[i]))
+    // The points gathered in visiting order first: a loop of independent loads overlaps
+    // their cache misses, where each query would wait for its own.
+    let visited_points = map_range(order.len(), |k| points[order[k] as usize]);
+    let visited = map(&visited_points, progress, f);
+    drop(visited_points);
+    by_index(&order, visited)
 }
 
 /// [`map_points`] where `f` also gets a state carried from one point to the next in the
@@ -357,19 +362,10 @@ where
     F: Fn(&mut S, &Point3) -> R + Sync + Send,
 {
     let order = morton_order(points);
-    let visited = map_with_state(&order, progress, |s, &i| f(s, &points[i as usize]));
+    let visited_points = map_range(order.len(), |k| points[order[k] as usize]);
+    let visited = map_with_state(&visited_points, progress, f);
+    drop(visited_points);
     by_index(&order, visited)
-}
-
-/// Maps `f` over `0..order.len()` visiting the indices in `order` (a permutation) and returns
-/// the results by index, like [`map`]: [`map_points`] with an order computed once and reused.
-pub(crate) fn map_in_order<R, F>(order: &[u32], progress: &dyn Progress, f: F) -> Vec<R>
-where
-    R: Send + Sync + Copy,
-    F: Fn(usize) -> R + Sync + Send,
-{
-    let visited = map(order, progress, |&i| f(i as usize));
-    by_index(order, visited)
 }
 
 /// `visited[k]` is the result for index `order[k]`: the results by index.
