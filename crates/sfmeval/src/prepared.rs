@@ -49,10 +49,9 @@ impl PreparedGroundTruth {
                 // steps leave cores idle); the mesh is checked first, as both read it.
                 m.validate("mesh")?;
                 let (idx, sampled) = crate::parallel::join(
-                    || MeshIndex::new(m),
+                    || MeshIndex::of_validated(m),
                     || sample_surface(m, samples, seed).map(|s| (s, m.area())),
                 );
-                let idx = idx?;
                 progress.finish();
                 progress.start(Stage::Sampling, 1);
                 let (s, area) = sampled?;

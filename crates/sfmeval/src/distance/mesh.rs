@@ -50,9 +50,14 @@ impl MeshIndex {
     /// Builds the BVH. The mesh must be valid ([`TriangleMesh::validate`]).
     pub fn new(mesh: &TriangleMesh) -> Result<Self> {
         mesh.validate("mesh")?;
-        Ok(MeshIndex {
+        Ok(Self::of_validated(mesh))
+    }
+
+    /// [`Self::new`] of a mesh its caller has validated already.
+    pub(crate) fn of_validated(mesh: &TriangleMesh) -> Self {
+        MeshIndex {
             bvh: TriangleBvh::new(mesh),
-        })
+        }
     }
 
     /// The closest surface point to `p` (a non-finite `p` gets a NaN distance). Of triangles
