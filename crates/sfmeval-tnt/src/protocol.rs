@@ -179,15 +179,17 @@ pub fn evaluate(
         });
     }
     let volume = &scene.crop;
-    // The crops run in parallel, the kept points come in input order.
+    // The crops run in parallel, the kept points come in input order (a kept point is moved
+    // twice, to the same bits).
     let crop = |pts: &[Point3]| -> Vec<Point3> {
-        parallel::filter_map(pts, |p| volume.contains(*p).then_some(*p))
+        parallel::keep_map(pts, |p| volume.contains(*p), |p| *p)
     };
     let crop_moved = |t: &Matrix4| -> Vec<Point3> {
-        parallel::filter_map(recon_points, |p| {
-            let moved = matrix::apply(t, *p);
-            volume.contains(moved).then_some(moved)
-        })
+        parallel::keep_map(
+            recon_points,
+            |p| volume.contains(matrix::apply(t, *p)),
+            |p| matrix::apply(t, *p),
+        )
     };
     let nonempty = |pts: Vec<Point3>, what: &str| -> Result<Vec<Point3>> {
         if pts.is_empty() {

@@ -18,21 +18,64 @@ where
     map_with_state(items, progress, |_: &mut (), t| f(t))
 }
 
-/// The `Some` results of `f` over `items`, in input order (a filter that keeps or maps each
-/// item on its own), in parallel where threads are available.
-pub fn filter_map<T, R, F>(items: &[T], f: F) -> Vec<R>
+/// `map(item)` for each of `items` that `keep(item)` keeps, in input order (a filter that
+/// tests each item on its own), in parallel where threads are available.
+///
+/// Two passes: the tests, as one flag an item and a count a run of [`CHUNK`] items; then the
+/// output at its final size (zeroed pages where `R::default()` is all zero bits, as for
+/// points), each run's kept items mapped straight into their place. `map` runs once per kept
+/// item, `keep` once per item. Collecting a filter through rayon's lists instead grew each
+/// part by doubling and appended the parts on one thread: a crop keeping 1.5M of 2M points
+/// spent longer on that than on its tests.
+pub fn keep_map<T, R>(
+    items: &[T],
+    keep: impl Fn(&T) -> bool + Sync + Send,
+    map: impl Fn(&T) -> R + Sync + Send,
+) -> Vec<R>
 where
     T: Sync,
-    R: Send,
-    F: Fn(&T) -> Option<R> + Sync + Send,
+    R: Send + Copy + Default,
 {
     #[cfg(feature = "parallel")]
     {
         use rayon::prelude::*;
-        items.par_iter().with_min_len(4096).filter_map(f).collect()
+        if items.len() <= CHUNK {
+            return items.iter().filter(|t| keep(t)).map(map).collect();
+        }
+        let mut flags = vec![false; items.len()];
+        let counts: Vec<usize> = flags
+            .par_chunks_mut(CHUNK)
+            .zip(items.par_chunks(CHUNK))
+            .map(|(flags, items)| {
+                let mut kept = 0;
+                for (flag, item) in flags.iter_mut().zip(items) {
+                    *flag = keep(item);
+                    kept += usize::from(*flag);
+                }
+                kept
+            })
+            .collect();
+        let mut out = vec![R::default(); counts.iter().sum()];
+        let mut rest = out.as_mut_slice();
+        let mut targets = Vec::with_capacity(counts.len());
+        for &n in &counts {
+            let (head, tail) = rest.split_at_mut(n);
+            targets.push(head);
+            rest = tail;
+        }
+        targets
+            .into_par_iter()
+            .zip(flags.par_chunks(CHUNK).zip(items.par_chunks(CHUNK)))
+            .for_each(|(target, (flags, items))| {
+                let kept = items.iter().zip(flags).filter(|(_, f)| **f).map(|(t, _)| t);
+                for (slot, item) in target.iter_mut().zip(kept) {
+                    *slot = map(item);
+                }
+            });
+        out
     }
     #[cfg(not(feature = "parallel"))]
-    items.iter().filter_map(f).collect()
+    items.iter().filter(|t| keep(t)).map(map).collect()
 }
 
 /// [`map`] where `f` also gets a state that starts as `S::default()` in each work unit and
@@ -395,6 +438,31 @@ mod tests {
                 }
             })
             .collect()
+    }
+
+    /// `keep_map` keeps and maps as a plain filter then map, in order, across chunks, for
+    /// none, some and all kept.
+    #[test]
+    fn keep_map_is_filter_then_map() {
+        let points = scrambled_points();
+        let tests: [&(dyn Fn(&Point3) -> bool + Sync); 4] = [
+            &|p| p[0] < 0.3,
+            &|p| p[1] > 0.5 || p[0].is_nan(),
+            &|_| false,
+            &|_| true,
+        ];
+        let moved = |p: &Point3| [p[0] * 3.0 + 1.0, p[2], -p[1]];
+        for keep in tests {
+            for items in [&points[..], &points[..100]] {
+                let expected: Vec<Point3> = items.iter().filter(|p| keep(p)).map(moved).collect();
+                let got = keep_map(items, keep, moved);
+                assert_eq!(got.len(), expected.len());
+                let bits = |v: &[Point3]| -> Vec<[u64; 3]> {
+                    v.iter().map(|p| p.map(f64::to_bits)).collect()
+                };
+                assert_eq!(bits(&got), bits(&expected));
+            }
+        }
     }
 
     /// Ascending, NaN (of either sign) last, -0 before +0, across many chunks.
