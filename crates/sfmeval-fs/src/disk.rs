@@ -7,7 +7,7 @@ use anyhow::{Context as _, Result};
 use sfmeval::align::{PointPair, parse_point_pairs};
 use sfmeval::dataset::{Dataset, DatasetPaths};
 use sfmeval::files::FileSource;
-use sfmeval::io::ReadLimits;
+use sfmeval::io::{LoadedCloud, ReadLimits};
 use sfmeval::transform::Similarity;
 
 /// The real filesystem. Paths are read as given (relative to the working directory or
@@ -41,6 +41,23 @@ impl FileSource for Disk {
 
     fn is_dir(&self, path: &str) -> bool {
         Path::new(path).is_dir()
+    }
+
+    /// A binary PLY cloud is read in pieces (the next read while the last is decoded); any
+    /// other file whole.
+    fn read_point_cloud(&self, path: &str) -> sfmeval::Result<Option<LoadedCloud>> {
+        let p = Path::new(path);
+        if !p.is_file() {
+            return Ok(None);
+        }
+        if crate::stream::is_ply_file(p)
+            && let Some(ply) = crate::stream::read_ply_cloud(p)?
+        {
+            return sfmeval::io::point_cloud_from_ply(path, ply).map(Some);
+        }
+        self.read(path)?
+            .map(|bytes| sfmeval::io::read_point_cloud(path, &bytes))
+            .transpose()
     }
 }
 
@@ -149,6 +166,52 @@ mod tests {
         assert_eq!(
             files.keys().collect::<Vec<_>>(),
             ["a.ply", "sparse/0/cameras.txt"]
+        );
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    /// The disk's clouds equal the core's reading of the file's bytes, streamed or not, and
+    /// name the path as the bytes' reader names it.
+    #[test]
+    fn point_clouds_read_as_the_core_reads_their_bytes() {
+        let dir = std::env::temp_dir().join(format!("sfmeval-fs-cloud-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let mut binary = b"ply\nformat binary_big_endian 1.0\nelement vertex 2\nproperty float x\nproperty float y\nproperty float z\nend_header\n".to_vec();
+        for v in [1.0f32, 2.0, 3.0, -4.0, 5.5, 6.25] {
+            binary.extend_from_slice(&v.to_be_bytes());
+        }
+        let files: [(&str, &[u8]); 3] = [
+            ("binary.ply", &binary),
+            ("ascii.ply", b"ply\nformat ascii 1.0\nelement vertex 1\nproperty double x\nproperty double y\nproperty double z\nend_header\n1 2 3\n"),
+            ("mesh.obj", b"v 1 2 3\nv 4 5 6\nv 0 1 0\nf 1 2 3\n"),
+        ];
+        for (name, bytes) in files {
+            let path = dir.join(name);
+            std::fs::write(&path, bytes).unwrap();
+            let path = path_str(&path).unwrap();
+            let disk = Disk.read_point_cloud(path).unwrap().unwrap();
+            let core = sfmeval::io::read_point_cloud(path, bytes).unwrap();
+            assert_eq!(
+                disk.cloud.points.as_f64(),
+                core.cloud.points.as_f64(),
+                "{name}"
+            );
+            assert_eq!(disk.format, core.format, "{name}");
+            assert_eq!(disk.notes.len(), core.notes.len(), "{name}");
+        }
+        let broken = dir.join("broken.ply");
+        std::fs::write(&broken, &binary[..binary.len() - 5]).unwrap();
+        let broken = path_str(&broken).unwrap();
+        assert_eq!(
+            Disk.read_point_cloud(broken).unwrap_err().to_string(),
+            sfmeval::io::read_point_cloud(broken, &binary[..binary.len() - 5])
+                .unwrap_err()
+                .to_string()
+        );
+        assert!(
+            Disk.read_point_cloud(path_str(&dir.join("none.ply")).unwrap())
+                .unwrap()
+                .is_none()
         );
         std::fs::remove_dir_all(&dir).unwrap();
     }

@@ -9,7 +9,6 @@ use super::trajectory::{LogFrame, Mapping, read_log, read_mapping};
 use sfmeval::crop::{Crop, Volume};
 use sfmeval::files::{FileSource, file_name, join};
 use sfmeval::geometry::Point3;
-use sfmeval::io;
 use sfmeval::{Error, Result};
 
 /// The toolbox's τ per scene (`config.py`'s `scenes_tau_dict`), in the scene's units (metres).
@@ -69,13 +68,20 @@ impl Scene {
         };
 
         let ground_truth_path = file(".ply");
-        let bytes = need(&ground_truth_path, "ground truth")?;
-        let ground_truth = io::read_point_cloud(&ground_truth_path, &bytes)
-            .map_err(|e| e.in_file("ground truth", &ground_truth_path))?
+        let ground_truth = source
+            .read_point_cloud(&ground_truth_path)
+            .map_err(|e| match e {
+                // The source's own errors name the file already.
+                Error::Io { .. } => e,
+                e => e.in_file("ground truth", &ground_truth_path),
+            })?
+            .ok_or_else(|| Error::Missing {
+                what: "Tanks and Temples ground truth".into(),
+                file: ground_truth_path.clone(),
+            })?
             .cloud
             .points
             .into_f64();
-        drop(bytes);
 
         let crop_path = file(".json");
         let crop =

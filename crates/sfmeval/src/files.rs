@@ -6,6 +6,7 @@
 use std::collections::BTreeMap;
 
 use crate::error::Result;
+use crate::io::LoadedCloud;
 
 /// Files readable by path.
 pub trait FileSource {
@@ -17,6 +18,15 @@ pub trait FileSource {
     fn list(&self, dir: &str) -> Result<Vec<String>>;
     /// Whether `path` is a folder.
     fn is_dir(&self, path: &str) -> bool;
+    /// The point cloud in the file at `path` as [`crate::io::read_point_cloud`] reads the
+    /// file's bytes (named by `path`); `Ok(None)` when there is no such file. A source may read
+    /// it in pieces: the disk streams binary PLY clouds, so that the file's bytes never sit in
+    /// memory beside its points.
+    fn read_point_cloud(&self, path: &str) -> Result<Option<LoadedCloud>> {
+        self.read(path)?
+            .map(|bytes| crate::io::read_point_cloud(path, &bytes))
+            .transpose()
+    }
 }
 
 /// `dir/name` (`name` when `dir` is empty).
