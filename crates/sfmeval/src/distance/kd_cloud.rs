@@ -29,7 +29,9 @@ impl KdCloud {
             });
         }
         let order = kd_order(points.len(), |i| points[i]);
-        let points: Vec<Point3> = order.iter().map(|&i| points[i as usize]).collect();
+        // Gathered in parallel: the reads land all over the input.
+        let points: Vec<Point3> =
+            crate::parallel::map_range(order.len(), |j| points[order[j] as usize]);
         let tree = SlotTree::new(points.len(), |k| points[k], |_| true);
         Ok(KdCloud { points, tree })
     }

@@ -44,7 +44,7 @@ pub(crate) fn kd_order(n: usize, point: impl Fn(usize) -> Point3 + Sync) -> Vec<
     split(&mut keys, depth_for(n));
     // Not `into_iter().collect()`: collecting in place would keep the keys' allocation,
     // four times the size of the order.
-    keys.iter().map(|&(_, i)| i).collect()
+    crate::parallel::map_range(keys.len(), |j| keys[j].1)
 }
 
 fn split(keys: &mut [Keyed], levels: u32) {
