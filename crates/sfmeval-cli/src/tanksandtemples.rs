@@ -129,10 +129,22 @@ pub fn tnt_cmd(args: &TntArgs) -> Result<()> {
     evaluation.report.notes.splice(0..0, recon.notes);
     let report = &evaluation.report;
     let json = evaluation.report_json();
-    write_atomic(&out.join("report.json"), json.as_bytes())?;
-    for (name, bytes) in evaluation.output_files() {
-        write_atomic(&out.join(name), &bytes)?;
-    }
+    // The plot renders while the report, the clouds and the texts are encoded and written.
+    let write_all = |files: Vec<(String, Vec<u8>)>| -> Result<()> {
+        for (name, bytes) in files {
+            write_atomic(&out.join(name), &bytes)?;
+        }
+        Ok(())
+    };
+    let (written, plots) = sfmeval::parallel::join(
+        || {
+            write_atomic(&out.join("report.json"), json.as_bytes())?;
+            write_all(evaluation.data_files())
+        },
+        || evaluation.plot_files(),
+    );
+    written?;
+    write_all(plots)?;
     if args.json {
         print!("{json}");
     } else if !args.quiet {

@@ -106,12 +106,20 @@ impl TntEvaluation {
         json
     }
 
-    /// Every file the toolbox writes beside the report, by file name, encoded (the two clouds
-    /// side by side): `<scene>.precision.ply`, `<scene>.recall.ply`, the curves and
-    /// `<scene>.prf_tau_plotstr.txt`, and the precision/recall plot `PR_<scene>_@d_th_0_<τ>.svg`
-    /// (and `.png` with the `png` feature, where the system has a font). What `sfmeval tnt` writes into its output folder and the
-    /// runner into a run's report folder.
+    /// Every file the toolbox writes beside the report, by file name, encoded:
+    /// [`Self::data_files`] then [`Self::plot_files`], made side by side. What the runner and
+    /// the Python package write into a report folder (`sfmeval tnt` writes the data files
+    /// while the plot renders).
     pub fn output_files(&self) -> Vec<(String, Vec<u8>)> {
+        let (mut files, plots) = parallel::join(|| self.data_files(), || self.plot_files());
+        files.extend(plots);
+        files
+    }
+
+    /// The clouds and texts the toolbox writes beside the report, by file name, encoded (the
+    /// two clouds side by side): `<scene>.precision.ply`, `<scene>.recall.ply`, the curves and
+    /// `<scene>.prf_tau_plotstr.txt`.
+    pub fn data_files(&self) -> Vec<(String, Vec<u8>)> {
         let name = &self.report.protocol.scene;
         let (precision, recall) = parallel::join(|| self.precision_ply(), || self.recall_ply());
         let mut files = vec![
@@ -121,8 +129,15 @@ impl TntEvaluation {
         for (suffix, text) in self.toolbox_texts() {
             files.push((format!("{name}{suffix}"), text.into_bytes()));
         }
-        let stem = plot::plot_stem(name, self.report.protocol.tau);
+        files
+    }
+
+    /// The precision/recall plot `PR_<scene>_@d_th_0_<τ>.svg` (and `.png` first, with the `png`
+    /// feature, where the system has a font), by file name.
+    pub fn plot_files(&self) -> Vec<(String, Vec<u8>)> {
+        let stem = plot::plot_stem(&self.report.protocol.scene, self.report.protocol.tau);
         let svg = plot::pr_svg(&self.report);
+        let mut files = Vec::new();
         #[cfg(feature = "png")]
         if let Some(png) = plot::svg_to_png(&svg) {
             files.push((format!("{stem}.png"), png));

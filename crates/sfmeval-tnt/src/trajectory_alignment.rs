@@ -200,6 +200,16 @@ impl<'a> Reference<'a> {
 /// The scaled Umeyama fit of a sample's frames (`source[i]` to `target[i]`); the identity when
 /// they are degenerate (fewer than 3, collinear, ...).
 fn fit(source: &[Point3], target: &[Point3], frames: &[u32]) -> Matrix4 {
+    // The pairs of a sample of the usual size on the stack: the RANSAC fits 100,000 of them.
+    const ON_STACK: usize = 8;
+    if frames.len() <= ON_STACK {
+        let (mut src, mut dst) = ([[0.0; 3]; ON_STACK], [[0.0; 3]; ON_STACK]);
+        for (k, &i) in frames.iter().enumerate() {
+            (src[k], dst[k]) = (source[i as usize], target[i as usize]);
+        }
+        let n = frames.len();
+        return umeyama(&src[..n], &dst[..n], true).map_or(IDENTITY, |s| s.matrix);
+    }
     let src: Vec<Point3> = frames.iter().map(|&i| source[i as usize]).collect();
     let dst: Vec<Point3> = frames.iter().map(|&i| target[i as usize]).collect();
     umeyama(&src, &dst, true).map_or(IDENTITY, |s| s.matrix)
