@@ -386,13 +386,7 @@ where
     R: Send + Sync + Copy,
     F: Fn(&Point3) -> R + Sync + Send,
 {
-    let order = morton_order(points);
-    // The points gathered in visiting order first: a loop of independent loads overlaps
-    // their cache misses, where each query would wait for its own.
-    let visited_points = map_range(order.len(), |k| points[order[k] as usize]);
-    let visited = map(&visited_points, progress, f);
-    drop(visited_points);
-    by_index(&order, visited)
+    in_visiting_order(points, |visited| map(visited, progress, f))
 }
 
 /// [`map_points`] where `f` also gets a state carried from one point to the next in the
@@ -404,9 +398,19 @@ where
     S: Default,
     F: Fn(&mut S, &Point3) -> R + Sync + Send,
 {
+    in_visiting_order(points, |visited| map_with_state(visited, progress, f))
+}
+
+/// `run`'s results over `points` taken in Morton order, returned in input order. The points
+/// are gathered in visiting order first: a loop of independent loads overlaps their cache
+/// misses, where each query would wait for its own.
+fn in_visiting_order<R: Send + Sync + Copy>(
+    points: &[Point3],
+    run: impl FnOnce(&[Point3]) -> Vec<R>,
+) -> Vec<R> {
     let order = morton_order(points);
     let visited_points = map_range(order.len(), |k| points[order[k] as usize]);
-    let visited = map_with_state(&visited_points, progress, f);
+    let visited = run(&visited_points);
     drop(visited_points);
     by_index(&order, visited)
 }
