@@ -21,7 +21,7 @@ where
 /// `map(item)` for each of `items` that `keep(item)` keeps, in input order (a filter that
 /// tests each item on its own), in parallel where threads are available.
 ///
-/// Two passes: the tests, as one flag an item and a count a run of [`CHUNK`] items; then the
+/// Two passes: the tests, as one flag an item and a count a run of 8192 items; then the
 /// output at its final size (zeroed pages where `R::default()` is all zero bits, as for
 /// points), each run's kept items mapped straight into their place. `map` runs once per kept
 /// item, `keep` once per item. Collecting a filter through rayon's lists instead grew each
