@@ -55,9 +55,7 @@ impl FileSource for Disk {
         {
             return sfmeval::io::point_cloud_from_ply(path, ply).map(Some);
         }
-        self.read(path)?
-            .map(|bytes| sfmeval::io::read_point_cloud(path, &bytes))
-            .transpose()
+        sfmeval::files::read_whole_point_cloud(self, path)
     }
 }
 

@@ -60,11 +60,12 @@ impl Scene {
             )));
         }
         let file = |suffix: &str| join(dir, &format!("{name}{suffix}"));
+        let missing = |path: &str, what: &str| Error::Missing {
+            what: format!("Tanks and Temples {what}"),
+            file: path.to_string(),
+        };
         let need = |path: &str, what: &str| -> Result<Vec<u8>> {
-            source.read(path)?.ok_or_else(|| Error::Missing {
-                what: format!("Tanks and Temples {what}"),
-                file: path.to_string(),
-            })
+            source.read(path)?.ok_or_else(|| missing(path, what))
         };
 
         let ground_truth_path = file(".ply");
@@ -75,10 +76,7 @@ impl Scene {
                 Error::Io { .. } => e,
                 e => e.in_file("ground truth", &ground_truth_path),
             })?
-            .ok_or_else(|| Error::Missing {
-                what: "Tanks and Temples ground truth".into(),
-                file: ground_truth_path.clone(),
-            })?
+            .ok_or_else(|| missing(&ground_truth_path, "ground truth"))?
             .cloud
             .points
             .into_f64();

@@ -23,10 +23,21 @@ pub trait FileSource {
     /// it in pieces: the disk streams binary PLY clouds, so that the file's bytes never sit in
     /// memory beside its points.
     fn read_point_cloud(&self, path: &str) -> Result<Option<LoadedCloud>> {
-        self.read(path)?
-            .map(|bytes| crate::io::read_point_cloud(path, &bytes))
-            .transpose()
+        read_whole_point_cloud(self, path)
     }
+}
+
+/// The point cloud in the file at `path`, read whole through [`FileSource::read`] and parsed by
+/// [`crate::io::read_point_cloud`]: [`FileSource::read_point_cloud`]'s default, and the
+/// fallback of a source that streams only some formats.
+pub fn read_whole_point_cloud<S: FileSource + ?Sized>(
+    source: &S,
+    path: &str,
+) -> Result<Option<LoadedCloud>> {
+    source
+        .read(path)?
+        .map(|bytes| crate::io::read_point_cloud(path, &bytes))
+        .transpose()
 }
 
 /// `dir/name` (`name` when `dir` is empty).
