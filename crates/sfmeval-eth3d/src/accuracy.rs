@@ -100,22 +100,31 @@ impl SphericalGrid {
                 )
             });
         // Cells in order, each cell's points by inclination (non-negative, or NaN last: the
-        // bits order them), for the window of `classify`.
-        let mut keys: Vec<(u32, u32, u32)> = sfmeval::parallel::map_range(located.len(), |k| {
-            (located[k].0, located[k].1.inclination.to_bits(), k as u32)
-        });
-        sfmeval::parallel::sort_unstable(&mut keys);
+        // bits order them), for the window of `classify`: a counting sort by cell (which keeps
+        // the points' order in a cell), then each cell's few points sorted.
         let mut starts = vec![0u32; cells + 1];
-        for (c, _, _) in &keys {
+        for (c, _) in &located {
             starts[*c as usize + 1] += 1;
         }
         for c in 0..cells {
             starts[c + 1] += starts[c];
         }
-        let sorted: Vec<SphericalPoint> = keys
-            .iter()
-            .map(|&(_, _, k)| located[k as usize].1)
-            .collect();
+        let mut next = starts.clone();
+        let mut order = vec![0u32; located.len()];
+        for (k, (c, _)) in located.iter().enumerate() {
+            let slot = &mut next[*c as usize];
+            order[*slot as usize] = k as u32;
+            *slot += 1;
+        }
+        drop(next);
+        for w in starts.windows(2) {
+            let cell = &mut order[w[0] as usize..w[1] as usize];
+            if cell.len() > 1 {
+                cell.sort_unstable_by_key(|&k| (located[k as usize].1.inclination.to_bits(), k));
+            }
+        }
+        let sorted: Vec<SphericalPoint> =
+            sfmeval::parallel::map_range(order.len(), |j| located[order[j] as usize].1);
         grid.starts = starts;
         grid.points = sorted;
         grid

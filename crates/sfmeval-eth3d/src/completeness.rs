@@ -4,11 +4,12 @@
 //! (`(d₀² + d₁²) + d₂²` in `float`), found by the radius search when strictly below the largest
 //! tolerance squared, and complete for a smaller tolerance when at most its square.
 //!
-//! The search runs on the core's exact [`KdCloud`] in double precision; the few nearest
-//! points it returns are measured again in the tool's `float` arithmetic, and the smallest of
-//! those is the tool's nearest distance.
+//! The search runs on the core's exact [`KdCloud`] in double precision. Where the nearest
+//! distance lies within rounding of a tolerance, the few nearest points are measured again in
+//! the tool's `float` arithmetic, and the smallest of those is the tool's nearest distance;
+//! elsewhere the double distance falls on the same side of every tolerance as the float one.
 
-use sfmeval::distance::KdCloud;
+use sfmeval::distance::{KdCloud, NO_POINT, distance2};
 use sfmeval::geometry::Point3;
 
 /// Candidates measured again in `float` (points within rounding of the nearest).
@@ -44,34 +45,157 @@ pub fn first_complete(
     // to the double search's rounding.
     let radius2 = f64::from(max2) * (1.0 + 1e-5) + 1e-30;
     let scan_f64: Vec<Point3> = scan.iter().map(|p| p.map(f64::from)).collect();
-    Ok(sfmeval::parallel::map_points(
+    // The thresholds the tool compares the float distance with: the largest (strictly below)
+    // and every other (at most).
+    let thresholds: Vec<f64> = tolerances2.iter().map(|&t| f64::from(t)).collect();
+    Ok(sfmeval::parallel::map_points_with_state(
         &scan_f64,
         &sfmeval::progress::NoProgress,
-        |q| {
+        |previous: &mut Previous, q| {
             if !q.iter().all(|c| c.is_finite()) {
                 return n as u32;
             }
-            let mut found = [(0.0f64, 0u32); CANDIDATES];
-            let (count, _) = tree.nearest_k_below(*q, radius2, &mut found);
-            let qf = q.map(|c| c as f32);
-            let mut best = f32::INFINITY;
-            for &(_, slot) in &found[..count] {
-                let p = tree.point(slot as usize).map(|c| c as f32);
-                best = best.min(flann_distance2(&qf, &p));
-            }
-            // The tool's loop: complete for the largest tolerance when the radius search
-            // found a point (strictly closer), then downwards while d² ≤ tolerance².
-            if !(best < max2) {
-                return n as u32;
-            }
-            let mut first = 0u32;
-            for t in (0..n - 1).rev() {
-                if tolerances2[t] < best {
-                    first = t as u32 + 1;
-                    break;
+            // The nearest point in double, bounded by the previous query's answer (a neighbour
+            // in the visiting order).
+            let mut bound = (radius2, NO_POINT);
+            if let Some(slot) = previous.0 {
+                let d2 = distance2(tree.point(slot), *q);
+                if d2 < radius2 {
+                    bound = (d2, slot);
                 }
             }
-            first
+            let (d2, slot) = tree.nearest_below(*q, bound);
+            if slot == NO_POINT {
+                return n as u32;
+            }
+            previous.0 = Some(slot);
+            // The float distance of each candidate lies within FLOAT_ERROR of its double one,
+            // so the float nearest does too: unless a threshold lies that close, it falls on
+            // the same side of every threshold as the double nearest.
+            let near_threshold = thresholds
+                .iter()
+                .any(|&t| (d2 - t).abs() <= NEAR_THRESHOLD * t.max(d2))
+                // (where the float square may underflow)
+                || d2 < TINY2;
+            let best = if near_threshold {
+                float_nearest2(&tree, q, radius2)
+            } else {
+                d2
+            };
+            first_tolerance(best, &thresholds)
         },
     ))
+}
+
+/// Relative error bound, with a wide margin, of the float squared distance against the double
+/// one: three float subtractions, squares and two additions are within 5 units in the last place
+/// (3e-7).
+const NEAR_THRESHOLD: f64 = 1e-5;
+
+/// Squared distances below which the float squares may lose bits to underflow.
+const TINY2: f64 = 1e-30;
+
+/// The previous query's nearest slot.
+#[derive(Default)]
+struct Previous(Option<usize>);
+
+/// The tool's squared nearest distance to `q` in float: the `CANDIDATES` nearest in double
+/// measured again as FLANN measures them (infinite when none is within `radius2`).
+fn float_nearest2(tree: &KdCloud, q: &Point3, radius2: f64) -> f64 {
+    let mut found = [(0.0f64, 0u32); CANDIDATES];
+    let (count, _) = tree.nearest_k_below(*q, radius2, &mut found);
+    let qf = q.map(|c| c as f32);
+    let mut best = f32::INFINITY;
+    for &(_, slot) in &found[..count] {
+        let p = tree.point(slot as usize).map(|c| c as f32);
+        best = best.min(flann_distance2(&qf, &p));
+    }
+    f64::from(best)
+}
+
+/// The tool's loop on a squared distance: complete for the largest tolerance when strictly
+/// closer (the radius search), then for each smaller one downwards while `d² ≤ tolerance²`.
+fn first_tolerance(best2: f64, thresholds: &[f64]) -> u32 {
+    let n = thresholds.len();
+    if !(best2 < thresholds[n - 1]) {
+        return n as u32;
+    }
+    (0..n - 1)
+        .rev()
+        .find(|&t| thresholds[t] < best2)
+        .map_or(0, |t| t as u32 + 1)
+}
+
+#[cfg(test)]
+#[allow(clippy::unwrap_used)]
+mod tests {
+    use super::*;
+
+    /// The tool's rule by brute force: the float nearest over every point, then its loop.
+    fn brute_force(scan: &[[f32; 3]], recon: &[[f32; 3]], tolerances2: &[f32]) -> Vec<u32> {
+        let n = tolerances2.len();
+        scan.iter()
+            .map(|q| {
+                let best = recon
+                    .iter()
+                    .map(|p| flann_distance2(q, p))
+                    .fold(f32::INFINITY, f32::min);
+                if !(best < tolerances2[n - 1]) {
+                    return n as u32;
+                }
+                (0..n - 1)
+                    .rev()
+                    .find(|&t| tolerances2[t] < best)
+                    .map_or(0, |t| t as u32 + 1)
+            })
+            .collect()
+    }
+
+    #[test]
+    fn equals_the_float_rule_also_at_the_tolerances() {
+        let mut state = 0x9e37_79b9_7f4a_7c15u64;
+        let mut next = move || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state >> 11) as f32 / (1u64 << 53) as f32
+        };
+        let tolerances = [0.01f32, 0.02, 0.05, 0.1];
+        let tolerances2: Vec<f32> = tolerances.iter().map(|t| t * t).collect();
+        let recon: Vec<[f32; 3]> = (0..300)
+            .map(|_| [next() * 0.5, next() * 0.5, next() * 0.05])
+            .collect();
+        let mut scan: Vec<[f32; 3]> = (0..3000)
+            .map(|_| {
+                [
+                    next() * 0.6 - 0.05,
+                    next() * 0.6 - 0.05,
+                    next() * 0.2 - 0.07,
+                ]
+            })
+            .collect();
+        // Scan points at a tolerance from a reconstruction point, within rounding (along an
+        // axis and along a diagonal), on a reconstruction point, and not finite.
+        for (k, p) in recon.iter().enumerate().take(100) {
+            let t = tolerances[k % tolerances.len()];
+            let d = t / 3f32.sqrt();
+            scan.push([p[0] + t, p[1], p[2]]);
+            scan.push([p[0], p[1] - t, p[2]]);
+            scan.push([p[0] + d, p[1] + d, p[2] + d]);
+            scan.push([p[0] + f32::EPSILON * t, p[1], p[2] + t]);
+            scan.push(*p);
+        }
+        scan.push([f32::NAN, 0.0, 0.0]);
+        let got = first_complete(&scan, &recon, &tolerances2).unwrap();
+        assert_eq!(got, brute_force(&scan, &recon, &tolerances2));
+        let n = tolerances.len() as u32;
+        // Every class occurs, so each branch of the rule was taken.
+        for class in 0..=n {
+            assert!(got.contains(&class), "no scan point of class {class}");
+        }
+        assert_eq!(
+            first_complete(&scan, &[], &tolerances2).unwrap(),
+            vec![n; scan.len()]
+        );
+    }
 }

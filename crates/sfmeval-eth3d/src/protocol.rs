@@ -146,11 +146,10 @@ pub fn evaluate(
         start_radius: options.beam_start_radius,
         tan_divergence: libm::tanf(deg_to_rad * options.beam_divergence_halfangle_deg),
     };
-    let grids: Vec<SphericalGrid> = scene
-        .scans
-        .iter()
-        .map(|s| SphericalGrid::new(&s.points))
-        .collect();
+    // (the scans at once: each grid's counting sort is serial)
+    let grids: Vec<SphericalGrid> = sfmeval::parallel::map_range(scene.scans.len(), |s| {
+        SphericalGrid::new(&scene.scans[s].points)
+    });
     let classes = classify_points(scene, &grids, reconstruction, &tolerances2, &beam);
     drop(grids);
     let first_accurate: Vec<u32> = classes.iter().map(|c| c.first_accurate).collect();

@@ -30,21 +30,99 @@ pub fn cell_of(p: &[f32; 3], voxel_size_inv: f32, shift: f32) -> [i32; 3] {
     p.map(|c| floor_coordinate(c * voxel_size_inv + shift))
 }
 
-/// The points' order grouped by cell of the grid with `shift` (cells in key order) and the
-/// bounds of each cell's run in it.
-fn grouped(points: &[[f32; 3]], voxel_size_inv: f32, shift: f32) -> (Vec<u32>, Vec<usize>) {
-    let mut keyed: Vec<([i32; 3], u32)> = sfmeval::parallel::map_range(points.len(), |i| {
-        (cell_of(&points[i], voxel_size_inv, shift), i as u32)
-    });
-    sfmeval::parallel::sort_unstable(&mut keyed);
-    let mut bounds = vec![0usize];
-    for k in 1..keyed.len() {
-        if keyed[k].0 != keyed[k - 1].0 {
-            bounds.push(k);
+/// For each occupied cell of the grid with `shift`, in key order, how many of its points are
+/// of each class (`class(i) < classes` for point `i`): `visit(counts)` with
+/// `counts.len() == classes`.
+///
+/// The cells are sorted as 64-bit keys when their coordinates' spans fit (each cell's key its
+/// coordinates' offsets from the smallest, x above y above z, the point's class below them: one
+/// sort of integers orders the cells and groups each cell's classes), and as coordinate
+/// triples otherwise.
+fn per_cell_classes(
+    points: &[[f32; 3]],
+    class: impl Fn(usize) -> u32 + Sync,
+    classes: u32,
+    voxel_size_inv: f32,
+    shift: f32,
+    mut visit: impl FnMut(&[usize]),
+) {
+    let cells: Vec<[i32; 3]> =
+        sfmeval::parallel::map(points, &sfmeval::progress::NoProgress, |p| {
+            cell_of(p, voxel_size_inv, shift)
+        });
+    let mut counts = vec![0usize; classes as usize];
+    let mut flush = |counts: &mut Vec<usize>| {
+        visit(counts);
+        counts.iter_mut().for_each(|c| *c = 0);
+    };
+    if let Some(packing) = Packing::of(&cells, classes) {
+        let mut keys: Vec<u64> =
+            sfmeval::parallel::map_range(cells.len(), |i| packing.key(&cells[i], class(i)));
+        drop(cells);
+        sfmeval::parallel::sort_unstable(&mut keys);
+        let class_mask = (1u64 << packing.class_bits) - 1;
+        for (k, &key) in keys.iter().enumerate() {
+            if k > 0 && key >> packing.class_bits != keys[k - 1] >> packing.class_bits {
+                flush(&mut counts);
+            }
+            counts[(key & class_mask) as usize] += 1;
+        }
+    } else {
+        let mut keyed: Vec<([i32; 3], u32)> =
+            sfmeval::parallel::map_range(cells.len(), |i| (cells[i], class(i)));
+        drop(cells);
+        sfmeval::parallel::sort_unstable(&mut keyed);
+        for k in 0..keyed.len() {
+            if k > 0 && keyed[k].0 != keyed[k - 1].0 {
+                flush(&mut counts);
+            }
+            counts[keyed[k].1 as usize] += 1;
         }
     }
-    bounds.push(keyed.len());
-    (keyed.into_iter().map(|(_, i)| i).collect(), bounds)
+    if !points.is_empty() {
+        flush(&mut counts);
+    }
+}
+
+/// How cell coordinates and a class pack into one `u64` whose order is the coordinates' order,
+/// then the class's.
+#[derive(Debug, Clone, Copy)]
+struct Packing {
+    lo: [i32; 3],
+    /// Bits of the y and z offsets.
+    bits: [u32; 2],
+    class_bits: u32,
+}
+
+impl Packing {
+    /// The packing of `cells` with `classes` classes, if their spans fit in 64 bits.
+    fn of(cells: &[[i32; 3]], classes: u32) -> Option<Packing> {
+        let mut lo = [i32::MAX; 3];
+        let mut hi = [i32::MIN; 3];
+        for c in cells {
+            for a in 0..3 {
+                lo[a] = lo[a].min(c[a]);
+                hi[a] = hi[a].max(c[a]);
+            }
+        }
+        let bits_of = |span: u64| 64 - span.leading_zeros();
+        let span = |a: usize| (i64::from(hi[a]) - i64::from(lo[a])).max(0) as u64;
+        let class_bits = bits_of(u64::from(classes.saturating_sub(1)));
+        let [bx, by, bz] = [0, 1, 2].map(|a| bits_of(span(a)));
+        (bx + by + bz + class_bits <= 64).then_some(Packing {
+            lo,
+            bits: [by, bz],
+            class_bits,
+        })
+    }
+
+    fn key(&self, c: &[i32; 3], class: u32) -> u64 {
+        let off = |a: usize| (i64::from(c[a]) - i64::from(self.lo[a])) as u64;
+        let [by, bz] = self.bits;
+        // (a shift by 64 when all spans are empty and there is one class: `checked_shl`)
+        let shl = |v: u64, s: u32| v.checked_shl(s).unwrap_or(0);
+        shl(shl(shl(off(0), by) | off(1), bz) | off(2), self.class_bits) | u64::from(class)
+    }
 }
 
 /// The tool's accuracy per tolerance: per cell, `accurate / (accurate + inaccurate)` in
@@ -62,19 +140,22 @@ pub fn accuracy(
     let mut valid = vec![0usize; tolerances];
     let mut acc = vec![0usize; tolerances];
     let mut inacc = vec![0usize; tolerances];
+    // A point's class: its first accurate tolerance (up to `tolerances`), twice, plus one when
+    // inaccurate.
+    let class = |i: usize| first_accurate[i].min(tolerances as u32) * 2 + u32::from(inaccurate[i]);
+    let classes = 2 * tolerances as u32 + 2;
     for shift in GRID_SHIFTS {
-        let (order, bounds) = grouped(points, voxel_size_inv, shift);
-        for w in bounds.windows(2) {
+        per_cell_classes(points, class, classes, voxel_size_inv, shift, |counts| {
             acc.iter_mut().for_each(|c| *c = 0);
             inacc.iter_mut().for_each(|c| *c = 0);
-            for &i in &order[w[0]..w[1]] {
-                let first = first_accurate[i as usize] as usize;
+            for (k, &count) in counts.iter().enumerate().filter(|(_, c)| **c > 0) {
+                let first = k / 2;
                 for c in acc.iter_mut().skip(first) {
-                    *c += 1;
+                    *c += count;
                 }
-                if inaccurate[i as usize] {
-                    for c in inacc.iter_mut().take(first.min(tolerances)) {
-                        *c += 1;
+                if k % 2 == 1 {
+                    for c in inacc.iter_mut().take(first) {
+                        *c += count;
                     }
                 }
             }
@@ -85,7 +166,7 @@ pub fn accuracy(
                     valid[t] += 1;
                 }
             }
-        }
+        });
     }
     let results = (0..tolerances)
         .map(|t| {
@@ -111,24 +192,30 @@ pub fn completeness(
     let mut sum = vec![0f64; tolerances];
     let mut cell_count = 0usize;
     let mut complete = vec![0usize; tolerances];
+    let class = |i: usize| first_complete[i].min(tolerances as u32);
     for shift in GRID_SHIFTS {
-        let (order, bounds) = grouped(points, voxel_size_inv, shift);
-        for w in bounds.windows(2) {
-            complete.iter_mut().for_each(|c| *c = 0);
-            for &i in &order[w[0]..w[1]] {
-                for c in complete
-                    .iter_mut()
-                    .skip(first_complete[i as usize] as usize)
-                {
-                    *c += 1;
+        per_cell_classes(
+            points,
+            class,
+            tolerances as u32 + 1,
+            voxel_size_inv,
+            shift,
+            |counts| {
+                complete.iter_mut().for_each(|c| *c = 0);
+                let mut all = 0usize;
+                for (first, &count) in counts.iter().enumerate() {
+                    for c in complete.iter_mut().skip(first) {
+                        *c += count;
+                    }
+                    all += count;
                 }
-            }
-            let count = (w[1] - w[0]) as f64;
-            for t in 0..tolerances {
-                sum[t] += complete[t] as f64 / count;
-            }
-            cell_count += 1;
-        }
+                let count = all as f64;
+                for t in 0..tolerances {
+                    sum[t] += complete[t] as f64 / count;
+                }
+                cell_count += 1;
+            },
+        );
     }
     let results = (0..tolerances)
         .map(|t| (sum[t] / cell_count as f64) as f32)
@@ -145,6 +232,63 @@ mod tests {
         let inv = voxel_size_inv(0.01);
         assert_eq!(cell_of(&[0.015, -0.015, -0.02], inv, 0.0), [1, -2, -2]);
         assert_eq!(cell_of(&[0.015, -0.015, 0.0], inv, 0.5), [2, -1, 0]);
+    }
+
+    /// The counts per cell in key order, from a map: what `per_cell_classes` must visit.
+    fn counts_by_map(points: &[[f32; 3]], class: &[u32], classes: u32) -> Vec<Vec<usize>> {
+        let mut map = std::collections::BTreeMap::<[i32; 3], Vec<usize>>::new();
+        for (p, &c) in points.iter().zip(class) {
+            map.entry(cell_of(p, voxel_size_inv(0.01), 0.5))
+                .or_insert_with(|| vec![0; classes as usize])[c as usize] += 1;
+        }
+        map.into_values().collect()
+    }
+
+    #[test]
+    fn cells_are_visited_in_key_order_with_their_class_counts() {
+        let mut state = 0x2545_f491_4f6c_dd1du64;
+        let mut next = move || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state >> 11) as f64 / (1u64 << 53) as f64
+        };
+        // A cloud whose cells pack into 64 bits, one whose spans do not (about 2^32 cells an
+        // axis: the coordinate-triple sort), and one with a non-finite point.
+        for (scale, n) in [(0.3f64, 5000), (2.0e7, 3000), (0.05, 2000)] {
+            let mut points: Vec<[f32; 3]> = (0..n)
+                .map(|_| [0, 1, 2].map(|_| ((next() - 0.5) * scale) as f32))
+                .collect();
+            if scale == 0.05 {
+                points[7] = [f32::NAN, 0.0, 1.0];
+                // Several points in one cell.
+                for k in 0..50 {
+                    points[100 + k] = [0.001, 0.002, 0.003];
+                }
+            }
+            let classes = 7;
+            let class: Vec<u32> = (0..n).map(|_| (next() * 7.0) as u32).collect();
+            let mut visited = Vec::new();
+            per_cell_classes(
+                &points,
+                |i| class[i],
+                classes,
+                voxel_size_inv(0.01),
+                0.5,
+                |counts| visited.push(counts.to_vec()),
+            );
+            assert_eq!(
+                visited,
+                counts_by_map(&points, &class, classes),
+                "scale {scale}"
+            );
+        }
+        let packs = |cells: &[[i32; 3]]| Packing::of(cells, 7).is_some();
+        assert!(packs(&[[-5, 0, 3], [9, 2, -1]]));
+        assert!(!packs(&[
+            [i32::MIN, i32::MIN, i32::MIN],
+            [i32::MAX, i32::MAX, i32::MAX]
+        ]));
     }
 
     #[test]

@@ -67,19 +67,31 @@ pub struct Eth3dOutputs {
 
 impl Eth3dOutputs {
     /// The tool's coloured clouds (`completeness.tolerance_T.ply`, `accuracy.tolerance_T.ply`)
-    /// by file name, made one at a time as `write` asks for them (each is 15 bytes a point).
-    pub fn write_vis_files(&self, mut write: impl FnMut(&str, &[u8]) -> Result<()>) -> Result<()> {
-        for (t, &tolerance) in self.evaluation.tolerances.iter().enumerate() {
-            write(
-                &eth3d::vis::file_name("completeness", tolerance),
-                &eth3d::vis::completeness_ply(&self.evaluation, t),
-            )?;
-            write(
-                &eth3d::vis::file_name("accuracy", tolerance),
-                &eth3d::vis::accuracy_ply(&self.evaluation, &self.recon, t),
-            )?;
-        }
-        Ok(())
+    /// by file name, as `write` asks for them. Two writers take the tolerances in turn, each
+    /// with its own copy of each kind's cloud, encoded once (15 bytes a point) and coloured
+    /// again for each tolerance: one's write to disk overlaps the other's colouring and write.
+    pub fn write_vis_files(&self, write: impl Fn(&str, &[u8]) -> Result<()> + Sync) -> Result<()> {
+        let e = &self.evaluation;
+        let writer = |first: usize| -> Result<()> {
+            let mut completeness: Option<eth3d::vis::PclCloud> = None;
+            let mut accuracy: Option<eth3d::vis::PclCloud> = None;
+            for (t, &tolerance) in e.tolerances.iter().enumerate().skip(first).step_by(2) {
+                let cloud =
+                    completeness.get_or_insert_with(|| eth3d::vis::PclCloud::new(&e.scan_points));
+                write(
+                    &eth3d::vis::file_name("completeness", tolerance),
+                    cloud.colour(eth3d::vis::completeness_colours(e, t)),
+                )?;
+                let cloud = accuracy.get_or_insert_with(|| eth3d::vis::PclCloud::new(&self.recon));
+                write(
+                    &eth3d::vis::file_name("accuracy", tolerance),
+                    cloud.colour(eth3d::vis::accuracy_colours(e, t)),
+                )?;
+            }
+            Ok(())
+        };
+        let (even, odd) = sfmeval::parallel::join(|| writer(0), || writer(1));
+        even.and(odd)
     }
 }
 
