@@ -368,14 +368,17 @@ pub fn evaluate(
         progress.finish();
         d
     };
-    // Each side's distances sorted once, for the scores, the curves and the median.
+    // Each side's distances sorted once, for the scores, the curves and the median (finite
+    // distances: the order is the total order's, whichever sort makes it).
     let sorted = |d: &[f64]| {
         let mut s = d.to_vec();
-        s.sort_by(f64::total_cmp);
+        parallel::sort_floats(&mut s);
         s
     };
-    let (precision_sorted, recall_sorted) =
-        (sorted(&precision_distances), sorted(&recall_distances));
+    let (precision_sorted, recall_sorted) = parallel::join(
+        || sorted(&precision_distances),
+        || sorted(&recall_distances),
+    );
     let scores = curves::scores(&precision_sorted, &recall_sorted, tau, PLOT_STRETCH);
 
     let (axis, axis_min, axis_max, polygon_vertices) = match volume {

@@ -244,7 +244,7 @@ pub fn sort_unstable<T: Ord + Send>(slice: &mut [T]) {
 
 /// Sorts numbers ascending with NaN last (the order of JavaScript's typed-array sort), in
 /// parallel where threads are available. Every NaN becomes the positive quiet NaN.
-pub(crate) fn sort_floats(values: &mut [f64]) {
+pub fn sort_floats(values: &mut [f64]) {
     for v in values.iter_mut().filter(|v| v.is_nan()) {
         *v = f64::NAN;
     }
