@@ -9,7 +9,7 @@
 //! the tool's `float` arithmetic, and the smallest of those is the tool's nearest distance;
 //! elsewhere the double distance falls on the same side of every tolerance as the float one.
 
-use sfmeval::distance::{KdCloud, NO_POINT, distance2};
+use sfmeval::distance::{KdCloud, NO_POINT, NeighbourList};
 use sfmeval::geometry::Point3;
 
 /// Candidates measured again in `float` (points within rounding of the nearest).
@@ -51,25 +51,17 @@ pub fn first_complete(
     Ok(sfmeval::parallel::map_points_with_state(
         &scan_f64,
         &sfmeval::progress::NoProgress,
-        |previous: &mut Previous, q| {
+        |list: &mut NeighbourList, q| {
             if !q.iter().all(|c| c.is_finite()) {
                 return n as u32;
             }
-            // The nearest point in double, bounded by the previous query's answer (a neighbour
-            // in the visiting order).
-            let mut bound = (radius2, NO_POINT);
-            if let Some(slot) = previous.0 {
-                let d2 = distance2(tree.point(slot), *q);
-                if d2 < radius2 {
-                    bound = (d2, slot);
-                }
-            }
-            let (d2, slot) = tree.nearest_below(*q, bound);
+            // The nearest point in double, through the neighbour list the queries before this
+            // one made (neighbours in the visiting order): exactly the tree's answer.
+            let (d2, slot) = list.nearest_below(&tree, *q, (radius2, NO_POINT), radius2, None);
             if slot == NO_POINT {
                 return n as u32;
             }
-            previous.0 = Some(slot);
-            // The float distance of each candidate lies within FLOAT_ERROR of its double one,
+            // The float distance of each candidate lies within NEAR_THRESHOLD of its double one,
             // so the float nearest does too: unless a threshold lies that close, it falls on
             // the same side of every threshold as the double nearest.
             let near_threshold = thresholds
@@ -94,10 +86,6 @@ const NEAR_THRESHOLD: f64 = 1e-5;
 
 /// Squared distances below which the float squares may lose bits to underflow.
 const TINY2: f64 = 1e-30;
-
-/// The previous query's nearest slot.
-#[derive(Default)]
-struct Previous(Option<usize>);
 
 /// The tool's squared nearest distance to `q` in float: the `CANDIDATES` nearest in double
 /// measured again as FLANN measures them (infinite when none is within `radius2`).
