@@ -24,7 +24,7 @@ use super::trajectory::{LogFrame, MAPPING_ABOVE_FRAMES};
 use super::trajectory_alignment::{TrajectoryAlignmentOptions, align_trajectories};
 use super::voxel::voxel_down_sample;
 use sfmeval::crop::{Axis, Volume};
-use sfmeval::distance::{KdCloud, NO_POINT};
+use sfmeval::distance::{KdCloud, NO_POINT, NeighbourList};
 use sfmeval::geometry::Point3;
 use sfmeval::note::{Code, Note};
 use sfmeval::parallel;
@@ -485,6 +485,16 @@ pub fn evaluate(
 /// `compute_point_cloud_distance`), each search bounded from the start by the previous point's
 /// answer in the Morton visiting order; the distances are those of an unbounded search.
 fn nearest_distances(points: &[Point3], index: &KdCloud, progress: &dyn Progress) -> Vec<f64> {
+    if points.len() >= LISTED_QUERIES_PER_POINT * index.len() {
+        // Queries much denser than the index (the recall of a sparse cloud): consecutive ones
+        // mostly find their nearest within the coverage of the neighbour list the queries
+        // before them made, without a walk of the tree (the same bits).
+        return parallel::map_points_with_state(points, progress, |list: &mut NeighbourList, p| {
+            let (d2, _) =
+                list.nearest_below(index, *p, (f64::INFINITY, NO_POINT), f64::INFINITY, None);
+            d2.sqrt()
+        });
+    }
     parallel::map_points_with_state(points, progress, |previous: &mut Option<usize>, p| {
         let (d, k) = index.nearest_from(*p, previous.unwrap_or(NO_POINT));
         if k != NO_POINT {
@@ -493,6 +503,9 @@ fn nearest_distances(points: &[Point3], index: &KdCloud, progress: &dyn Progress
         d
     })
 }
+
+/// Queries per index point from which [`nearest_distances`] reads neighbour lists.
+const LISTED_QUERIES_PER_POINT: usize = 8;
 
 /// The camera centres the alignment uses: every frame's, or through the mapping file the
 /// reference frames of a video trajectory (longer than [`MAPPING_ABOVE_FRAMES`]).
