@@ -121,20 +121,14 @@ mod tests {
 
     /// The tool's rule by brute force: the float nearest over every point, then its loop.
     fn brute_force(scan: &[[f32; 3]], recon: &[[f32; 3]], tolerances2: &[f32]) -> Vec<u32> {
-        let n = tolerances2.len();
+        let thresholds: Vec<f64> = tolerances2.iter().map(|&t| f64::from(t)).collect();
         scan.iter()
             .map(|q| {
                 let best = recon
                     .iter()
                     .map(|p| flann_distance2(q, p))
                     .fold(f32::INFINITY, f32::min);
-                if !(best < tolerances2[n - 1]) {
-                    return n as u32;
-                }
-                (0..n - 1)
-                    .rev()
-                    .find(|&t| tolerances2[t] < best)
-                    .map_or(0, |t| t as u32 + 1)
+                first_tolerance(f64::from(best), &thresholds)
             })
             .collect()
     }
