@@ -1,6 +1,9 @@
 //! Order-preserving parallel map: rayon with the `parallel` feature, a plain loop without it.
 //! Results come back in input order, so every later reduction is independent of thread count.
 
+use std::panic::{AssertUnwindSafe, catch_unwind, resume_unwind};
+use std::sync::atomic::{AtomicBool, Ordering};
+
 use crate::geometry::Point3;
 use crate::progress::Progress;
 use crate::spatial_order::morton_keys;
@@ -88,11 +91,14 @@ where
     S: Default,
     F: Fn(&mut S, &T) -> R + Sync + Send,
 {
+    let abandon = Abandon::default();
     let run = |c: &[T]| {
-        let mut state = S::default();
-        let out: Vec<R> = c.iter().map(|t| f(&mut state, t)).collect();
-        progress.advance(c.len() as u64);
-        out
+        abandon.run(|| {
+            let mut state = S::default();
+            let out: Vec<R> = c.iter().map(|t| f(&mut state, t)).collect();
+            progress.advance(c.len() as u64);
+            out
+        })
     };
     #[cfg(feature = "parallel")]
     {
@@ -348,12 +354,15 @@ where
     F: Fn(&mut S, usize) -> R + Sync + Send,
 {
     let starts: Vec<usize> = (start..end).step_by(STATE_CHUNK).collect();
+    let abandon = Abandon::default();
     let chunk = |&s: &usize| {
-        let e = (s + STATE_CHUNK).min(end);
-        let mut state = S::default();
-        let out: Vec<R> = (s..e).map(|k| f(&mut state, k)).collect();
-        progress.advance((e - s) as u64);
-        out
+        abandon.run(|| {
+            let e = (s + STATE_CHUNK).min(end);
+            let mut state = S::default();
+            let out: Vec<R> = (s..e).map(|k| f(&mut state, k)).collect();
+            progress.advance((e - s) as u64);
+            out
+        })
     };
     #[cfg(feature = "parallel")]
     let chunks: Vec<Vec<R>> = {
@@ -367,6 +376,30 @@ where
         out.extend(c);
     }
     out
+}
+
+/// Lets the chunks of one map that reports progress stop early. A chunk that panics (a front
+/// end's hook stopping the work, as the Python package's Ctrl-C does, or a bug) marks the map
+/// abandoned, and the chunks that start after it return nothing instead of doing their work:
+/// rayon runs the rest of a split before it passes a panic on (on one thread, all the rest of
+/// the map), so without this a stop asked for early came near the stage's end.
+#[derive(Default)]
+struct Abandon(AtomicBool);
+
+impl Abandon {
+    /// `work()`, or nothing once a chunk of the map has panicked.
+    fn run<R>(&self, work: impl FnOnce() -> Vec<R>) -> Vec<R> {
+        if self.0.load(Ordering::Relaxed) {
+            return Vec::new();
+        }
+        match catch_unwind(AssertUnwindSafe(work)) {
+            Ok(out) => out,
+            Err(payload) => {
+                self.0.store(true, Ordering::Relaxed);
+                resume_unwind(payload)
+            }
+        }
+    }
 }
 
 /// Indices of `points` in Morton order (`spatial_order::morton_keys`, sorted in parallel): ties
@@ -516,6 +549,64 @@ mod tests {
         assert_eq!(got.len(), want.len());
         for (g, w) in got.iter().zip(&want) {
             assert!(g.0.to_bits() == w.0.to_bits() && g.1 == w.1);
+        }
+    }
+
+    /// A panic in one chunk reaches the caller without the rest of the map being worked
+    /// through: on one thread only the first chunk runs; on two, at most one more a thread
+    /// (the chunks already started). Both maps that report progress.
+    #[cfg(feature = "parallel")]
+    #[test]
+    fn a_stop_in_one_chunk_skips_the_chunks_not_started() {
+        /// A hook that stops the work at its first call (as the Python package's Ctrl-C does).
+        struct StopAtFirstAdvance;
+
+        impl Progress for StopAtFirstAdvance {
+            fn start(&self, _: crate::progress::Stage, _: u64) {}
+            fn advance(&self, _: u64) {
+                std::panic::resume_unwind(Box::new("stop"));
+            }
+            fn finish(&self) {}
+        }
+        use std::sync::atomic::AtomicUsize;
+        let items = vec![0u32; 64 * CHUNK];
+        let chunks = items.len() / CHUNK;
+        for threads in [1, 2] {
+            let Ok(pool) = rayon::ThreadPoolBuilder::new().num_threads(threads).build() else {
+                panic!("a pool of {threads} threads");
+            };
+            let worked = AtomicUsize::new(0);
+            let count = |_: &mut (), _: &u32| {
+                worked.fetch_add(1, Ordering::Relaxed);
+            };
+            let stopped = pool.install(|| {
+                catch_unwind(AssertUnwindSafe(|| {
+                    map_with_state(&items, &StopAtFirstAdvance, count)
+                }))
+            });
+            assert!(stopped.is_err());
+            let per_chunk = (items.len() / (4 * threads)).clamp(256, CHUNK);
+            let ran = worked.load(Ordering::Relaxed).div_ceil(per_chunk);
+            assert!(
+                ran <= 2 * threads,
+                "{threads} threads: {ran} of {chunks} chunks ran"
+            );
+
+            let worked = AtomicUsize::new(0);
+            let count = |_: &mut (), _: usize| {
+                worked.fetch_add(1, Ordering::Relaxed);
+            };
+            let stopped = pool.install(|| {
+                catch_unwind(AssertUnwindSafe(|| {
+                    map_range_with_state(0, 64 * STATE_CHUNK, &StopAtFirstAdvance, count)
+                }))
+            });
+            assert!(stopped.is_err());
+            let ran = worked.load(Ordering::Relaxed).div_ceil(STATE_CHUNK);
+            assert!(
+                ran <= 2 * threads,
+                "{threads} threads: {ran} of 64 ranges ran"
+            );
         }
     }
 }
