@@ -118,6 +118,8 @@ fn first_tolerance(best2: f64, thresholds: &[f64]) -> u32 {
 #[allow(clippy::unwrap_used)]
 mod tests {
     use super::*;
+    use rand::{Rng as _, SeedableRng as _};
+    use rand_chacha::ChaCha8Rng;
 
     /// The tool's rule by brute force: the float nearest over every point, then its loop.
     fn brute_force(scan: &[[f32; 3]], recon: &[[f32; 3]], tolerances2: &[f32]) -> Vec<u32> {
@@ -135,13 +137,8 @@ mod tests {
 
     #[test]
     fn equals_the_float_rule_also_at_the_tolerances() {
-        let mut state = 0x9e37_79b9_7f4a_7c15u64;
-        let mut next = move || {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            (state >> 11) as f32 / (1u64 << 53) as f32
-        };
+        let mut rng = ChaCha8Rng::seed_from_u64(0x9e37_79b9_7f4a_7c15u64);
+        let mut next = move || rng.random::<f32>();
         let tolerances = [0.01f32, 0.02, 0.05, 0.1];
         let tolerances2: Vec<f32> = tolerances.iter().map(|t| t * t).collect();
         let recon: Vec<[f32; 3]> = (0..300)

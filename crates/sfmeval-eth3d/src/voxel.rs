@@ -226,6 +226,8 @@ pub fn completeness(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use rand::{Rng as _, SeedableRng as _};
+    use rand_chacha::ChaCha8Rng;
 
     #[test]
     fn cells_floor_as_the_tool_does() {
@@ -246,13 +248,8 @@ mod tests {
 
     #[test]
     fn cells_are_visited_in_key_order_with_their_class_counts() {
-        let mut state = 0x2545_f491_4f6c_dd1du64;
-        let mut next = move || {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            (state >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut rng = ChaCha8Rng::seed_from_u64(0x2545_f491_4f6c_dd1du64);
+        let mut next = move || rng.random::<f64>();
         // A cloud whose cells pack into 64 bits, one whose spans do not (about 2^32 cells an
         // axis: the coordinate-triple sort), and one with a non-finite point.
         for (scale, n) in [(0.3f64, 5000), (2.0e7, 3000), (0.05, 2000)] {

@@ -218,6 +218,8 @@ fn fit(source: &[Point3], target: &[Point3], frames: &[u32]) -> Matrix4 {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use rand::{Rng as _, SeedableRng as _};
+    use rand_chacha::ChaCha8Rng;
 
     #[test]
     fn finds_the_similarity_despite_outliers_and_is_reproducible() {
@@ -286,13 +288,8 @@ mod tests {
         centres[7] = centres[3];
         centres[8] = [centres[9][0] + 1e-12, centres[9][1], centres[9][2]];
         let reference = Reference::new(&centres).unwrap();
-        let mut s = 0x2545_f491_4f6c_dd1du64;
-        let mut next = move || {
-            s ^= s << 13;
-            s ^= s >> 7;
-            s ^= s << 17;
-            (s >> 11) as f64 / (1u64 << 53) as f64 - 0.5
-        };
+        let mut rng = ChaCha8Rng::seed_from_u64(0x2545_f491_4f6c_dd1du64);
+        let mut next = move || rng.random::<f64>() - 0.5;
         let mut shortcuts = 0;
         for reach in [1e-6, 0.01, 0.1, 0.3, 1.0, 10.0] {
             for (k, c) in centres.iter().enumerate() {

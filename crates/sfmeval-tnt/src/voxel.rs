@@ -301,6 +301,8 @@ impl Hasher for VoxelHasher {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use rand::{Rng as _, SeedableRng as _};
+    use rand_chacha::ChaCha8Rng;
 
     #[test]
     fn means_per_voxel_anchored_half_a_voxel_below_the_minimum() {
@@ -331,13 +333,8 @@ mod tests {
 
     #[test]
     fn bounds_equal_the_pairwise_minimum_and_maximum() {
-        let mut state = 0x9e37_79b9_7f4a_7c15u64;
-        let mut next = move || {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            (state >> 11) as f64 / (1u64 << 53) as f64 - 0.5
-        };
+        let mut rng = ChaCha8Rng::seed_from_u64(0x9e37_79b9_7f4a_7c15u64);
+        let mut next = move || rng.random::<f64>() - 0.5;
         let specials = [f64::NAN, f64::INFINITY, f64::NEG_INFINITY, -0.0];
         for n in [1usize, 3, 4, 5, 17, 70_001] {
             for special in [None, Some(0), Some(1), Some(2), Some(3)] {
@@ -370,14 +367,9 @@ mod tests {
 
     #[test]
     fn radix_sort_orders_by_the_high_bits_stably() {
-        let mut state = 0x853c_49e6_748f_ea9bu64;
+        let mut rng = ChaCha8Rng::seed_from_u64(0x853c_49e6_748f_ea9b);
         let mut keys: Vec<u64> = (0..20_000u64)
-            .map(|i| {
-                state ^= state << 13;
-                state ^= state >> 7;
-                state ^= state << 17;
-                ((state % 3000) << 32) | i
-            })
+            .map(|i| (rng.random_range(0..3000u64) << 32) | i)
             .collect();
         let mut want = keys.clone();
         want.sort_unstable();
@@ -397,13 +389,8 @@ mod tests {
     #[test]
     fn sorted_and_packed_runs_equal_the_hash_map_in_voxels_order_and_bits() {
         // 60k seeded points over ~4k voxels, in no spatial order, several chunks of the sort.
-        let mut state = 0x2545_f491_4f6c_dd1du64;
-        let mut next = move || {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            (state >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut rng = ChaCha8Rng::seed_from_u64(0x2545_f491_4f6c_dd1d);
+        let mut next = move || rng.random::<f64>();
         let pts: Vec<Point3> = (0..60_000)
             .map(|_| [next() * 16.0, next() * 16.0 - 8.0, next() * 16.0 + 1e3])
             .collect();

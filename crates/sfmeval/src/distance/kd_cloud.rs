@@ -119,16 +119,13 @@ pub fn distance2(a: Point3, b: Point3) -> f64 {
 mod tests {
     use super::*;
     use crate::distance::CloudIndex;
+    use rand::{Rng as _, SeedableRng as _};
+    use rand_chacha::ChaCha8Rng;
 
     /// A seeded scatter with clumps of exact duplicates.
     fn cloud(n: usize, seed: u64) -> Vec<Point3> {
-        let mut s = seed.wrapping_mul(0x9e37_79b9_7f4a_7c15) | 1;
-        let mut next = move || {
-            s ^= s << 13;
-            s ^= s >> 7;
-            s ^= s << 17;
-            (s >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut rng = ChaCha8Rng::seed_from_u64(seed);
+        let mut next = move || rng.random::<f64>();
         (0..n)
             .map(|i| {
                 if i % 11 == 0 {

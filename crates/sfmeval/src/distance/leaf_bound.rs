@@ -150,6 +150,8 @@ pub(crate) fn margin(p_local: Point3, origin: Point3, extent: Point3) -> f32 {
 #[allow(clippy::disallowed_methods)]
 pub(super) mod tests {
     use super::*;
+    use rand::{Rng as _, SeedableRng as _};
+    use rand_chacha::ChaCha8Rng;
 
     /// Exact squared point-triangle distance (Ericson's region walk), f64; the oriented boxes'
     /// tests use it too.
@@ -171,13 +173,8 @@ pub(super) mod tests {
     }
 
     fn rng(seed: u64) -> impl FnMut() -> f64 {
-        let mut s = seed;
-        move || {
-            s ^= s << 13;
-            s ^= s >> 7;
-            s ^= s << 17;
-            (s >> 11) as f64 / (1u64 << 53) as f64
-        }
+        let mut rng = ChaCha8Rng::seed_from_u64(seed);
+        move || rng.random::<f64>()
     }
 
     fn check(origin: Point3, size: f64, far: f64, seed: u64) -> usize {

@@ -163,18 +163,15 @@ fn read(
 mod tests {
     use super::*;
     use crate::distance::kd_cloud::NO_POINT;
+    use rand::{Rng as _, SeedableRng as _};
+    use rand_chacha::ChaCha8Rng;
 
     /// A seeded cloud with exact duplicates: points on a coarse lattice (a few copies of each
     /// site, many sites at the same distance from a query: ties the list decides) and a clump
     /// of more than `LIST_LEN` copies of one point (ties only the tree decides).
     fn cloud(n: usize, seed: u64) -> Vec<Point3> {
-        let mut s = seed.wrapping_mul(0x9e37_79b9_7f4a_7c15) | 1;
-        let mut next = move || {
-            s ^= s << 13;
-            s ^= s >> 7;
-            s ^= s << 17;
-            (s >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut rng = ChaCha8Rng::seed_from_u64(seed);
+        let mut next = move || rng.random::<f64>();
         (0..n)
             .map(|i| match i % 5 {
                 0 => [0.5, 0.25, 0.125],

@@ -5,6 +5,9 @@
 
 use std::collections::BTreeMap;
 
+use rand::{Rng as _, SeedableRng as _};
+use rand_chacha::ChaCha8Rng;
+
 use super::*;
 
 /// Bytes of a file under `tests/fixtures/models/`.
@@ -14,25 +17,6 @@ pub(crate) fn fixture(name: &str) -> Vec<u8> {
         env!("CARGO_MANIFEST_DIR")
     );
     std::fs::read(&path).unwrap_or_else(|e| panic!("fixture {path}: {e}"))
-}
-
-/// xorshift64*: a tiny deterministic generator.
-struct Rng(u64);
-
-impl Rng {
-    fn next(&mut self) -> u64 {
-        self.0 ^= self.0 >> 12;
-        self.0 ^= self.0 << 25;
-        self.0 ^= self.0 >> 27;
-        self.0.wrapping_mul(0x2545_F491_4F6C_DD1D)
-    }
-    fn below(&mut self, n: usize) -> usize {
-        if n == 0 {
-            0
-        } else {
-            (self.next() % n as u64) as usize
-        }
-    }
 }
 
 const INTERESTING: &[&[u8]] = &[
@@ -59,39 +43,39 @@ const INTERESTING: &[&[u8]] = &[
 
 /// One random mutation: flip bytes, overwrite with an interesting token, insert, delete a span,
 /// truncate, or duplicate a span.
-fn mutate(rng: &mut Rng, src: &[u8]) -> Vec<u8> {
+fn mutate(rng: &mut ChaCha8Rng, src: &[u8]) -> Vec<u8> {
     let mut b = src.to_vec();
-    let rounds = 1 + rng.below(4);
+    let rounds = 1 + rng.random_range(0..4);
     for _ in 0..rounds {
         let len = b.len();
-        let pos = rng.below(len + 1);
-        match rng.below(7) {
+        let pos = rng.random_range(0..len + 1);
+        match rng.random_range(0..7) {
             0 => {
                 if let Some(x) = b.get_mut(pos) {
-                    *x ^= 1 << rng.below(8);
+                    *x ^= 1 << rng.random_range(0..8);
                 }
             }
             1 => {
                 if let Some(x) = b.get_mut(pos) {
-                    *x = rng.next() as u8;
+                    *x = rng.random::<u8>();
                 }
             }
             2 => {
-                let tok = INTERESTING[rng.below(INTERESTING.len())];
+                let tok = INTERESTING[rng.random_range(0..INTERESTING.len())];
                 let end = (pos + tok.len()).min(len);
                 b.splice(pos..end, tok.iter().copied());
             }
             3 => {
-                let tok = INTERESTING[rng.below(INTERESTING.len())];
+                let tok = INTERESTING[rng.random_range(0..INTERESTING.len())];
                 b.splice(pos..pos, tok.iter().copied());
             }
             4 => {
-                let end = (pos + rng.below(64)).min(len);
+                let end = (pos + rng.random_range(0..64)).min(len);
                 b.drain(pos..end);
             }
             5 => b.truncate(pos),
             _ => {
-                let end = (pos + rng.below(64)).min(len);
+                let end = (pos + rng.random_range(0..64)).min(len);
                 let chunk: Vec<u8> = b.get(pos..end).unwrap_or_default().to_vec();
                 b.splice(pos..pos, chunk);
             }
@@ -104,9 +88,9 @@ fn mutate(rng: &mut Rng, src: &[u8]) -> Vec<u8> {
 const N: usize = 10_000;
 
 fn hammer(label: &str, sources: &[Vec<u8>], seed: u64, mut read: impl FnMut(usize, &[u8])) {
-    let mut rng = Rng(seed);
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
     for i in 0..N {
-        let which = rng.below(sources.len());
+        let which = rng.random_range(0..sources.len());
         let m = mutate(&mut rng, &sources[which]);
         let result = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| read(which, &m)));
         assert!(
@@ -164,9 +148,9 @@ fn colmap_folder_never_panics() {
     }
     let keys: Vec<String> = files.keys().cloned().collect();
     let src: Vec<Vec<u8>> = files.values().cloned().collect();
-    let mut rng = Rng(3);
+    let mut rng = ChaCha8Rng::seed_from_u64(3);
     for _ in 0..N / 10 {
-        let which = rng.below(src.len());
+        let which = rng.random_range(0..src.len());
         let mut f = files.clone();
         f.insert(keys[which].clone(), mutate(&mut rng, &src[which]));
         let _ = colmap::read_colmap_folder(&f);
@@ -216,7 +200,7 @@ fn strip_and_pose_metrics_never_panic_on_mutated_models() {
     // Whatever a mutated model reads as, the downstream code must cope.
     let gt = cameras_json::read_cameras_json(&fixture("gt_cameras.json")).unwrap();
     let src = [fixture("colmap38.nvm")];
-    let mut rng = Rng(8);
+    let mut rng = ChaCha8Rng::seed_from_u64(8);
     let mut evaluated = 0;
     for _ in 0..N / 5 {
         let m = mutate(&mut rng, &src[0]);
