@@ -218,8 +218,6 @@ fn fit(source: &[Point3], target: &[Point3], frames: &[u32]) -> Matrix4 {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use rand::{Rng as _, SeedableRng as _};
-    use rand_chacha::ChaCha8Rng;
 
     #[test]
     fn finds_the_similarity_despite_outliers_and_is_reproducible() {
