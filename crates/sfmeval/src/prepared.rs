@@ -5,7 +5,7 @@ use crate::distance::{CloudIndex, MeshHint, MeshIndex};
 use crate::error::{Error, Result};
 use crate::geometry::{Aabb, GroundTruth, Point3};
 use crate::progress::{Progress, Stage};
-use crate::sampling::sample_surface;
+use crate::sampling::sample_surface_with_area;
 
 enum GtIndex {
     Mesh(Box<MeshIndex>),
@@ -50,7 +50,7 @@ impl PreparedGroundTruth {
                 m.validate("mesh")?;
                 let (idx, sampled) = crate::parallel::join(
                     || MeshIndex::of_validated(m),
-                    || sample_surface(m, samples, seed).map(|s| (s, m.area())),
+                    || sample_surface_with_area(m, samples, seed),
                 );
                 progress.finish();
                 progress.start(Stage::Sampling, 1);

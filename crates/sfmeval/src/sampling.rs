@@ -13,6 +13,16 @@ const WORDS_PER_SAMPLE: u128 = 6;
 
 /// Draws `n` points uniformly by area on the mesh surface.
 pub fn sample_surface(mesh: &TriangleMesh, n: usize, seed: u64) -> Result<Vec<Point3>> {
+    sample_surface_with_area(mesh, n, seed).map(|(samples, _)| samples)
+}
+
+/// [`sample_surface`] and the mesh's surface area, the sum its sampling adds up anyway (the
+/// same bits as [`TriangleMesh::area`]: the same areas added in the same order).
+pub fn sample_surface_with_area(
+    mesh: &TriangleMesh,
+    n: usize,
+    seed: u64,
+) -> Result<(Vec<Point3>, f64)> {
     // The areas in parallel, their running sum in order (the same bits as one loop).
     let mut cumulative = parallel::map_range(mesh.triangles.len(), |i| {
         triangle_area(mesh.corners(&mesh.triangles[i]))
@@ -74,7 +84,7 @@ pub fn sample_surface(mesh: &TriangleMesh, n: usize, seed: u64) -> Result<Vec<Po
         place[k as usize] = j as u32;
     }
     drop(by_target);
-    Ok(parallel::map_range(n, |k| sorted[place[k] as usize]))
+    Ok((parallel::map_range(n, |k| sorted[place[k] as usize]), total))
 }
 
 #[cfg(test)]
@@ -103,6 +113,18 @@ mod tests {
                 .all(|p| p[2] == 0.0 && (p[0] < 5.0 && p[0] + p[1] <= 1.0 + 1e-12 || p[0] >= 10.0))
         );
         assert_eq!(s, sample_surface(&mesh, 100_000, 7).unwrap());
+        // The area of the sampling's running sum is the mesh's own, to the bit, on a mesh of
+        // many uneven triangles.
+        let mut rng = ChaCha8Rng::seed_from_u64(11);
+        let uneven = TriangleMesh {
+            vertices: (0..3000)
+                .map(|_| [0; 3].map(|_: i32| rng.random::<f64>() * 10.0 - 5.0))
+                .collect(),
+            triangles: (0..1000).map(|t| [3 * t, 3 * t + 1, 3 * t + 2]).collect(),
+        };
+        let (samples, area) = sample_surface_with_area(&uneven, 1000, 3).unwrap();
+        assert_eq!(area.to_bits(), uneven.area().to_bits());
+        assert_eq!(samples, sample_surface(&uneven, 1000, 3).unwrap());
         // The chunks drawn in parallel continue one stream: the samples of a per-sample loop.
         let mut rng = ChaCha8Rng::seed_from_u64(7);
         let total = 0.5 + 4.5;
