@@ -50,10 +50,8 @@ impl FileSource for Disk {
         if !p.is_file() {
             return Ok(None);
         }
-        if crate::stream::is_ply_file(p)
-            && let Some(ply) = crate::stream::read_ply_cloud(p)?
-        {
-            return sfmeval::io::point_cloud_from_ply(path, ply).map(Some);
+        if let Some(loaded) = crate::stream::read_streamed_cloud(p, path)? {
+            return Ok(Some(loaded));
         }
         sfmeval::files::read_whole_point_cloud(self, path)
     }

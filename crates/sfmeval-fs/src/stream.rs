@@ -6,6 +6,7 @@ use std::io::Read as _;
 use std::path::Path;
 
 use anyhow::{Context as _, Result};
+use sfmeval::io::LoadedCloud;
 use sfmeval::io::ply::PlyData;
 use sfmeval::io::ply_stream::{HEAD_BYTES, PlyCloudStream};
 use sfmeval::model;
@@ -21,8 +22,20 @@ const PIECE_BYTES: usize = 8 << 20;
 /// not one that streams (ascii, a mesh, ...: read it whole). The next piece is read while the
 /// last one is decoded. Errors reading the file are [`sfmeval::Error::Io`] naming it; format
 /// errors are the core's, as from a whole-file read.
-pub(crate) fn read_ply_cloud(path: &Path) -> sfmeval::Result<Option<PlyData>> {
+fn read_ply_cloud(path: &Path) -> sfmeval::Result<Option<PlyData>> {
     read_ply_cloud_in_pieces(path, PIECE_BYTES)
+}
+
+/// The point cloud in the binary PLY file at `path`, read in pieces ([`read_ply_cloud`]) and
+/// named `name` in the core's errors; `Ok(None)` when `path` is not a `.ply` file that streams
+/// (read it whole).
+pub(crate) fn read_streamed_cloud(path: &Path, name: &str) -> sfmeval::Result<Option<LoadedCloud>> {
+    if !is_ply_file(path) {
+        return Ok(None);
+    }
+    read_ply_cloud(path)?
+        .map(|ply| sfmeval::io::point_cloud_from_ply(name, ply))
+        .transpose()
 }
 
 /// [`read_ply_cloud`] with pieces of `piece_bytes`.
@@ -78,12 +91,7 @@ fn fill(file: &mut File, buf: &mut [u8]) -> std::io::Result<usize> {
 /// [`ReconInput`] either way. Errors name the path.
 pub fn read_reconstruction(path: &Path, name: &str) -> Result<ReconInput> {
     let context = || format!("reconstruction '{}'", path.display());
-    if is_ply_file(path)
-        && let Some(ply) = read_ply_cloud(path).with_context(context)?
-    {
-        let loaded = sfmeval::io::point_cloud_from_ply(&name_of(path), ply)
-            .map_err(anyhow::Error::new)
-            .with_context(context)?;
+    if let Some(loaded) = read_streamed_cloud(path, &name_of(path)).with_context(context)? {
         return Ok(pipeline::reconstruction_from_cloud(name, loaded));
     }
     pipeline::read_reconstruction(name, &read_input_files(path)?).with_context(context)
