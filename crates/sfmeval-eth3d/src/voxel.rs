@@ -44,43 +44,54 @@ fn per_cell_classes(
     classes: u32,
     voxel_size_inv: f32,
     shift: f32,
-    mut visit: impl FnMut(&[usize]),
+    visit: impl FnMut(&[usize]),
 ) {
     let cells: Vec<[i32; 3]> =
         sfmeval::parallel::map(points, &sfmeval::progress::NoProgress, |p| {
             cell_of(p, voxel_size_inv, shift)
         });
-    let mut counts = vec![0usize; classes as usize];
-    let mut flush = |counts: &mut Vec<usize>| {
-        visit(counts);
-        counts.iter_mut().for_each(|c| *c = 0);
-    };
     if let Some(packing) = Packing::of(&cells, classes) {
         let mut keys: Vec<u64> =
             sfmeval::parallel::map_range(cells.len(), |i| packing.key(&cells[i], class(i)));
         drop(cells);
         sfmeval::parallel::sort_unstable(&mut keys);
         let class_mask = (1u64 << packing.class_bits) - 1;
-        for (k, &key) in keys.iter().enumerate() {
-            if k > 0 && key >> packing.class_bits != keys[k - 1] >> packing.class_bits {
-                flush(&mut counts);
-            }
-            counts[(key & class_mask) as usize] += 1;
-        }
+        tally_runs(
+            &keys,
+            |key| (key >> packing.class_bits, (key & class_mask) as usize),
+            classes,
+            visit,
+        );
     } else {
         let mut keyed: Vec<([i32; 3], u32)> =
             sfmeval::parallel::map_range(cells.len(), |i| (cells[i], class(i)));
         drop(cells);
         sfmeval::parallel::sort_unstable(&mut keyed);
-        for k in 0..keyed.len() {
-            if k > 0 && keyed[k].0 != keyed[k - 1].0 {
-                flush(&mut counts);
-            }
-            counts[keyed[k].1 as usize] += 1;
-        }
+        tally_runs(&keyed, |&(cell, c)| (cell, c as usize), classes, visit);
     }
-    if !points.is_empty() {
-        flush(&mut counts);
+}
+
+/// Walks `sorted` (items grouped by cell), where `cell_class(item)` is an item's cell and
+/// class, and calls `visit(counts)` for each run of one cell with its items' count per class.
+fn tally_runs<T, C: PartialEq>(
+    sorted: &[T],
+    cell_class: impl Fn(&T) -> (C, usize),
+    classes: u32,
+    mut visit: impl FnMut(&[usize]),
+) {
+    let mut counts = vec![0usize; classes as usize];
+    let mut current = None;
+    for item in sorted {
+        let (cell, class) = cell_class(item);
+        if current.as_ref().is_some_and(|c| *c != cell) {
+            visit(&counts);
+            counts.iter_mut().for_each(|c| *c = 0);
+        }
+        current = Some(cell);
+        counts[class] += 1;
+    }
+    if current.is_some() {
+        visit(&counts);
     }
 }
 
